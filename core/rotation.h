@@ -39,9 +39,9 @@ std::optional<EulerOrder> EulerOrderFromAxes(const std::array<int, 3>& axes);
 // Angles in radians, angles[i] about axis EulerAxes(order)[i].
 Quat EulerToQuaternion(const Eigen::Vector3d& angles, EulerOrder order);
 
-// The Euler angles of q in `order`, with the middle angle in [-pi/2, pi/2]. Of the equivalent
-// angle triples, returns the one closest to `near` (each angle unwrapped by multiples of 2 pi),
-// which keeps consecutive frames continuous when exporting a clip.
+// The Euler angles of q in `order`. Of the equivalent triples (a, b, c) and
+// (a + pi, pi - b, c + pi), each angle unwrapped by multiples of 2 pi, returns the one closest to
+// `near`, which keeps consecutive frames continuous when exporting a clip.
 Eigen::Vector3d QuaternionToEuler(const Quat& q, EulerOrder order,
                                   const Eigen::Vector3d& near = Eigen::Vector3d::Zero());
 

@@ -1,0 +1,429 @@
+#include "core/bvh_reader.h"
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_replace.h"
+#include "tests/test_data.h"
+
+namespace motiondb {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Two joints: a 6-channel ZXY root and a 3-channel XYZ child with an End Site. 9 values a row.
+constexpr char kMinimal[] =
+    "HIERARCHY\n"                                                                 // 1
+    "ROOT Hips\n"                                                                 // 2
+    "{\n"                                                                         // 3
+    "\tOFFSET 0.0 0.0 0.0\n"                                                      // 4
+    "\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"  // 5
+    "\tJOINT Chest\n"                                                             // 6
+    "\t{\n"                                                                       // 7
+    "\t\tOFFSET 0.0 5.5 0.0\n"                                                    // 8
+    "\t\tCHANNELS 3 Xrotation Yrotation Zrotation\n"                              // 9
+    "\t\tEnd Site\n"                                                              // 10
+    "\t\t{\n"                                                                     // 11
+    "\t\t\tOFFSET 0.0 3.0 0.0\n"                                                  // 12
+    "\t\t}\n"                                                                     // 13
+    "\t}\n"                                                                       // 14
+    "}\n"                                                                         // 15
+    "MOTION\n"                                                                    // 16
+    "Frames: 2\n"                                                                 // 17
+    "Frame Time: 0.0333333\n"                                                     // 18
+    "1.0 90.0 -2.5 10.0 20.0 30.0 -40.0 50.0 60.0\n"                              // 19
+    "1.5 91.0 -2.0 11.0 21.0 31.0 -41.0 51.0 61.0\n";                             // 20
+
+absl::StatusOr<BvhReadResult> Read(absl::string_view text, const BvhReadOptions& options = {}) {
+  return ReadBvh(text, options);
+}
+
+std::string Replace(absl::string_view text, absl::string_view from, absl::string_view to) {
+  return absl::StrReplaceAll(text, {{from, to}});
+}
+
+TEST(BvhReader, ReadsHierarchyChannelsAndValues) {
+  absl::StatusOr<BvhReadResult> result = Read(kMinimal);
+  ASSERT_TRUE(result.ok()) << result.status();
+  const Clip& clip = result->clip;
+  const Skeleton& skeleton = clip.skeleton();
+  ASSERT_EQ(skeleton.joint_count(), 2);
+  EXPECT_EQ(skeleton.joint(0).name, "Hips");
+  EXPECT_EQ(skeleton.joint(1).name, "Chest");
+  EXPECT_EQ(skeleton.joint(1).parent, 0);
+  EXPECT_EQ(skeleton.joint(1).offset, Eigen::Vector3d(0, 5.5, 0));
+  ASSERT_TRUE(skeleton.joint(1).end_site.has_value());
+  EXPECT_EQ(*skeleton.joint(1).end_site, Eigen::Vector3d(0, 3, 0));
+  EXPECT_EQ(skeleton.channel_count(), 9);
+  EXPECT_EQ(skeleton.rotation_order(0), EulerOrder::kZXY);
+  EXPECT_EQ(skeleton.rotation_order(1), EulerOrder::kXYZ);
+  EXPECT_EQ(clip.frame_count(), 2);
+  EXPECT_NEAR(clip.fps(), 30.0, 1e-4);
+  EXPECT_TRUE(result->warnings.empty());
+  EXPECT_EQ(clip.root_position(1), Eigen::Vector3d(1.5, 91.0, -2.0));
+  const Quat root = EulerToQuaternion(Eigen::Vector3d(11, 21, 31) * kDeg, EulerOrder::kZXY);
+  const Quat chest = EulerToQuaternion(Eigen::Vector3d(-41, 51, 61) * kDeg, EulerOrder::kXYZ);
+  EXPECT_LT(AngleBetween(clip.rotation(1, 0), root), 1e-12);
+  EXPECT_LT(AngleBetween(clip.rotation(1, 1), chest), 1e-12);
+}
+
+// Every dialect below must parse to exactly the same clip as kMinimal.
+void ExpectSameAsMinimal(const std::string& text) {
+  absl::StatusOr<BvhReadResult> expected = Read(kMinimal);
+  absl::StatusOr<BvhReadResult> result = Read(text);
+  ASSERT_TRUE(result.ok()) << result.status() << "\n" << text;
+  EXPECT_EQ(result->clip.rotations(), expected->clip.rotations());
+  EXPECT_EQ(result->clip.positions(), expected->clip.positions());
+  EXPECT_EQ(result->clip.frame_time(), expected->clip.frame_time());
+  EXPECT_TRUE(result->warnings.empty());
+}
+
+TEST(BvhReaderDialects, CrlfLineEndings) { ExpectSameAsMinimal(Replace(kMinimal, "\n", "\r\n")); }
+
+TEST(BvhReaderDialects, NoFinalNewline) {
+  std::string text = kMinimal;
+  text.pop_back();
+  ExpectSameAsMinimal(text);
+  ExpectSameAsMinimal(Replace(text, "\n", "\r\n"));
+}
+
+TEST(BvhReaderDialects, SpacesInsteadOfTabsAndIndentedRows) {
+  std::string text = Replace(kMinimal, "\t", "    ");
+  text = Replace(text, "\n1.", "\n    1.");
+  ExpectSameAsMinimal(text);
+}
+
+TEST(BvhReaderDialects, TabAfterFramesAndGluedValues) {
+  ExpectSameAsMinimal(Replace(kMinimal, "Frames: 2", "Frames:\t2"));
+  ExpectSameAsMinimal(Replace(kMinimal, "Frames: 2", "Frames:2"));
+  ExpectSameAsMinimal(Replace(kMinimal, "Frame Time: 0.0333333", "Frame Time:\t0.0333333"));
+}
+
+TEST(BvhReaderDialects, ENotationAndExplicitPlus) {
+  ExpectSameAsMinimal(Replace(Replace(kMinimal, "90.0 -2.5", "9.0E+01 -2.5e0"), "1.5 ", "+1.5 "));
+}
+
+TEST(BvhReaderDialects, ByteOrderMarkAndBlankLines) {
+  ExpectSameAsMinimal("\xEF\xBB\xBF" + Replace(kMinimal, "\n1.5", "\n\n   \n1.5") + "\n\n");
+}
+
+TEST(BvhReaderDialects, BraceOnTheJointLine) {
+  ExpectSameAsMinimal(Replace(kMinimal, "JOINT Chest\n\t{\n", "JOINT Chest {\n"));
+}
+
+TEST(BvhReaderDialects, ColonsAndSpacesInJointNames) {
+  absl::StatusOr<BvhReadResult> result = Read(Replace(
+      Replace(kMinimal, "ROOT Hips", "ROOT mixamorig:Hips"), "JOINT Chest", "JOINT Upper Chest"));
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->clip.skeleton().joint(0).name, "mixamorig:Hips");
+  EXPECT_EQ(result->clip.skeleton().joint(1).name, "Upper Chest");
+}
+
+TEST(BvhReaderDialects, LeafWithoutEndSiteAndSixChannelsOnAChild) {
+  std::string text =
+      Replace(kMinimal, "\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 0.0 3.0 0.0\n\t\t}\n", "");
+  text = Replace(text, "CHANNELS 3 Xrotation Yrotation Zrotation",
+                 "CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation");
+  text = Replace(Replace(text, "-40.0", "7 8 9 -40.0"), "-41.0", "7 8 9 -41.0");
+  absl::StatusOr<BvhReadResult> result = Read(text);
+  ASSERT_TRUE(result.ok()) << result.status();
+  const Skeleton& skeleton = result->clip.skeleton();
+  EXPECT_FALSE(skeleton.joint(1).end_site.has_value());
+  EXPECT_EQ(skeleton.position_slot(1), 1);
+  EXPECT_EQ(result->clip.positions().row(0).tail<3>(), Eigen::RowVector3d(7, 8, 9));
+}
+
+TEST(BvhReaderDialects, JointWithoutChannelsIsIdentity) {
+  std::string text = Replace(kMinimal, "\t\tCHANNELS 3 Xrotation Yrotation Zrotation\n", "");
+  text = Replace(Replace(text, " -40.0 50.0 60.0", ""), " -41.0 51.0 61.0", "");
+  absl::StatusOr<BvhReadResult> result = Read(text);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_FALSE(result->clip.skeleton().has_rotation(1));
+  EXPECT_LT(AngleBetween(result->clip.rotation(0, 1), Quat::Identity()), 1e-15);
+}
+
+TEST(BvhReaderWarnings, FramesHeaderDisagreeingWithRowsKeepsTheRows) {
+  for (const char* header : {"Frames: 3", "Frames: 1"}) {
+    absl::StatusOr<BvhReadResult> result = Read(Replace(kMinimal, "Frames: 2", header));
+    ASSERT_TRUE(result.ok()) << result.status();
+    EXPECT_EQ(result->clip.frame_count(), 2);
+    ASSERT_EQ(result->warnings.size(), 1u);
+    EXPECT_THAT(result->warnings[0], HasSubstr("line 17"));
+    EXPECT_THAT(result->warnings[0], HasSubstr("2 frame rows"));
+  }
+}
+
+// Malformed input: the error names the line and what was expected.
+struct MalformedCase {
+  const char* name;
+  std::string text;
+  absl::StatusCode code;
+  std::vector<std::string> message_parts;
+};
+
+std::string Truncated(size_t keep) { return std::string(kMinimal).substr(0, keep); }
+
+std::vector<MalformedCase> MalformedCases() {
+  const std::string minimal = kMinimal;
+  const size_t last_row = minimal.find("1.5 91.0");
+  return {
+      {"EmptyFile", "", absl::StatusCode::kInvalidArgument, {"empty file"}},
+      {"OnlyWhitespace", " \r\n\t\n", absl::StatusCode::kInvalidArgument, {"empty file"}},
+      {"BinaryGarbage",
+       std::string("\x7f"
+                   "ELF\x02\x01\x01\0\0\0",
+                   10),
+       absl::StatusCode::kInvalidArgument,
+       {"line 1", "expected 'HIERARCHY'", "binary data"}},
+      {"NotBvh",
+       "{\"hello\": 1}\n",
+       absl::StatusCode::kInvalidArgument,
+       {"line 1", "expected 'HIERARCHY'"}},
+      {"TruncatedInOffset",
+       Truncated(minimal.find("0.0 5.5") + 8),
+       absl::StatusCode::kInvalidArgument,
+       {"line 8", "OFFSET", "end of file"}},
+      {"TruncatedBeforeMotion",
+       Truncated(minimal.find("MOTION")),
+       absl::StatusCode::kInvalidArgument,
+       {"expected 'MOTION'", "end of file"}},
+      {"TruncatedHierarchyBraces",
+       Truncated(minimal.find("\t}\n}")),
+       absl::StatusCode::kInvalidArgument,
+       {"line 14", "'}'", "end of file"}},
+      {"TruncatedLastRow",
+       Truncated(last_row + 12),
+       absl::StatusCode::kInvalidArgument,
+       {"line 20", "expected 9 values, found 3", "truncated"}},
+      {"TooFewValuesOnARow",
+       Replace(minimal, "10.0 20.0 30.0 ", ""),
+       absl::StatusCode::kInvalidArgument,
+       {"line 19", "expected 9 values, found 6"}},
+      {"TooManyValuesOnARow",
+       Replace(minimal, "61.0", "61.0 62.0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 20", "expected 9 values, found more"}},
+      {"NotANumber",
+       Replace(minimal, "50.0", "5O.0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 19", "a number (value 8 of 9)", "'5O.0'"}},
+      {"NaNValue",
+       Replace(minimal, "51.0", "nan"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 20", "value 8 is nan", "finite"}},
+      {"InfValue",
+       Replace(minimal, "1.0 90.0", "1.0 -inf"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 19", "value 2 is -inf"}},
+      {"NaNOffset",
+       Replace(minimal, "0.0 5.5 0.0", "0.0 NaN 0.0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 8", "finite number in OFFSET", "'NaN'"}},
+      {"UnknownChannel",
+       Replace(minimal, "Xrotation Yrotation Zrotation", "Xrotation Wrotation Zrotation"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 9", "channel name", "'Wrotation'"}},
+      {"BadChannelCount",
+       Replace(minimal, "CHANNELS 3", "CHANNELS 7"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 9", "channel count from 0 to 6", "'7'"}},
+      {"TwoRotationChannels",
+       Replace(minimal, "CHANNELS 3 Xrotation Yrotation Zrotation",
+               "CHANNELS 2 Xrotation Yrotation"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 9", "expected 0 or 3 rotation channels"}},
+      {"RepeatedChannel",
+       Replace(minimal, "Xrotation Yrotation Zrotation", "Xrotation Yrotation Xrotation"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 9", "listed twice"}},
+      {"DuplicateJointName",
+       Replace(minimal, "JOINT Chest", "JOINT Hips"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 6", "'Hips' is already used on line 2"}},
+      {"UnexpectedKeyword",
+       Replace(minimal, "\tJOINT Chest", "\tJIONT Chest"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 6", "'JIONT'"}},
+      {"MissingMotion",
+       Replace(minimal, "MOTION", "MOTOIN"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 16", "expected 'MOTION'", "'MOTOIN'"}},
+      {"SecondRoot",
+       Replace(minimal, "MOTION", "ROOT Other\n{\n}\nMOTION"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 16", "second ROOT"}},
+      {"NegativeFrames",
+       Replace(minimal, "Frames: 2", "Frames: -2"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 17", "non-negative frame count", "'-2'"}},
+      {"AbsurdFrames",
+       Replace(minimal, "Frames: 2", "Frames: 99999999999"),
+       absl::StatusCode::kResourceExhausted,
+       {"line 17", "over the limit"}},
+      {"OverflowingFrames",
+       Replace(minimal, "Frames: 2", "Frames: 999999999999999999999999"),
+       absl::StatusCode::kResourceExhausted,
+       {"line 17", "over the limit"}},
+      {"MissingFrames",
+       Replace(minimal, "Frames: 2\n", ""),
+       absl::StatusCode::kInvalidArgument,
+       {"line 17", "'Frames:'", "'Frame'"}},
+      {"ZeroFrameTime",
+       Replace(minimal, "0.0333333", "0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 18", "positive frame time"}},
+      {"NaNFrameTime",
+       Replace(minimal, "0.0333333", "nan"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 18", "positive frame time"}},
+      {"NoRows",
+       Truncated(minimal.find("1.0 90.0")),
+       absl::StatusCode::kInvalidArgument,
+       {"expected frame rows", "end of file"}},
+  };
+}
+
+class BvhReaderMalformed : public ::testing::TestWithParam<MalformedCase> {};
+
+TEST_P(BvhReaderMalformed, IsRejectedWithLineAndExpectation) {
+  const MalformedCase& c = GetParam();
+  absl::StatusOr<BvhReadResult> result = Read(c.text);
+  ASSERT_FALSE(result.ok()) << "accepted:\n" << c.text;
+  EXPECT_EQ(result.status().code(), c.code) << result.status();
+  for (const std::string& part : c.message_parts) {
+    EXPECT_THAT(std::string(result.status().message()), HasSubstr(part));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BvhReaderMalformed, ::testing::ValuesIn(MalformedCases()),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(BvhReaderLimits, InputOverTheSizeLimitIsRefusedBeforeParsing) {
+  BvhReadOptions options;
+  options.max_bytes = 100;
+  absl::StatusOr<BvhReadResult> result = Read(kMinimal, options);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("over the limit of 100"));
+}
+
+TEST(BvhReaderLimits, MoreRowsThanTheFrameLimitAreRefused) {
+  BvhReadOptions options;
+  options.max_frames = 1;
+  absl::StatusOr<BvhReadResult> result = Read(Replace(kMinimal, "Frames: 2", "Frames: 1"), options);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("line 20"));
+}
+
+TEST(BvhReaderLimits, TooManyJointsAreRefused) {
+  BvhReadOptions options;
+  options.max_joints = 1;
+  EXPECT_EQ(Read(kMinimal, options).status().code(), absl::StatusCode::kResourceExhausted);
+}
+
+TEST(BvhReaderLimits, DeepHierarchiesDoNotOverflowTheStack) {
+  std::string text =
+      "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n";
+  const int depth = 999;
+  for (int i = 1; i <= depth; ++i) {
+    text += "JOINT j" + std::to_string(i) +
+            "\n{\nOFFSET 0 1 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n";
+  }
+  for (int i = 0; i <= depth; ++i) text += "}\n";
+  text += "MOTION\nFrames: 1\nFrame Time: 0.01\n";
+  for (int i = 0; i <= depth; ++i) text += "0 0 0 ";
+  absl::StatusOr<BvhReadResult> result = Read(text);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->clip.skeleton().joint_count(), depth + 1);
+}
+
+TEST(BvhReaderFile, MissingFileIsNotFoundAndErrorsNameThePath) {
+  absl::StatusOr<BvhReadResult> missing = ReadBvhFile("/nonexistent/walk.bvh");
+  EXPECT_EQ(missing.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(missing.status().message()), HasSubstr("/nonexistent/walk.bvh"));
+
+  const std::string path = ::testing::TempDir() + "/bad_reader_test.bvh";
+  FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  const std::string text = Replace(kMinimal, "50.0", "x");
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+  absl::StatusOr<BvhReadResult> bad = ReadBvhFile(path);
+  EXPECT_THAT(std::string(bad.status().message()), HasSubstr(path + ": line 19"));
+}
+
+// The conformance corpus: each real quirk, with what the corpus README says about it.
+class ConformanceTest : public ::testing::Test {
+ protected:
+  BvhReadResult Load(const std::string& name) {
+    const std::filesystem::path path = *testing::MocapDir() / "conformance" / name;
+    absl::StatusOr<BvhReadResult> result = ReadBvhFile(path.string());
+    EXPECT_TRUE(result.ok()) << result.status();
+    return result.ok() ? *std::move(result) : BvhReadResult{Read(kMinimal)->clip, {"failed"}};
+  }
+  void SetUp() override {
+    if (!testing::MocapDir()) GTEST_SKIP() << "../shared/mocap is absent; skipped";
+  }
+};
+
+TEST_F(ConformanceTest, NoEndSiteXyz) {
+  const BvhReadResult r = Load("no_end_site_xyz.bvh");
+  ASSERT_EQ(r.clip.skeleton().joint_count(), 4);
+  for (const Joint& joint : r.clip.skeleton().joints()) EXPECT_FALSE(joint.end_site.has_value());
+  EXPECT_EQ(r.clip.skeleton().rotation_order(1), EulerOrder::kXYZ);
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+TEST_F(ConformanceTest, LeavesWithoutEndSite) {
+  for (const char* name : {"leaf_no_end_site_handspring.bvh", "leaf_no_end_site_cartwheel.bvh"}) {
+    const BvhReadResult r = Load(name);
+    const Skeleton& skeleton = r.clip.skeleton();
+    int bare_leaves = 0;
+    for (int j = 0; j < skeleton.joint_count(); ++j) {
+      bare_leaves += skeleton.Children(j).empty() && !skeleton.joint(j).end_site;
+    }
+    EXPECT_GT(bare_leaves, 0) << name;
+    EXPECT_GT(r.clip.frame_count(), 100) << name;
+  }
+}
+
+TEST_F(ConformanceTest, CrlfFiles) {
+  EXPECT_EQ(Load("crlf_no_final_newline.bvh").clip.frame_count(), 60);
+  const BvhReadResult mixed = Load("crlf_mixed_orders_zyx_zxy.bvh");
+  const Skeleton& skeleton = mixed.clip.skeleton();
+  EXPECT_EQ(skeleton.rotation_order(0), EulerOrder::kZYX);
+  int zxy = 0;
+  for (int j = 0; j < skeleton.joint_count(); ++j) {
+    zxy += skeleton.has_rotation(j) && skeleton.rotation_order(j) == EulerOrder::kZXY;
+  }
+  EXPECT_GT(zxy, 0);
+  EXPECT_GT(Load("crlf_example.bvh").clip.frame_count(), 0);
+  EXPECT_GT(Load("tab_after_frames_crlf.bvh").clip.frame_count(), 0);
+}
+
+TEST_F(ConformanceTest, OneAndTwoFrames) {
+  EXPECT_EQ(Load("single_frame.bvh").clip.frame_count(), 1);
+  EXPECT_EQ(Load("two_frames.bvh").clip.frame_count(), 2);
+}
+
+TEST_F(ConformanceTest, ColonNamesENotationIndentedRowsPymo) {
+  EXPECT_EQ(Load("colon_joint_names.bvh").clip.skeleton().joint(0).name, "mixamorig:Hips");
+  EXPECT_GT(Load("e_notation.bvh").clip.frame_count(), 0);
+  EXPECT_GT(Load("indented_rows.bvh").clip.frame_count(), 0);
+  EXPECT_GT(Load("pymo_walk.bvh").clip.frame_count(), 0);
+}
+
+TEST_F(ConformanceTest, FramesHeaderMismatchKeepsRowsAndWarns) {
+  const BvhReadResult r = Load("frames_header_mismatch.bvh");
+  EXPECT_EQ(r.clip.frame_count(), 3070);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_THAT(r.warnings[0], HasSubstr("Frames: 3069"));
+}
+
+}  // namespace
+}  // namespace motiondb

@@ -1,0 +1,49 @@
+// Where the tests find their data: the shared mocap corpus, Debian's assimp-testmodels, the
+// built CLI; and helpers to compare clips.
+#ifndef MOTIONDB_TESTS_TEST_DATA_H_
+#define MOTIONDB_TESTS_TEST_DATA_H_
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/clip.h"
+
+namespace motiondb::testing {
+
+// The shared corpus (env MOTIONDB_MOCAP_DIR overrides the build-time path), or nullopt when it
+// is absent.
+std::optional<std::filesystem::path> MocapDir();
+// Debian's assimp-testmodels BVH folder, or nullopt when the package is not installed.
+std::optional<std::filesystem::path> AssimpBvhDir();
+// The built motiondb CLI.
+std::string CliPath();
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // standard output
+  std::string err;  // standard error
+};
+// Runs the built CLI with `args` (each shell-quoted here) and captures its output.
+CommandResult RunCli(const std::vector<std::string>& args);
+
+// Every *.bvh below `dir`, sorted.
+std::vector<std::filesystem::path> BvhFilesUnder(const std::filesystem::path& dir);
+std::string ReadFileOrDie(const std::filesystem::path& path);
+
+// The largest joint-rotation difference in radians (sign-invariant) between two clips of the
+// same shape, and the largest difference of any joint's position channels relative to the
+// larger magnitude.
+double MaxRotationError(const Clip& a, const Clip& b);
+double MaxRelativePositionError(const Clip& a, const Clip& b);
+
+}  // namespace motiondb::testing
+
+// Skips the current test with a message when the shared corpus is missing.
+#define MOTIONDB_REQUIRE_MOCAP(dir_variable)                                          \
+  const auto dir_variable##_optional = ::motiondb::testing::MocapDir();               \
+  if (!dir_variable##_optional) GTEST_SKIP() << "../shared/mocap is absent; skipped"; \
+  const std::filesystem::path dir_variable = *dir_variable##_optional
+
+#endif  // MOTIONDB_TESTS_TEST_DATA_H_
