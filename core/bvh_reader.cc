@@ -1,5 +1,6 @@
 #include "core/bvh_reader.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -148,11 +149,12 @@ absl::StatusOr<std::string> ParseJointName(Scanner& scanner, bool& brace_consume
     while (!name.empty() && IsBlank(name.back())) name.remove_suffix(1);
     brace_consumed = true;
   }
-  if (name.empty() || name == "{") return ErrorAt(scanner.token_line(), "a joint name", name);
-  for (char c : name) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7f) return ErrorAt(scanner.token_line(), "a joint name", name);
-  }
+  // Braces inside a name could not be written back unambiguously.
+  const bool bad = name.empty() || std::any_of(name.begin(), name.end(), [](char c) {
+                     const auto u = static_cast<unsigned char>(c);
+                     return u < 0x20 || u == 0x7f || c == '{' || c == '}';
+                   });
+  if (bad) return ErrorAt(scanner.token_line(), "a joint name without braces", name);
   return std::string(name);
 }
 

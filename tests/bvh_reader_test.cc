@@ -246,6 +246,8 @@ std::vector<MalformedCase> MalformedCases() {
        Replace(minimal, "JOINT Chest", "JOINT Hips"),
        absl::StatusCode::kInvalidArgument,
        {"line 6", "'Hips' is already used on line 2"}},
+      {"BraceInJointName", Replace(minimal, "JOINT Chest", "JOINT Chest{{"),
+       absl::StatusCode::kInvalidArgument, {"line 6", "joint name without braces", "'Chest{'"}},
       {"UnexpectedKeyword",
        Replace(minimal, "\tJOINT Chest", "\tJIONT Chest"),
        absl::StatusCode::kInvalidArgument,
