@@ -1,0 +1,29 @@
+// What the fast and the exact search share: checking a query against a library, the clip filter,
+// and turning a warp into a result.
+#ifndef MOTIONDB_CORE_SEARCH_QUERY_H_
+#define MOTIONDB_CORE_SEARCH_QUERY_H_
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/coordinate_view.h"
+#include "core/library_index.h"
+#include "core/search_params.h"
+#include "core/search_result.h"
+#include "core/time_warp.h"
+
+namespace motiondb {
+
+// Checks the parameters and that the query has frames, the library's dimensions, and finite
+// coordinates; returns the allowed-clip mask of the filters (empty: every clip).
+absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
+                                               const SearchParams& params);
+
+SearchResult MakeResult(const LibraryIndex& library, int clip_index, Warp warp, int64_t seed_frame);
+
+// CANCELLED when the caller's should_stop says so.
+absl::Status CheckStop(const SearchParams& params);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SEARCH_QUERY_H_

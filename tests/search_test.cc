@@ -1,0 +1,370 @@
+// The library index, the fast search pipeline and the exact search, on synthetic projected
+// libraries with planted patterns (no space needed).
+#include <algorithm>
+#include <atomic>
+#include <random>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/exact_search.h"
+#include "core/library_index.h"
+#include "core/motion_search.h"
+#include "core/time_warp.h"
+#include "tests/search_test_data.h"
+
+namespace motiondb {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr int kDims = 12;
+
+struct Planted {
+  int clip;
+  int64_t first;
+  int64_t last;
+};
+
+// Three clips of noise; the pattern planted at known places, at 1x, 1.4x slower and 0.75x.
+class SearchTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::vector<LibraryClip> clips;
+    const std::vector<std::vector<std::pair<int64_t, int>>> plan = {
+        {{100, 40}, {700, 56}}, {{300, 30}}, {}};
+    for (size_t c = 0; c < plan.size(); ++c) {
+      RowMatrixXf curve = testing::SmoothNoise(1200, kDims, 10 + c);
+      for (const auto& [at, frames] : plan[c]) {
+        testing::Plant(curve, testing::Pattern(frames, kDims), at);
+        planted_.push_back({static_cast<int>(c), at, at + frames - 1});
+      }
+      clips.push_back({static_cast<int64_t>(100 + c),
+                       "clip" + std::to_string(c),
+                       {c == 1 ? "dance" : "walk"},
+                       std::move(curve)});
+    }
+    library_ = *LibraryIndex::Build(std::move(clips), 30.0, {});
+    query_ = testing::Pattern(40, kDims);
+  }
+
+  CoordinateView query() const { return CoordinateView::Of(query_); }
+
+ public:
+  // True when some result covers most of the planted range.
+  static bool Found(const std::vector<SearchResult>& results, const Planted& p) {
+    return std::any_of(results.begin(), results.end(), [&](const SearchResult& r) {
+      const int64_t overlap = std::min(r.last_frame, p.last) - std::max(r.first_frame, p.first) + 1;
+      return r.clip_index == p.clip && overlap > 0.7 * (p.last - p.first + 1);
+    });
+  }
+
+ protected:
+  std::unique_ptr<LibraryIndex> library_;
+  RowMatrixXf query_;
+  std::vector<Planted> planted_;
+};
+
+TEST_F(SearchTest, LibraryMapsGlobalFramesToClips) {
+  EXPECT_EQ(library_->total_frames(), 3600);
+  EXPECT_EQ(library_->Locate(0), std::make_pair(0, int64_t{0}));
+  EXPECT_EQ(library_->Locate(1199), std::make_pair(0, int64_t{1199}));
+  EXPECT_EQ(library_->Locate(1200), std::make_pair(1, int64_t{0}));
+  EXPECT_EQ(library_->Locate(3599), std::make_pair(2, int64_t{1199}));
+  EXPECT_EQ(library_->FindClip(101), 1);
+  EXPECT_EQ(library_->FindClip(7), -1);
+}
+
+TEST_F(SearchTest, NearestAgreesWithBruteForce) {
+  std::mt19937 rng(3);
+  const CoordinateView all = library_->coordinates();
+  for (int trial = 0; trial < 20; ++trial) {
+    const float* point = all.row(rng() % library_->total_frames());
+    // Filters: none, all but one clip (kd-tree and post-filter), and one clip (linear scan).
+    for (const std::vector<bool>& allowed :
+         std::vector<std::vector<bool>>{{}, {true, false, true}, {false, true, false}}) {
+      std::vector<float> expected;
+      for (int64_t f = 0; f < all.rows; ++f) {
+        if (allowed.empty() || allowed[library_->Locate(f).first]) {
+          expected.push_back(Distance(point, all.row(f), 10));
+        }
+      }
+      std::sort(expected.begin(), expected.end());
+      const std::vector<Neighbour> found = library_->Nearest(point, 10, 50, 0.0f, allowed);
+      ASSERT_EQ(found.size(), 50u);
+      for (size_t i = 0; i < found.size(); ++i) {
+        EXPECT_NEAR(found[i].distance, expected[i], 1e-4) << i;
+        EXPECT_NEAR(found[i].distance, Distance(point, all.row(found[i].frame), 10), 1e-4);
+        if (!allowed.empty()) EXPECT_TRUE(allowed[library_->Locate(found[i].frame).first]);
+      }
+    }
+    // Other dimensions than the tree's are answered by a scan.
+    const std::vector<Neighbour> six = library_->Nearest(point, 6, 5, 0.0f, {});
+    EXPECT_EQ(six[0].distance, 0.0f);
+  }
+}
+
+TEST_F(SearchTest, TreeMemoryIsSmallBesideTheCoordinates) {
+  // The index reads coordinates in place: its own memory is below 2x the indexed float32s.
+  const int64_t indexed_bytes = library_->total_frames() * library_->ann_dims() * 4;
+  EXPECT_LT(library_->tree_bytes(), 2 * indexed_bytes);
+  EXPECT_EQ(library_->coordinate_bytes(), library_->total_frames() * kDims * 4);
+}
+
+TEST_F(SearchTest, BuildRejectsBadLibraries) {
+  EXPECT_FALSE(LibraryIndex::Build({}, 30.0, {}).ok());
+  std::vector<LibraryClip> mixed;
+  mixed.push_back({1, "a", {}, RowMatrixXf::Zero(10, 12)});
+  mixed.push_back({2, "b", {}, RowMatrixXf::Zero(10, 11)});
+  EXPECT_EQ(LibraryIndex::Build(std::move(mixed), 30.0, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  std::vector<LibraryClip> nan;
+  nan.push_back({1, "a", {}, RowMatrixXf::Constant(10, 12, NAN)});
+  EXPECT_FALSE(LibraryIndex::Build(std::move(nan), 30.0, {}).ok());
+  std::vector<LibraryClip> narrow;
+  narrow.push_back({1, "a", {}, RowMatrixXf::Zero(10, 4)});
+  EXPECT_FALSE(LibraryIndex::Build(std::move(narrow), 30.0, {}).ok());
+}
+
+TEST_F(SearchTest, CharacteristicFrameIsTheFarthestFromTheNeutralPose) {
+  // The pattern peaks in the middle; its ends are at the origin.
+  EXPECT_NEAR(FindCharacteristicFrame(query(), 10, NeutralPose::kOrigin), 19.5, 3);
+  EXPECT_NEAR(FindCharacteristicFrame(query(), 10, NeutralPose::kBoundaryMean), 19.5, 3);
+  RowMatrixXf ramp(5, 2);
+  ramp << 0, 0, 1, 0, 2, 0, 3, 0, 10, 0;
+  EXPECT_EQ(FindCharacteristicFrame(CoordinateView::Of(ramp), 2, NeutralPose::kQueryMean), 4);
+  EXPECT_EQ(FindCharacteristicFrame(CoordinateView::Of(ramp), 2, NeutralPose::kOrigin), 4);
+}
+
+TEST_F(SearchTest, FastSearchFindsEveryPlantedCopyFirst) {
+  SearchParams params;
+  params.neighbours = 200;
+  absl::StatusOr<SearchResponse> response = Search(*library_, query(), params);
+  ASSERT_TRUE(response.ok()) << response.status();
+  const std::vector<SearchResult>& results = response->results;
+  ASSERT_GE(results.size(), planted_.size());
+  const std::vector<SearchResult> top(results.begin(), results.begin() + planted_.size());
+  for (const Planted& p : planted_) EXPECT_TRUE(Found(top, p)) << p.clip << ":" << p.first;
+  EXPECT_LT(results[0].score, 0.05);
+  for (size_t i = 1; i < results.size(); ++i) EXPECT_LE(results[i - 1].score, results[i].score);
+  for (size_t i = 0; i < results.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) EXPECT_FALSE(Overlaps(results[i], results[j], 0.5));
+  }
+  const SearchStats& stats = response->stats;
+  EXPECT_EQ(stats.seeds, 200);
+  EXPECT_GT(stats.clusters, 0);
+  EXPECT_LE(stats.clusters, stats.seeds);
+  EXPECT_GT(stats.warps, 0);
+  EXPECT_GE(stats.total_ms, stats.warps_ms);
+  EXPECT_EQ(results[0].clip_name, "clip" + std::to_string(results[0].clip_index));
+  EXPECT_NEAR(results[0].start_s, results[0].first_frame / 30.0, 1e-9);
+}
+
+TEST_F(SearchTest, PathsAreReturnedOnRequest) {
+  SearchParams params;
+  params.return_path = true;
+  absl::StatusOr<SearchResponse> response = Search(*library_, query(), params);
+  ASSERT_TRUE(response.ok());
+  for (const SearchResult& r : response->results) {
+    ASSERT_EQ(r.path.size(), 40u);
+    EXPECT_EQ(r.path.front(), r.first_frame);
+    EXPECT_EQ(r.path.back(), r.last_frame);
+    EXPECT_EQ(r.path[response->stats.characteristic_frame], r.seed_frame);
+  }
+}
+
+TEST_F(SearchTest, FiltersByClipIdAndTag) {
+  SearchParams params;
+  params.clip_ids = {101};
+  absl::StatusOr<SearchResponse> by_id = Search(*library_, query(), params);
+  ASSERT_TRUE(by_id.ok());
+  ASSERT_FALSE(by_id->results.empty());
+  for (const SearchResult& r : by_id->results) EXPECT_EQ(r.clip_id, 101);
+  params.clip_ids.clear();
+  params.tags = {"walk"};
+  absl::StatusOr<SearchResponse> by_tag = Search(*library_, query(), params);
+  ASSERT_TRUE(by_tag.ok());
+  for (const SearchResult& r : by_tag->results) EXPECT_NE(r.clip_id, 101);
+  params.tags = {"nothing-has-this"};
+  EXPECT_TRUE(Search(*library_, query(), params)->results.empty());
+  params.tags.clear();
+  params.clip_ids = {999};
+  EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST_F(SearchTest, RejectsBadParametersAndQueries) {
+  const auto code = [&](auto change) {
+    SearchParams params;
+    change(params);
+    return Search(*library_, query(), params).status().code();
+  };
+  const auto bad = absl::StatusCode::kInvalidArgument;
+  EXPECT_EQ(code([](SearchParams& p) { p.ann_dims = 0; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.ann_dims = 13; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.dtw_dims = 99; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.neighbours = 0; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.neighbours = 100'000'000; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.epsilon = -1; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.epsilon = NAN; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.slope_limit = 0; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.slope_limit = 9; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.max_results = 0; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.characteristic_frame = 40; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.cluster_gap_s = -1; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.max_overlap = 2; }), bad);
+  RowMatrixXf nan = query_;
+  nan(3, 2) = NAN;
+  EXPECT_EQ(Search(*library_, CoordinateView::Of(nan), {}).status().code(), bad);
+  const RowMatrixXf narrow = query_.leftCols(8);
+  absl::StatusOr<SearchResponse> narrow_result = Search(*library_, CoordinateView::Of(narrow), {});
+  EXPECT_EQ(narrow_result.status().code(), bad);
+  EXPECT_THAT(std::string(narrow_result.status().message()), HasSubstr("dimensions"));
+  EXPECT_EQ(Search(*library_, CoordinateView{query_.data(), 0, kDims}, {}).status().code(), bad);
+}
+
+TEST_F(SearchTest, StopsWhenTheCallerSaysSo) {
+  SearchParams params;
+  params.should_stop = [] { return true; };
+  EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kCancelled);
+  EXPECT_EQ(ExactSearch(*library_, query(), params).status().code(), absl::StatusCode::kCancelled);
+}
+
+TEST_F(SearchTest, ConcurrentSearchesAgree) {
+  const SearchResponse reference = *Search(*library_, query(), {});
+  std::atomic<int> mismatches = 0;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&] {
+      for (int i = 0; i < 20; ++i) {
+        absl::StatusOr<SearchResponse> r = Search(*library_, query(), {});
+        if (!r.ok() || r->results.size() != reference.results.size() ||
+            r->results[0].first_frame != reference.results[0].first_frame) {
+          ++mismatches;
+        }
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(mismatches, 0);
+}
+
+// The subsequence-DTW definition of a match, by brute force over every start: for each clip
+// frame, the best warp ending there (over all starts); then ranked with overlap suppression.
+std::vector<SearchResult> ExhaustiveReference(const LibraryIndex& library, const RowMatrixXf& q,
+                                              int s, int dims, int k) {
+  std::vector<SearchResult> candidates;
+  for (int c = 0; c < library.clip_count(); ++c) {
+    const CoordinateView x = library.clip_coordinates(c);
+    std::vector<SearchResult> best_ending_at(x.rows);
+    for (SearchResult& r : best_ending_at) r.score = INFINITY;
+    for (int64_t start = 0; start < x.rows; ++start) {
+      // best[j][z]: best cost with the current query row on clip frame start + j.
+      const int64_t width = std::min<int64_t>(x.rows - start, s * (q.rows() - 1) + 1);
+      std::vector<std::vector<double>> best(width, std::vector<double>(s, INFINITY));
+      best[0][0] = Distance(q.row(0).data(), x.row(start), dims);
+      for (int i = 1; i < q.rows(); ++i) {
+        std::vector<std::vector<double>> next(width, std::vector<double>(s, INFINITY));
+        for (int64_t j = 0; j < width; ++j) {
+          for (int z = 0; z < s; ++z) {
+            if (!std::isfinite(best[j][z])) continue;
+            for (int advance = 0; advance <= s; ++advance) {
+              const int nz = advance == 0 ? z + 1 : 0;
+              if (nz > s - 1 || j + advance >= width) continue;
+              const double c2 =
+                  best[j][z] + Distance(q.row(i).data(), x.row(start + j + advance), dims);
+              next[j + advance][nz] = std::min(next[j + advance][nz], c2);
+            }
+          }
+        }
+        best.swap(next);
+      }
+      for (int64_t j = 0; j < width; ++j) {
+        const double total = *std::min_element(best[j].begin(), best[j].end());
+        if (!std::isfinite(total)) continue;
+        SearchResult& r = best_ending_at[start + j];
+        if (total / q.rows() < r.score) {
+          r.clip_index = c;
+          r.first_frame = start;
+          r.last_frame = start + j;
+          r.score = total / q.rows();
+        }
+      }
+    }
+    for (const SearchResult& r : best_ending_at) {
+      if (std::isfinite(r.score)) candidates.push_back(r);
+    }
+  }
+  return RankResults(std::move(candidates), 0.5, k);
+}
+
+TEST(ExactSearch, MatchesAnExhaustiveReferenceOnSmallLibraries) {
+  for (int trial = 0; trial < 6; ++trial) {
+    const int s = 1 + trial % 3;
+    std::vector<LibraryClip> clips;
+    for (int c = 0; c < 2; ++c) {
+      clips.push_back({c, "c", {}, testing::SmoothNoise(90 + 13 * c, 4, 50 + 7 * trial + c)});
+    }
+    const std::unique_ptr<LibraryIndex> library =
+        *LibraryIndex::Build(std::move(clips), 30, {4, 8});
+    const RowMatrixXf q = testing::SmoothNoise(7, 4, 900 + trial);
+    SearchParams params;
+    params.slope_limit = s;
+    params.dtw_dims = 4;
+    params.ann_dims = 4;
+    params.max_results = 5;
+    absl::StatusOr<SearchResponse> exact = ExactSearch(*library, CoordinateView::Of(q), params);
+    ASSERT_TRUE(exact.ok()) << exact.status();
+    const std::vector<SearchResult> reference = ExhaustiveReference(*library, q, s, 4, 5);
+    ASSERT_EQ(exact->results.size(), reference.size()) << "trial " << trial;
+    // The best match is exactly the global optimum; the rest agree in score.
+    EXPECT_NEAR(exact->results[0].score, reference[0].score, 1e-5) << "trial " << trial;
+    for (size_t i = 0; i < reference.size(); ++i) {
+      EXPECT_NEAR(exact->results[i].score, reference[i].score, 1e-4)
+          << "trial " << trial << " #" << i;
+    }
+  }
+}
+
+TEST_F(SearchTest, ExactSearchFindsThePlantedCopiesAndPrunes) {
+  SearchParams params;
+  params.max_results = 3;
+  absl::StatusOr<SearchResponse> exact = ExactSearch(*library_, query(), params);
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  ASSERT_EQ(exact->results.size(), 3u);
+  for (const Planted& p : planted_) EXPECT_TRUE(Found(exact->results, p)) << p.first;
+  EXPECT_GT(exact->stats.pruned_blocks, 0);
+  EXPECT_LT(exact->stats.cells, library_->total_frames() * query_.rows() / 2)
+      << "early abandoning should skip most cells";
+}
+
+TEST(SearchRecall, FastSearchFindsWhatExactSearchFinds) {
+  // Eight copies of the pattern at speeds 0.75x to 1.4x among noise: exact search ranks them
+  // first, and the fast search must find every one of them.
+  std::vector<LibraryClip> clips;
+  std::vector<Planted> planted;
+  const std::vector<int> lengths = {30, 34, 38, 40, 44, 48, 52, 56};
+  for (int c = 0; c < 4; ++c) {
+    RowMatrixXf curve = testing::SmoothNoise(900, kDims, 70 + c);
+    for (int k = 0; k < 2; ++k) {
+      const int frames = lengths[2 * c + k];
+      testing::Plant(curve, testing::Pattern(frames, kDims), 150 + 400 * k);
+      planted.push_back({c, 150 + 400 * k, 150 + 400 * k + frames - 1});
+    }
+    clips.push_back({c, "clip", {}, std::move(curve)});
+  }
+  const std::unique_ptr<LibraryIndex> library = *LibraryIndex::Build(std::move(clips), 30, {});
+  const RowMatrixXf query = testing::Pattern(40, kDims);
+  SearchParams params;
+  params.max_results = 8;
+  const SearchResponse exact = *ExactSearch(*library, CoordinateView::Of(query), params);
+  const SearchResponse fast = *Search(*library, CoordinateView::Of(query), params);
+  ASSERT_EQ(exact.results.size(), 8u);
+  for (const Planted& p : planted) {
+    EXPECT_TRUE(SearchTest::Found(exact.results, p)) << p.clip << ":" << p.first;
+    EXPECT_TRUE(SearchTest::Found(fast.results, p)) << p.clip << ":" << p.first;
+  }
+}
+
+}  // namespace
+}  // namespace motiondb

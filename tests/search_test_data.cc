@@ -1,0 +1,41 @@
+#include "tests/search_test_data.h"
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace motiondb::testing {
+
+RowMatrixXf SmoothNoise(int64_t frames, int dims, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> step(0.0f, 0.15f);
+  RowMatrixXf curve(frames, dims);
+  std::vector<float> value(dims, 0.0f), velocity(dims, 0.0f);
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int k = 0; k < dims; ++k) {
+      velocity[k] = 0.9f * velocity[k] + step(rng);
+      value[k] = 0.95f * value[k] + 0.1f * velocity[k];
+      curve(f, k) = value[k];
+    }
+  }
+  return curve;
+}
+
+RowMatrixXf Pattern(int frames, int dims) {
+  RowMatrixXf pattern(frames, dims);
+  for (int f = 0; f < frames; ++f) {
+    const double t = frames > 1 ? static_cast<double>(f) / (frames - 1) : 0.0;
+    for (int k = 0; k < dims; ++k) {
+      // A raise-and-return shape, different in each dimension.
+      pattern(f, k) =
+          static_cast<float>(3.0 * std::sin(std::numbers::pi * t) * std::cos(0.7 * k + 2.0 * t));
+    }
+  }
+  return pattern;
+}
+
+void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at) {
+  curve.middleRows(at, pattern.rows()) = pattern;
+}
+
+}  // namespace motiondb::testing

@@ -1,0 +1,25 @@
+// Synthetic projected libraries for the search tests: smooth random curves with a distinctive
+// pattern planted at known places, some of them time-stretched.
+#ifndef MOTIONDB_TESTS_SEARCH_TEST_DATA_H_
+#define MOTIONDB_TESTS_SEARCH_TEST_DATA_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "core/matrix.h"
+
+namespace motiondb::testing {
+
+// A smooth random curve of `frames` x `dims` with values of about +/- 1.
+RowMatrixXf SmoothNoise(int64_t frames, int dims, uint32_t seed);
+
+// The pattern: a raise-and-return bump far from the noise, sampled in `frames` frames (so a
+// longer pattern is the same motion performed more slowly).
+RowMatrixXf Pattern(int frames, int dims);
+
+// Writes `pattern` into `curve` starting at `at`.
+void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at);
+
+}  // namespace motiondb::testing
+
+#endif  // MOTIONDB_TESTS_SEARCH_TEST_DATA_H_
