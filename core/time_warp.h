@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/coordinate_view.h"
@@ -35,13 +36,13 @@ struct Warp {
   std::vector<int64_t> path;  // clip frame of every query frame, when requested
 };
 
-// Reusable buffers for AnchoredWarp, so that warps allocate nothing; one per thread.
+// Reusable buffers for AnchoredWarp, so that warps allocate nothing once warm; one per thread.
 struct WarpWorkspace {
-  std::vector<float> cost[2];        // the previous and the current row: band cells x states
-  std::vector<float> best_of_cell;   // per previous-row cell, the best over its states
-  std::vector<uint8_t> best_state;   // ... and which state that was
-  std::vector<uint8_t> steps;        // per row, cell and state: the step taken to get there
-  std::vector<int64_t> row_offsets;  // where each row starts in `steps`
+  std::vector<float> cost[2];        // the half-warp's cost table, and one row's distances
+  std::vector<float> best_of_cell;   // per previous-row cell, the best over its pause states
+  std::vector<int64_t> row_offsets;  // where each row starts in the cost table
+  std::vector<float> frames;         // the clip frames the half-warp can reach, dims-major
+  std::vector<std::pair<int64_t, int64_t>> computed;  // per row: the offsets filled in
 };
 
 // The best warp of `query` onto `clip` that matches query frame `query_anchor` to clip frame

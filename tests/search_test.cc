@@ -96,7 +96,9 @@ TEST_F(SearchTest, NearestAgreesWithBruteForce) {
       for (size_t i = 0; i < found.size(); ++i) {
         EXPECT_NEAR(found[i].distance, expected[i], 1e-4) << i;
         EXPECT_NEAR(found[i].distance, Distance(point, all.row(found[i].frame), 10), 1e-4);
-        if (!allowed.empty()) EXPECT_TRUE(allowed[library_->Locate(found[i].frame).first]);
+        if (!allowed.empty()) {
+          EXPECT_TRUE(allowed[library_->Locate(found[i].frame).first]);
+        }
       }
     }
     // Other dimensions than the tree's are answered by a scan.
