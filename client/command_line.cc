@@ -13,7 +13,7 @@ absl::StatusOr<CommandLine> CommandLine::Parse(const std::vector<std::string>& a
                                                const std::set<std::string>& flags) {
   CommandLine line;
   for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
+    const std::string& arg = args[i] == "-o" && value_options.count("out") ? "--out" : args[i];
     if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) {
       line.positionals_.push_back(arg);
       continue;
@@ -35,7 +35,7 @@ absl::StatusOr<CommandLine> CommandLine::Parse(const std::vector<std::string>& a
         }
         inline_value = args[++i];
       }
-      line.values_[name] = *inline_value;
+      line.values_[name].push_back(*inline_value);
     } else {
       return absl::InvalidArgumentError(absl::StrCat("unknown option --", name));
     }
@@ -46,7 +46,12 @@ absl::StatusOr<CommandLine> CommandLine::Parse(const std::vector<std::string>& a
 std::optional<std::string> CommandLine::value(const std::string& name) const {
   const auto it = values_.find(name);
   if (it == values_.end()) return std::nullopt;
-  return it->second;
+  return it->second.back();
+}
+
+std::vector<std::string> CommandLine::values(const std::string& name) const {
+  const auto it = values_.find(name);
+  return it == values_.end() ? std::vector<std::string>() : it->second;
 }
 
 absl::StatusOr<std::optional<double>> CommandLine::number(const std::string& name) const {

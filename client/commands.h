@@ -8,8 +8,12 @@
 
 namespace motiondb::cli {
 
+// Offline commands.
 int RunInspect(const std::vector<std::string>& args);
 int RunConvert(const std::vector<std::string>& args);
+int RunSpace(const std::vector<std::string>& args);
+int RunProject(const std::vector<std::string>& args);
+
 
 }  // namespace motiondb::cli
 

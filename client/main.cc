@@ -13,7 +13,13 @@ constexpr char kUsage[] =
     "\n"
     "Offline commands (no server needed):\n"
     "  inspect FILE... [--json]                         describe BVH files\n"
-    "  convert IN.bvh OUT.bvh [--fps R] [--from F --to T]  resample and/or cut a BVH file\n";
+    "  convert IN.bvh OUT.bvh [--fps R] [--from F --to T]  resample and/or cut a BVH file\n"
+    "  space build --train FILE[:FROM-TO]... --out SPACE.mcs [--rate 30]\n"
+    "        [--weights mass|uniform|FILE.json] [--keep-heading] [--json]\n"
+    "                                                   build a Motion Curve space\n"
+    "  project FILE.bvh --space SPACE.mcs [--dims 3] [--csv]  print a clip's motion curve\n"
+    "\n"
+    "Frame numbers count from 0 at the clip's own rate; ranges are inclusive.\n";
 
 }  // namespace
 
@@ -26,6 +32,8 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (command == "inspect") return motiondb::cli::RunInspect(args);
   if (command == "convert") return motiondb::cli::RunConvert(args);
+  if (command == "space") return motiondb::cli::RunSpace(args);
+  if (command == "project") return motiondb::cli::RunProject(args);
   if (command == "help" || command == "--help" || command == "-h") {
     std::cout << kUsage;
     return 0;

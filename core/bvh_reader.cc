@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <numbers>
 #include <system_error>
 #include <utility>
@@ -12,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/file_io.h"
 #include "core/status_macros.h"
 
 namespace motiondb {
@@ -427,19 +427,7 @@ absl::StatusOr<BvhReadResult> ReadBvh(absl::string_view text, const BvhReadOptio
 }
 
 absl::StatusOr<BvhReadResult> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open file"));
-  const std::streamoff size = in.tellg();
-  if (size < 0) return absl::InvalidArgumentError(absl::StrCat(path, ": cannot read file"));
-  if (size > options.max_bytes) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": file is ", size, " bytes, over the limit of ", options.max_bytes));
-  }
-  std::string text(static_cast<size_t>(size), '\0');
-  in.seekg(0);
-  if (!in.read(text.data(), size)) {
-    return absl::InvalidArgumentError(absl::StrCat(path, ": cannot read file"));
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string text, ReadFileBytes(path, options.max_bytes));
   absl::StatusOr<BvhReadResult> result = ReadBvh(text, options);
   if (!result.ok()) {
     return absl::Status(result.status().code(),

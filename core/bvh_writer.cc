@@ -1,12 +1,11 @@
 #include "core/bvh_writer.h"
 
 #include <charconv>
-#include <cstdio>
-#include <fstream>
 #include <numbers>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/file_io.h"
 #include "core/status_macros.h"
 
 namespace motiondb {
@@ -117,22 +116,7 @@ absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange>
 absl::Status WriteBvhFile(const std::string& path, const Clip& clip,
                           std::optional<FrameRange> range) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::string text, WriteBvh(clip, range));
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot create file"));
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.close();
-    if (!out) {
-      std::remove(temporary.c_str());
-      return absl::DataLossError(absl::StrCat(path, ": write failed"));
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot rename into place"));
-  }
-  return absl::OkStatus();
+  return WriteFileAtomically(path, text);
 }
 
 }  // namespace motiondb

@@ -1,0 +1,232 @@
+// Search latency (issue 4): the fast search beside the exact search on the same data in the same
+// run, on synthetic libraries reproducing the thesis's validation set (6.3.1) at several
+// lengths and rates, and the thesis's sweeps of sampling rate (Table 6.3), neighbours (6.4) and
+// DTW dimensions (6.5). One query thread. Queries are 2.8 s windows around generated actions,
+// anchored at the action's peak (the thesis's manual characteristic point).
+//
+// usage: search_latency [--scenario 70s120|1h30|10h30|10h120|sweeps|all] [--queries N]
+//          [--exact-queries N]
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "client/command_line.h"
+#include "core/exact_search.h"
+#include "core/library_index.h"
+#include "core/motion_search.h"
+#include "core/search_coordinates.h"
+#include "core/status_macros.h"
+#include "core/synthetic_library.h"
+
+namespace motiondb {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double Percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[std::min(v.size() - 1, static_cast<size_t>(p * v.size()))];
+}
+
+// Resident memory now, in MiB.
+double ResidentMiB() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * (sysconf(_SC_PAGESIZE) / 1048576.0);
+}
+
+struct Query {
+  RowMatrixXf coordinates;
+  int characteristic_frame;
+};
+
+struct Bench {
+  std::unique_ptr<MotionSpace> space;
+  std::unique_ptr<LibraryIndex> library;
+  std::vector<Query> queries;
+  double generate_s = 0, project_s = 0, build_s = 0, build_rss_mib = 0;
+};
+
+// A synthetic library of `duration_s` at `rate` Hz (the space rate too), projected to `dims`
+// dimensions (-1: all), and queries of 2.8 s around its first actions.
+absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int query_count) {
+  Bench bench;
+  Clock::time_point start = Clock::now();
+  SyntheticLibraryOptions options;
+  options.fps = rate;
+  options.target_duration_s = duration_s;
+  MOTIONDB_ASSIGN_OR_RETURN(SyntheticLibrary generated, GenerateSyntheticLibrary(options));
+  bench.generate_s = Seconds(start);
+
+  start = Clock::now();
+  // The space is trained on the first clip (up to 10 minutes), as a studio trains on a
+  // representative sample rather than on everything.
+  SpaceOptions space_options;
+  space_options.sample_rate = rate;
+  MOTIONDB_ASSIGN_OR_RETURN(
+      MotionSpace space,
+      MotionSpace::Build({{"synthetic", generated.clips[0], std::nullopt}}, space_options));
+  bench.space = std::make_unique<MotionSpace>(std::move(space));
+  std::vector<LibraryClip> clips;
+  for (size_t c = 0; c < generated.clips.size(); ++c) {
+    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates,
+                              SearchCoordinates(*bench.space, generated.clips[c], dims));
+    clips.push_back({static_cast<int64_t>(c), "synthetic", {}, std::move(coordinates)});
+  }
+  // Queries: 2.8 s windows centred on the peaks of the first actions of the script.
+  const int length = static_cast<int>(std::lround(2.8 * rate));
+  for (const SyntheticSegment& segment : generated.segments) {
+    if (static_cast<int>(bench.queries.size()) == query_count) break;
+    const int centre = (segment.peak_first_frame + segment.peak_last_frame) / 2;
+    const int first = std::max(0, centre - length / 2);
+    const RowMatrixXf& curve = clips[segment.clip].coordinates;
+    if (first + length > curve.rows()) continue;
+    bench.queries.push_back({curve.middleRows(first, length), segment.peak_first_frame - first});
+  }
+  generated = SyntheticLibrary();  // the joint rotations are not needed any more
+  bench.project_s = Seconds(start);
+
+  const double rss_before = ResidentMiB();
+  start = Clock::now();
+  MOTIONDB_ASSIGN_OR_RETURN(bench.library, LibraryIndex::Build(std::move(clips), rate, {}));
+  bench.build_s = Seconds(start);
+  bench.build_rss_mib = ResidentMiB() - rss_before;
+  return bench;
+}
+
+struct Run {
+  std::vector<double> latencies;
+  double seeds = 0, clusters = 0, warps = 0, results = 0;
+  double seeds_ms = 0, clusters_ms = 0, warps_ms = 0, ranking_ms = 0;
+};
+
+absl::StatusOr<Run> RunQueries(const Bench& bench, SearchParams params, bool exact, int count,
+                               int repeat) {
+  Run run;
+  for (int r = 0; r < repeat; ++r) {
+    for (int q = 0; q < count && q < static_cast<int>(bench.queries.size()); ++q) {
+      params.characteristic_frame = bench.queries[q].characteristic_frame;
+      const CoordinateView query = CoordinateView::Of(bench.queries[q].coordinates);
+      MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse response,
+                                exact ? ExactSearch(*bench.library, query, params)
+                                      : Search(*bench.library, query, params));
+      const SearchStats& s = response.stats;
+      run.latencies.push_back(s.total_ms);
+      run.seeds += s.seeds;
+      run.clusters += s.clusters;
+      run.warps += s.warps;
+      run.results += response.results.size();
+      run.seeds_ms += s.seeds_ms;
+      run.clusters_ms += s.clusters_ms;
+      run.warps_ms += s.warps_ms;
+      run.ranking_ms += s.ranking_ms;
+    }
+  }
+  const double n = std::max<size_t>(1, run.latencies.size());
+  for (double* v : {&run.seeds, &run.clusters, &run.warps, &run.results, &run.seeds_ms,
+                    &run.clusters_ms, &run.warps_ms, &run.ranking_ms}) {
+    *v /= n;
+  }
+  return run;
+}
+
+absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
+                      int exact_queries) {
+  MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(duration_s, rate, 16, queries));
+  const LibraryIndex& library = *bench.library;
+  const double indexed_mib = library.total_frames() * library.ann_dims() * 4 / 1048576.0;
+  std::printf("\n## %s: %.0f s at %.0f Hz = %lld frames (%d clips), %zu queries of %lld frames\n",
+              name.c_str(), duration_s, rate, static_cast<long long>(library.total_frames()),
+              library.clip_count(), bench.queries.size(),
+              static_cast<long long>(bench.queries[0].coordinates.rows()));
+  std::printf("generate %.2f s, space+project %.2f s, index build %.3f s\n", bench.generate_s,
+              bench.project_s, bench.build_s);
+  std::printf("memory: indexed coordinates (%d dims, float32) %.1f MiB; kd-tree %.1f MiB = "
+              "%.2fx; stored coordinates (16 dims) %.1f MiB; RSS growth during build %.1f MiB\n",
+              library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
+              library.tree_bytes() / 1048576.0 / indexed_mib,
+              library.coordinate_bytes() / 1048576.0, bench.build_rss_mib);
+  MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, {}, false, queries, 3));
+  std::printf("fast : p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f ranking "
+              "%.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results\n",
+              Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99), fast.seeds_ms,
+              fast.clusters_ms, fast.warps_ms, fast.ranking_ms, fast.seeds, fast.clusters,
+              fast.warps, fast.results);
+  MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, exact_queries, 1));
+  std::printf("exact: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
+              Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
+              exact.latencies.size(), exact.results);
+  std::fflush(stdout);
+  return absl::OkStatus();
+}
+
+absl::Status Sweeps(int queries) {
+  std::printf("\n## Sweeps on 70 s of synthetic capture (thesis Tables 6.3-6.5)\n");
+  std::printf("\n| rate (Hz) | results | fast p50 (ms) | exact p50 (ms) |\n|---|---|---|---|\n");
+  for (double rate : {240.0, 120.0, 60.0, 30.0}) {
+    MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(70, rate, 16, queries));
+    MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, {}, false, queries, 3));
+    MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, 3, 1));
+    std::printf("| %.0f | %.1f | %.3f | %.1f |\n", rate, fast.results,
+                Percentile(fast.latencies, 0.5), Percentile(exact.latencies, 0.5));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(70, 120, -1, queries));
+  std::printf("\n120 Hz, %d dims:\n\n| neighbours | clusters | results | fast p50 (ms) |\n"
+              "|---|---|---|---|\n",
+              bench.library->dims());
+  for (int k : {100, 250, 500, 1000, 1500, 2500, 5000}) {
+    SearchParams params;
+    params.neighbours = k;
+    MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, params, false, queries, 3));
+    std::printf("| %d | %.1f | %.1f | %.3f |\n", k, fast.clusters, fast.results,
+                Percentile(fast.latencies, 0.5));
+  }
+  std::printf("\n| DTW dims | results | fast p50 (ms) | exact p50 (ms) |\n|---|---|---|---|\n");
+  for (int dims : {1, 3, 5, 10, 20, bench.library->dims()}) {
+    SearchParams params;
+    params.dtw_dims = dims;
+    MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, params, false, queries, 3));
+    MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, params, true, 3, 1));
+    std::printf("| %d | %.1f | %.3f | %.1f |\n", dims, fast.results,
+                Percentile(fast.latencies, 0.5), Percentile(exact.latencies, 0.5));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status Main(const cli::CommandLine& line) {
+  const std::string scenario = line.value("scenario").value_or("all");
+  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> queries, line.integer("queries"));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> exact, line.integer("exact-queries"));
+  const int q = queries.value_or(20), e = exact.value_or(5);
+  const auto wants = [&](const char* name) { return scenario == "all" || scenario == name; };
+  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e));
+  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e));
+  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e));
+  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e));
+  if (wants("sweeps")) MOTIONDB_RETURN_IF_ERROR(Sweeps(q));
+  return absl::OkStatus();
+}
+
+}  // namespace
+}  // namespace motiondb
+
+int main(int argc, char** argv) {
+  const absl::StatusOr<motiondb::cli::CommandLine> line = motiondb::cli::CommandLine::Parse(
+      std::vector<std::string>(argv + 1, argv + argc), {"scenario", "queries", "exact-queries"},
+      {});
+  const absl::Status status = line.ok() ? motiondb::Main(*line) : line.status();
+  if (!status.ok()) {
+    std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,142 @@
+// motiondb's embedded storage: one SQLite file (WAL, foreign keys, schema migrations by
+// PRAGMA user_version) holding skeletons, clips (frames as float32 blobs), Motion Curve spaces
+// (serialised), each clip's cached projection per space, and labels.
+//
+// Every multi-row write is one transaction: a crash at any point loses no acknowledged write
+// and leaves no half-written clip or space. Open() runs an integrity check.
+//
+// Thread-safe: methods may be called from any thread; writes are serialised, reads run
+// concurrently on their own connections. One writer connection behind a mutex runs every write
+// transaction (BEGIN IMMEDIATE; synchronous=FULL, so a returned write is on disk); each read
+// leases a read-only connection from a small pool (storage/read_pool.h) and, the file being in
+// WAL mode, sees the last commit without waiting for the writer or other readers. Another
+// process holding the write lock past busy_timeout_ms makes writes fail with UNAVAILABLE.
+//
+// Invariant: every clip has a projection in every space of its skeleton, so that a space's
+// projections load complete. InsertClip and InsertSpace refuse (FAILED_PRECONDITION) writes that
+// would break it. Ids are never reused after a delete.
+#ifndef MOTIONDB_STORAGE_DATABASE_H_
+#define MOTIONDB_STORAGE_DATABASE_H_
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/clip.h"
+#include "core/matrix.h"
+#include "core/motion_space.h"
+
+namespace motiondb::storage {
+
+struct DatabaseOptions {
+  // Create the file (and its schema) when it does not exist.
+  bool create_if_missing = true;
+  // Milliseconds a connection waits for another's write lock before failing.
+  int busy_timeout_ms = 5000;
+  // Run PRAGMA quick_check on open; a damaged file fails Open() instead of serving errors.
+  bool integrity_check = true;
+};
+
+// A clip as stored: its frames, and what the catalogue shows.
+struct ClipRecord {
+  int64_t clip_id = 0;            // assigned by InsertClip
+  std::string name;               // the file name without .bvh
+  std::string source_file;        // as uploaded
+  std::vector<std::string> tags;  // a set: stored sorted and without repeats
+  int64_t skeleton_id = 0;        // clips with identical joint names and parents share one
+  int64_t created_unix_ms = 0;    // 0 on insert: the time of the insert
+};
+
+struct StoredClip {
+  ClipRecord record;
+  Clip clip;  // offsets and channels are the clip's own
+};
+
+// A clip's projection into a space: frames at the space rate x the space's dimensions,
+// pre-scaled by the space's metric (core/search_coordinates.h).
+struct Projection {
+  int64_t clip_id = 0;
+  RowMatrixXf coordinates;
+};
+
+struct SpaceRecord {
+  int64_t space_id = 0;
+  std::string name;
+  int64_t skeleton_id = 0;        // 0 on insert: the skeleton of the space's topology
+  int version = 1;                // rebuilding a space under the same name makes a new version
+  int64_t created_unix_ms = 0;    // 0 on insert: the time of the insert
+  std::string build_report_json;  // dims, explained variance, reconstruction errors, options
+};
+
+struct Page {
+  int page_size = 100;     // at most 1000
+  std::string page_token;  // empty for the first page
+};
+
+struct ClipPage {
+  std::vector<ClipRecord> clips;
+  std::string next_page_token;  // empty on the last page
+};
+
+struct Counts {
+  int64_t skeletons = 0, clips = 0, frames = 0, spaces = 0, projections = 0, labels = 0;
+};
+
+class Database {
+ public:
+  // Opens (or creates) the database, upgrades its schema, checks integrity. FAILED_PRECONDITION
+  // for a file of a newer schema or one that fails the integrity check.
+  static absl::StatusOr<std::unique_ptr<Database>> Open(const std::string& path,
+                                                        const DatabaseOptions& options = {});
+  ~Database();
+
+  // Stores a clip, finding or creating its skeleton, together with its projection into every
+  // space of that skeleton (`projections`: one per space, keyed by space id), in one
+  // transaction. Returns the new clip id. ALREADY_EXISTS when a clip of that name exists;
+  // NOT_FOUND for an unknown space; FAILED_PRECONDITION when `projections` misses a space of the
+  // skeleton or names one of another; INVALID_ARGUMENT for a name of 0 or over 512 bytes, a tag
+  // of 0 or over 128 bytes, over 64 tags, values beyond float32, or a projection with
+  // non-finite values or more columns than its space. Projection::clip_id is ignored here.
+  absl::StatusOr<int64_t> InsertClip(
+      const ClipRecord& record, const Clip& clip,
+      const std::vector<std::pair<int64_t, Projection>>& projections);
+  // The skeleton id a clip of this topology has or would get (-1 when none is stored yet).
+  absl::StatusOr<int64_t> FindSkeleton(const Skeleton& skeleton);
+  absl::StatusOr<StoredClip> GetClip(int64_t clip_id);  // NOT_FOUND
+  absl::StatusOr<ClipRecord> GetClipRecord(int64_t clip_id);
+  // Clips in id order; optionally only those carrying `tag`. page_size 0 means 100; outside
+  // 0-1000, or a malformed page_token: INVALID_ARGUMENT.
+  absl::StatusOr<ClipPage> ListClips(const Page& page, const std::string& tag = "");
+  // Deletes the clip, its projections and labels. NOT_FOUND when absent.
+  absl::Status DeleteClip(int64_t clip_id);
+
+  // Stores a space built on `skeleton_id` with the projections of every clip of that skeleton,
+  // in one transaction. ALREADY_EXISTS when a space of that name exists; NOT_FOUND for an
+  // unknown skeleton or clip; FAILED_PRECONDITION when the space's topology is not the
+  // skeleton's, or `projections` misses a clip of the skeleton or names one of another.
+  absl::StatusOr<int64_t> InsertSpace(const SpaceRecord& record, const MotionSpace& space,
+                                      const std::vector<Projection>& projections);
+  absl::StatusOr<SpaceRecord> GetSpaceRecord(const std::string& name);  // NOT_FOUND
+  absl::StatusOr<MotionSpace> GetSpace(int64_t space_id);
+  absl::StatusOr<std::vector<SpaceRecord>> ListSpaces();
+  absl::Status DeleteSpace(const std::string& name);  // and its projections
+  // Every cached projection of a space, in clip id order (loaded at start, not recomputed).
+  absl::StatusOr<std::vector<Projection>> LoadProjections(int64_t space_id);
+  // Ids of the clips of a skeleton, in id order.
+  absl::StatusOr<std::vector<int64_t>> ClipsOfSkeleton(int64_t skeleton_id);
+
+  absl::StatusOr<Counts> GetCounts();
+
+ private:
+  class Impl;
+  explicit Database(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace motiondb::storage
+
+#endif  // MOTIONDB_STORAGE_DATABASE_H_

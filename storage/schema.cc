@@ -1,0 +1,154 @@
+#include "storage/schema.h"
+
+#include <array>
+
+#include "absl/strings/str_cat.h"
+#include "core/status_macros.h"
+#include "storage/sqlite_transaction.h"
+
+namespace motiondb::storage {
+namespace {
+
+// Ids are AUTOINCREMENT where other rows, caches or clients refer to them, so that the id of a
+// deleted clip, space or label is never handed to a new one.
+constexpr const char* kMigration1 = R"sql(
+-- Clips whose joint names and parents are identical share a skeleton. topology_key is the
+-- canonical text of that topology (storage/blob_codec.h); names and parents are kept readable.
+CREATE TABLE skeletons (
+  skeleton_id INTEGER PRIMARY KEY,
+  topology_key TEXT NOT NULL UNIQUE,
+  joint_count INTEGER NOT NULL CHECK (joint_count > 0),
+  joint_names TEXT NOT NULL,    -- one name a line
+  joint_parents TEXT NOT NULL,  -- comma-separated parent indices, -1 for the root
+  created_unix_ms INTEGER NOT NULL
+);
+
+-- Frames as little-endian float32: rotations frames x 4 joints (w, x, y, z), positions
+-- frames x 3 position joints. layout is the clip's own skeleton (offsets and channels differ
+-- between actors of one topology).
+CREATE TABLE clips (
+  clip_id INTEGER PRIMARY KEY AUTOINCREMENT,
+  name TEXT NOT NULL UNIQUE,
+  source_file TEXT NOT NULL,
+  skeleton_id INTEGER NOT NULL REFERENCES skeletons (skeleton_id),
+  frame_time REAL NOT NULL CHECK (frame_time > 0),
+  frame_count INTEGER NOT NULL CHECK (frame_count >= 0),
+  joint_count INTEGER NOT NULL CHECK (joint_count > 0),
+  position_joint_count INTEGER NOT NULL CHECK (position_joint_count >= 0),
+  layout BLOB NOT NULL,
+  rotations BLOB NOT NULL CHECK (length(rotations) = 16 * frame_count * joint_count),
+  positions BLOB NOT NULL CHECK (length(positions) = 12 * frame_count * position_joint_count),
+  created_unix_ms INTEGER NOT NULL
+);
+CREATE INDEX clips_by_skeleton ON clips (skeleton_id, clip_id);
+
+CREATE TABLE clip_tags (
+  clip_id INTEGER NOT NULL REFERENCES clips (clip_id) ON DELETE CASCADE,
+  tag TEXT NOT NULL CHECK (length(tag) > 0),
+  PRIMARY KEY (clip_id, tag)
+) WITHOUT ROWID;
+CREATE INDEX clip_tags_by_tag ON clip_tags (tag, clip_id);
+
+-- data is SerializeSpace (core/space_serialization.h): versioned and checksummed.
+CREATE TABLE spaces (
+  space_id INTEGER PRIMARY KEY AUTOINCREMENT,
+  name TEXT NOT NULL UNIQUE,
+  skeleton_id INTEGER NOT NULL REFERENCES skeletons (skeleton_id),
+  version INTEGER NOT NULL CHECK (version >= 1),
+  dims INTEGER NOT NULL CHECK (dims > 0),
+  created_unix_ms INTEGER NOT NULL,
+  data BLOB NOT NULL,
+  build_report_json TEXT NOT NULL
+);
+CREATE INDEX spaces_by_skeleton ON spaces (skeleton_id);
+
+-- A clip's motion curve in a space: frames x dims little-endian float32.
+CREATE TABLE projections (
+  space_id INTEGER NOT NULL REFERENCES spaces (space_id) ON DELETE CASCADE,
+  clip_id INTEGER NOT NULL REFERENCES clips (clip_id) ON DELETE CASCADE,
+  frames INTEGER NOT NULL CHECK (frames >= 0),
+  dims INTEGER NOT NULL CHECK (dims > 0),
+  data BLOB NOT NULL CHECK (length(data) = 4 * frames * dims),
+  PRIMARY KEY (space_id, clip_id)
+);
+-- Deleting a clip finds its projections through this index, not by a scan.
+CREATE INDEX projections_by_clip ON projections (clip_id);
+
+-- Markup (SPEC 5): manual labels, and propagated ones with the label, space and score they
+-- came from and the job that wrote them (a re-run replaces its job's rows). Deleting a space
+-- keeps the labels found in it, without the space.
+CREATE TABLE labels (
+  label_id INTEGER PRIMARY KEY AUTOINCREMENT,
+  clip_id INTEGER NOT NULL REFERENCES clips (clip_id) ON DELETE CASCADE,
+  first_frame INTEGER NOT NULL CHECK (first_frame >= 0),
+  last_frame INTEGER NOT NULL CHECK (last_frame >= first_frame),
+  descriptor TEXT NOT NULL CHECK (length(descriptor) > 0),
+  value REAL NOT NULL CHECK (value BETWEEN 0 AND 1),
+  origin TEXT NOT NULL CHECK (origin IN ('manual', 'propagated')),
+  source_label_id INTEGER REFERENCES labels (label_id) ON DELETE CASCADE,
+  space_id INTEGER REFERENCES spaces (space_id) ON DELETE SET NULL,
+  score REAL,
+  job_id TEXT,
+  created_unix_ms INTEGER NOT NULL
+);
+CREATE INDEX labels_by_descriptor ON labels (descriptor, value);
+CREATE INDEX labels_by_clip ON labels (clip_id, first_frame);
+-- For the cascades and for replacing a job's output.
+CREATE INDEX labels_by_source ON labels (source_label_id);
+CREATE INDEX labels_by_space ON labels (space_id);
+CREATE INDEX labels_by_job ON labels (job_id);
+)sql";
+
+// Append only: a file at version i has run exactly the first i entries.
+constexpr std::array kMigrations = {kMigration1};
+
+}  // namespace
+
+int LatestSchemaVersion() { return static_cast<int>(kMigrations.size()); }
+
+absl::Status CheckSchemaVersion(SqliteConnection& connection) {
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t version, connection.QueryInt64("PRAGMA user_version"));
+  if (version > LatestSchemaVersion()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the database has schema version ", version, ", newer than version ", LatestSchemaVersion(),
+        " that this build of motiondb reads; upgrade motiondb"));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t application,
+                            connection.QueryInt64("PRAGMA application_id"));
+  if (application != 0 && application != kApplicationId) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the file is a SQLite database of another application (application_id ", application, ")"));
+  }
+  if (version == 0) {
+    MOTIONDB_ASSIGN_OR_RETURN(const int64_t objects,
+                              connection.QueryInt64("SELECT count(*) FROM sqlite_schema"));
+    if (objects > 0) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("the file is a SQLite database of another application (", objects,
+                       " schema objects but no motiondb schema version)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status MigrateSchema(SqliteConnection& connection) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteTransaction transaction,
+                            SqliteTransaction::Begin(connection, SqliteTransaction::Kind::kWrite));
+  // Checked again under the write lock: another process may have migrated meanwhile.
+  MOTIONDB_RETURN_IF_ERROR(CheckSchemaVersion(connection));
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t version, connection.QueryInt64("PRAGMA user_version"));
+  if (version == LatestSchemaVersion()) return absl::OkStatus();
+  for (int next = static_cast<int>(version) + 1; next <= LatestSchemaVersion(); ++next) {
+    if (absl::Status status = connection.Execute(kMigrations[next - 1]); !status.ok()) {
+      return absl::Status(status.code(),
+                          absl::StrCat("schema migration ", next, ": ", status.message()));
+    }
+  }
+  // PRAGMAs take no parameters; both values are numbers of ours.
+  MOTIONDB_RETURN_IF_ERROR(
+      connection.Execute(absl::StrCat("PRAGMA application_id = ", kApplicationId,
+                                      "; PRAGMA user_version = ", LatestSchemaVersion())));
+  return transaction.Commit();
+}
+
+}  // namespace motiondb::storage

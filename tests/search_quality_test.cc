@@ -1,0 +1,148 @@
+// Retrieval quality (issue 4): the thesis's synthetic validation (6.3.2), and precision and
+// recall on real labelled capture (../shared/mocap/bandai2-normal, skipped when absent).
+#include <algorithm>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "core/motion_search.h"
+#include "core/retrieval_evaluation.h"
+#include "core/search_coordinates.h"
+#include "core/synthetic_library.h"
+#include "tests/labelled_library.h"
+#include "tests/test_data.h"
+
+namespace motiondb {
+namespace {
+
+class SyntheticValidation : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    absl::StatusOr<SyntheticLibrary> generated = GenerateSyntheticLibrary({});
+    ASSERT_TRUE(generated.ok()) << generated.status();
+    synthetic_ = new SyntheticLibrary(*std::move(generated));
+    std::vector<ClipRange> training;
+    for (const Clip& clip : synthetic_->clips)
+      training.push_back({"synthetic", clip, std::nullopt});
+    absl::StatusOr<MotionSpace> space = MotionSpace::Build(training, {});
+    ASSERT_TRUE(space.ok()) << space.status();
+    space_ = new MotionSpace(*std::move(space));
+    std::vector<LibraryClip> clips;
+    for (size_t c = 0; c < synthetic_->clips.size(); ++c) {
+      clips.push_back({static_cast<int64_t>(c),
+                       "synthetic",
+                       {},
+                       *SearchCoordinates(*space_, synthetic_->clips[c])});
+    }
+    library_ = LibraryIndex::Build(std::move(clips), space_->sample_rate(), {})->release();
+  }
+  static void TearDownTestSuite() {
+    delete library_;
+    delete space_;
+    delete synthetic_;
+  }
+
+  // A ground-truth segment's frames at the space rate.
+  static std::pair<int64_t, int64_t> AtSpaceRate(const SyntheticSegment& s) {
+    const double ratio = space_->sample_rate() * synthetic_->clips[s.clip].frame_time();
+    return {std::llround(s.first_frame * ratio), std::llround(s.last_frame * ratio)};
+  }
+
+  // The segment a result covers (more than half of the segment), or -1.
+  static int MatchedSegment(const SearchResult& r) {
+    for (size_t g = 0; g < synthetic_->segments.size(); ++g) {
+      const SyntheticSegment& s = synthetic_->segments[g];
+      if (s.clip != r.clip_index) continue;
+      const auto [first, last] = AtSpaceRate(s);
+      const int64_t overlap = std::min(r.last_frame, last) - std::max(r.first_frame, first) + 1;
+      if (overlap > 0.5 * (last - first + 1)) return static_cast<int>(g);
+    }
+    return -1;
+  }
+
+  static SyntheticLibrary* synthetic_;
+  static MotionSpace* space_;
+  static LibraryIndex* library_;
+};
+
+SyntheticLibrary* SyntheticValidation::synthetic_ = nullptr;
+MotionSpace* SyntheticValidation::space_ = nullptr;
+LibraryIndex* SyntheticValidation::library_ = nullptr;
+
+// Querying with the first instance of each class ranks every instance of that class above every
+// instance of another class. As in the thesis, the characteristic point is the moment of
+// maximum extension (the first frame of the peak hold).
+TEST_F(SyntheticValidation, FirstInstanceRanksItsWholeClassFirst) {
+  for (SyntheticAction action :
+       {SyntheticAction::kRightArmRaise, SyntheticAction::kLeftArmRaise,
+        SyntheticAction::kBothArmsRaise, SyntheticAction::kShrug, SyntheticAction::kSlouch}) {
+    SCOPED_TRACE(SyntheticActionName(action));
+    const auto first = std::find_if(synthetic_->segments.begin(), synthetic_->segments.end(),
+                                    [&](const SyntheticSegment& s) { return s.action == action; });
+    ASSERT_NE(first, synthetic_->segments.end());
+    const Clip& clip = synthetic_->clips[first->clip];
+    const Clip query_clip = *clip.Slice({first->first_frame, first->last_frame});
+    const RowMatrixXf query = *SearchCoordinates(*space_, query_clip);
+    SearchParams params;
+    params.max_results = 200;
+    params.neighbours = 2000;
+    params.characteristic_frame = static_cast<int>(std::min<int64_t>(
+        query.rows() - 1, std::llround((first->peak_first_frame - first->first_frame) *
+                                       space_->sample_rate() * clip.frame_time())));
+    absl::StatusOr<SearchResponse> response = Search(*library_, CoordinateView::Of(query), params);
+    ASSERT_TRUE(response.ok()) << response.status();
+
+    const int instances = static_cast<int>(
+        std::count_if(synthetic_->segments.begin(), synthetic_->segments.end(),
+                      [&](const SyntheticSegment& s) { return s.action == action; }));
+    std::vector<bool> found(synthetic_->segments.size(), false);
+    int same_found = 0, last_same_rank = -1, first_other_rank = -1;
+    for (size_t rank = 0; rank < response->results.size(); ++rank) {
+      const int g = MatchedSegment(response->results[rank]);
+      if (g < 0 || found[g]) continue;
+      found[g] = true;
+      if (synthetic_->segments[g].action == action) {
+        ++same_found;
+        last_same_rank = static_cast<int>(rank);
+      } else if (first_other_rank < 0) {
+        first_other_rank = static_cast<int>(rank);
+      }
+    }
+    EXPECT_EQ(same_found, instances);
+    if (first_other_rank >= 0) {
+      EXPECT_LT(last_same_rank, first_other_rank);
+    }
+  }
+}
+
+class BandaiQuality : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto mocap = testing::MocapDir();
+    if (!mocap) GTEST_SKIP() << "../shared/mocap is absent; skipped";
+    folder_ = *mocap / "bandai2-normal";
+  }
+  std::filesystem::path folder_;
+};
+
+// Each clip as a query against all the others: precision@5 of the content class >= 0.8 and the
+// fast search's recall@10 against exact search >= 0.9, with the default (unit) metric.
+TEST_F(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
+  absl::StatusOr<testing::LabelledLibrary> library = testing::LoadLabelledLibrary(folder_, {}, {});
+  ASSERT_TRUE(library.ok()) << library.status();
+  ASSERT_EQ(library->index->clip_count(), 465);
+  RetrievalOptions options;
+  options.exact_every = 10;
+  absl::StatusOr<RetrievalReport> report =
+      EvaluateLeaveOneOut(*library->index, library->labels, options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_GE(report->precision, 0.8);
+  EXPECT_GE(report->exact_precision, 0.8);
+  EXPECT_GE(report->recall, 0.9);
+  for (const auto& [label, precision] : report->precision_by_label) {
+    EXPECT_GE(precision, 0.6) << label;
+  }
+}
+
+}  // namespace
+}  // namespace motiondb

@@ -1,0 +1,143 @@
+// The binary space format: exact round trips, and every kind of damage rejected.
+#include "core/space_serialization.h"
+
+#include <filesystem>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tests/synthetic_motion.h"
+
+namespace motiondb {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr size_t kHeaderSize = 20;  // magic, version, payload size
+
+class SpaceSerializationTest : public ::testing::Test {
+ protected:
+  SpaceSerializationTest()
+      : clip_(testing::SyntheticClip(testing::HumanoidSkeleton(/*still_root=*/true),
+                                     {.frames = 60, .turn_rate = 0.4})),
+        space_(*MotionSpace::Build(
+            {{"walk.bvh", clip_, FrameRange{5, 50}}},
+            {.yaw_rate_weight = 0.7, .metric = SpaceMetric::kEigenvalueScaled})),
+        bytes_(SerializeSpace(space_)) {}
+
+  // `bytes` with its checksum recomputed, so that only the later checks can reject it.
+  static std::string Resealed(std::string bytes) {
+    const uint32_t crc = Crc32(absl::string_view(bytes).substr(0, bytes.size() - 4));
+    for (int i = 0; i < 4; ++i) bytes[bytes.size() - 4 + i] = static_cast<char>(crc >> (8 * i));
+    return bytes;
+  }
+
+  Clip clip_;
+  MotionSpace space_;
+  std::string bytes_;
+};
+
+TEST_F(SpaceSerializationTest, RoundTripIsExact) {
+  const absl::StatusOr<MotionSpace> parsed = ParseSpace(bytes_);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  const SpaceData& a = space_.data();
+  const SpaceData& b = parsed->data();
+  EXPECT_TRUE(a.skeleton->SameTopology(*b.skeleton));
+  for (int j = 0; j < a.skeleton->joint_count(); ++j) {
+    EXPECT_EQ(a.skeleton->joint(j).offset, b.skeleton->joint(j).offset);
+    EXPECT_EQ(a.skeleton->joint(j).channels, b.skeleton->joint(j).channels);
+    EXPECT_EQ(a.skeleton->joint(j).end_site, b.skeleton->joint(j).end_site);
+  }
+  EXPECT_EQ(a.sample_rate, b.sample_rate);
+  EXPECT_EQ(a.pose.remove_heading, b.pose.remove_heading);
+  EXPECT_EQ(a.pose.yaw_rate_window, b.pose.yaw_rate_window);
+  EXPECT_EQ(b.yaw_rate_weight, 0.7);
+  EXPECT_EQ(b.metric, SpaceMetric::kEigenvalueScaled);
+  EXPECT_EQ(a.joint_weights, b.joint_weights);
+  EXPECT_EQ(a.references, b.references);
+  EXPECT_EQ(a.mean, b.mean);
+  EXPECT_EQ(a.basis, b.basis);
+  EXPECT_EQ(a.eigenvalues, b.eigenvalues);
+  ASSERT_EQ(b.training.size(), 1u);
+  EXPECT_EQ(b.training[0].source, "walk.bvh");
+  EXPECT_EQ(b.training[0].frames.first, 5);
+  EXPECT_EQ(b.training[0].frames.last, 50);
+  EXPECT_EQ(*parsed->ProjectClip(clip_), *space_.ProjectClip(clip_));
+  EXPECT_EQ(SerializeSpace(*parsed), bytes_);
+}
+
+TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
+  EXPECT_EQ(bytes_.substr(0, 8), "MDBSPACE");
+  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x01\x00\x00\x00", 4));
+  uint64_t payload = 0;
+  for (int i = 0; i < 8; ++i) payload |= uint64_t{static_cast<uint8_t>(bytes_[12 + i])} << (8 * i);
+  EXPECT_EQ(payload, bytes_.size() - kHeaderSize - 4);
+  EXPECT_EQ(Crc32("123456789"), 0xCBF43926u);  // the standard check value
+  EXPECT_EQ(Crc32(""), 0u);
+}
+
+TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
+  std::string magic = bytes_;
+  magic[0] = 'X';
+  EXPECT_EQ(ParseSpace(magic).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(ParseSpace(magic).status().message(), HasSubstr("bad magic"));
+  EXPECT_THAT(ParseSpace("BVH HIERARCHY").status().message(), HasSubstr("bad magic"));
+
+  std::string version = bytes_;
+  version[8] = 2;
+  EXPECT_EQ(ParseSpace(version).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 2 is not supported"));
+
+  for (const size_t at : {kHeaderSize, bytes_.size() / 2, bytes_.size() - 5, bytes_.size() - 1}) {
+    std::string flipped = bytes_;
+    flipped[at] ^= 0x10;
+    const absl::Status status = ParseSpace(flipped).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << at;
+    EXPECT_THAT(status.message(), HasSubstr("checksum")) << at;
+  }
+}
+
+TEST_F(SpaceSerializationTest, RejectsEveryTruncationAndTrailingBytes) {
+  for (size_t size = 0; size < bytes_.size(); ++size) {
+    EXPECT_FALSE(ParseSpace(absl::string_view(bytes_).substr(0, size)).ok()) << size;
+  }
+  EXPECT_THAT(ParseSpace(bytes_ + "x").status().message(), HasSubstr("header says"));
+}
+
+TEST_F(SpaceSerializationTest, RejectsSealedButInconsistentContents) {
+  // A basis entry scaled: the checksum is right, the space is not.
+  std::string scaled = bytes_;
+  const size_t basis_end = scaled.size() - 4 - (4 + 4 + 8 + 4 + 4);  // training range, checksum
+  scaled[basis_end - 1] ^= 0x40;  // an exponent bit of the last basis entry
+  EXPECT_THAT(ParseSpace(Resealed(scaled)).status().message(), HasSubstr("orthonormal"));
+
+  // A payload that ends early inside a field the header still covers.
+  std::string short_payload = bytes_.substr(0, kHeaderSize + 40);
+  const uint64_t payload = 40;
+  for (int i = 0; i < 8; ++i) short_payload[12 + i] = static_cast<char>(payload >> (8 * i));
+  short_payload += "0000";
+  const absl::Status status = ParseSpace(Resealed(short_payload)).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(status.message(), HasSubstr("truncated"));
+}
+
+TEST_F(SpaceSerializationTest, FilesRoundTripAndErrorsNameThePath) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "space_files";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "walk.mcs").string();
+  ASSERT_TRUE(WriteSpaceFile(path, space_).ok());
+  const absl::StatusOr<MotionSpace> read = ReadSpaceFile(path);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->data().basis, space_.data().basis);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+
+  const absl::Status missing = ReadSpaceFile((dir / "none.mcs").string()).status();
+  EXPECT_EQ(missing.code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(missing.message(), HasSubstr("none.mcs"));
+  std::filesystem::resize_file(path, 100);
+  EXPECT_THAT(ReadSpaceFile(path).status().message(), HasSubstr("walk.mcs: space is"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace motiondb

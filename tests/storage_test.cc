@@ -1,0 +1,746 @@
+// The SQLite storage layer on real files: round trips, pagination, skeleton sharing, spaces and
+// projections, cascades, atomic failures, damaged and foreign files, concurrency, and a writer
+// killed mid-stream.
+#include "storage/database.h"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cfloat>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <tuple>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/space_serialization.h"
+#include "storage/schema.h"
+#include "storage/sqlite_connection.h"
+#include "tests/clip_builder.h"
+#include "tests/synthetic_motion.h"
+
+namespace motiondb::storage {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::tuple<int64_t, int64_t, int64_t, int64_t, int64_t, int64_t> AsTuple(const Counts& c) {
+  return {c.skeletons, c.clips, c.frames, c.spaces, c.projections, c.labels};
+}
+
+// `skeleton` with every offset and End Site scaled: another actor of the same topology.
+std::shared_ptr<const Skeleton> Rescaled(const Skeleton& skeleton, double scale) {
+  std::vector<Joint> joints = skeleton.joints();
+  for (Joint& joint : joints) {
+    joint.offset *= scale;
+    if (joint.end_site) *joint.end_site *= scale;
+  }
+  return std::make_shared<const Skeleton>(*Skeleton::Create(std::move(joints)));
+}
+
+// `skeleton` with its last joint renamed: another topology.
+std::shared_ptr<const Skeleton> Renamed(const Skeleton& skeleton, const std::string& name) {
+  std::vector<Joint> joints = skeleton.joints();
+  joints.back().name = name;
+  return std::make_shared<const Skeleton>(*Skeleton::Create(std::move(joints)));
+}
+
+// A clip of `frames` frames whose rotations and positions vary with `seed`.
+Clip Motion(std::shared_ptr<const Skeleton> skeleton, int frames, int seed = 0) {
+  return testing::MakeClip(
+      std::move(skeleton), frames, 1.0 / 120.0,
+      [seed](int f, int j) {
+        return Quat(
+            Eigen::AngleAxisd(0.37 * f + 1.1 * j + seed,
+                              Eigen::Vector3d(1.0, 0.3 * j, 0.1 * seed + 0.2).normalized()));
+      },
+      [seed](int f, int j) { return Eigen::Vector3d(0.013 * f - 7.1, 91.7 + j, 3.3 * seed); });
+}
+
+Page Sized(int page_size) {
+  Page page;
+  page.page_size = page_size;
+  return page;
+}
+
+ClipRecord Named(const std::string& name, std::vector<std::string> tags = {}) {
+  ClipRecord record;
+  record.name = name;
+  record.source_file = name + ".bvh";
+  record.tags = std::move(tags);
+  return record;
+}
+
+void ExpectSameLayout(const Skeleton& a, const Skeleton& b) {
+  ASSERT_EQ(a.joint_count(), b.joint_count());
+  for (int j = 0; j < a.joint_count(); ++j) {
+    EXPECT_EQ(a.joint(j).name, b.joint(j).name);
+    EXPECT_EQ(a.joint(j).parent, b.joint(j).parent);
+    EXPECT_EQ(a.joint(j).offset, b.joint(j).offset);
+    EXPECT_EQ(a.joint(j).channels, b.joint(j).channels);
+    EXPECT_EQ(a.joint(j).end_site, b.joint(j).end_site);
+  }
+}
+
+void ExpectSameFrames(const Clip& expected, const Clip& actual) {
+  EXPECT_EQ(actual.frame_time(), expected.frame_time());
+  ASSERT_EQ(actual.frame_count(), expected.frame_count());
+  ExpectSameLayout(expected.skeleton(), actual.skeleton());
+  double worst_angle = 0.0;
+  for (int f = 0; f < expected.frame_count(); ++f) {
+    for (int j = 0; j < expected.skeleton().joint_count(); ++j) {
+      worst_angle =
+          std::max(worst_angle, AngleBetween(expected.rotation(f, j), actual.rotation(f, j)));
+    }
+  }
+  EXPECT_LT(worst_angle, 1e-6);
+  const RowMatrixXd& p = expected.positions();
+  ASSERT_EQ(actual.positions().rows(), p.rows());
+  ASSERT_EQ(actual.positions().cols(), p.cols());
+  for (Eigen::Index i = 0; i < p.size(); ++i) {
+    EXPECT_NEAR(actual.positions().data()[i], p.data()[i],
+                1e-6 * std::max(1.0, std::abs(p.data()[i])));
+  }
+}
+
+// A fresh directory for one test's database file.
+class StorageTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (std::filesystem::temp_directory_path() / "motiondb_storage_XXXXXX");
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+    path_ = (dir_ / "motion.db").string();
+  }
+  void TearDown() override {
+    db_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  Database& Db() {
+    if (db_ == nullptr) {
+      absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_);
+      EXPECT_TRUE(db.ok()) << db.status();
+      db_ = *std::move(db);
+    }
+    return *db_;
+  }
+  void Close() { db_.reset(); }
+
+  int64_t Insert(const ClipRecord& record, const Clip& clip,
+                 const std::vector<std::pair<int64_t, Projection>>& projections = {}) {
+    const absl::StatusOr<int64_t> id = Db().InsertClip(record, clip, projections);
+    EXPECT_TRUE(id.ok()) << id.status();
+    return id.value_or(-1);
+  }
+  Counts CountsNow() {
+    const absl::StatusOr<Counts> counts = Db().GetCounts();
+    EXPECT_TRUE(counts.ok()) << counts.status();
+    return counts.value_or(Counts{});
+  }
+  // A raw connection, to look at and damage what the Database wrote.
+  std::unique_ptr<SqliteConnection> Raw() {
+    auto raw = SqliteConnection::Open(path_, SqliteConnection::Mode::kReadWrite, 1000);
+    EXPECT_TRUE(raw.ok()) << raw.status();
+    return *std::move(raw);
+  }
+  std::string FileBytes() {
+    std::ifstream file(path_, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(file), {});
+  }
+
+  std::filesystem::path dir_;
+  std::string path_;
+  std::unique_ptr<Database> db_;
+};
+
+// Humanoid clips and a space built on the first, for the tests of spaces and projections.
+class StorageSpaceTest : public StorageTest {
+ protected:
+  StorageSpaceTest()
+      : skeleton_(testing::HumanoidSkeleton(/*still_root=*/true)),
+        walk_(testing::SyntheticClip(skeleton_, {.frames = 90, .seed = 1})),
+        wave_(testing::SyntheticClip(Rescaled(*skeleton_, 1.1), {.frames = 70, .seed = 2})),
+        space_(*MotionSpace::Build({{"walk.bvh", walk_, std::nullopt}})) {}
+
+  Projection ProjectionOf(int64_t clip_id, const Clip& clip, int dims = 8) {
+    Projection projection;
+    projection.clip_id = clip_id;
+    projection.coordinates = space_.ProjectClip(clip, dims)->cast<float>();
+    return projection;
+  }
+  SpaceRecord SpaceNamed(const std::string& name, int64_t skeleton_id) {
+    SpaceRecord record;
+    record.name = name;
+    record.skeleton_id = skeleton_id;
+    record.version = 3;
+    record.build_report_json = R"({"dims": 8})";
+    return record;
+  }
+
+  std::shared_ptr<const Skeleton> skeleton_;
+  Clip walk_;
+  Clip wave_;
+  MotionSpace space_;
+};
+
+TEST_F(StorageTest, ClipRoundTripKeepsFramesLayoutAndRecord) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 50, 3);
+  ClipRecord record = Named("walk_01", {"walk", "actor:b", "walk"});
+  record.created_unix_ms = 1700000000123;
+  const int64_t id = Insert(record, clip);
+  ASSERT_GT(id, 0);
+
+  const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  EXPECT_EQ(stored->record.clip_id, id);
+  EXPECT_EQ(stored->record.name, "walk_01");
+  EXPECT_EQ(stored->record.source_file, "walk_01.bvh");
+  EXPECT_THAT(stored->record.tags, ::testing::ElementsAre("actor:b", "walk"));
+  EXPECT_EQ(stored->record.created_unix_ms, 1700000000123);
+  EXPECT_GT(stored->record.skeleton_id, 0);
+  ExpectSameFrames(clip, stored->clip);
+
+  const absl::StatusOr<ClipRecord> only_record = Db().GetClipRecord(id);
+  ASSERT_TRUE(only_record.ok()) << only_record.status();
+  EXPECT_EQ(only_record->name, "walk_01");
+  EXPECT_EQ(only_record->tags, stored->record.tags);
+  EXPECT_EQ(only_record->skeleton_id, stored->record.skeleton_id);
+
+  const Counts counts = CountsNow();
+  EXPECT_EQ(counts.clips, 1);
+  EXPECT_EQ(counts.frames, 50);
+  EXPECT_EQ(counts.skeletons, 1);
+
+  // A clip without frames stores empty blobs.
+  const int64_t empty = Insert(Named("empty"), Motion(testing::ChainSkeleton(), 0));
+  const absl::StatusOr<StoredClip> stored_empty = Db().GetClip(empty);
+  ASSERT_TRUE(stored_empty.ok()) << stored_empty.status();
+  EXPECT_EQ(stored_empty->clip.frame_count(), 0);
+}
+
+TEST_F(StorageTest, TagFilterListsOnlyTaggedClips) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 5);
+  const int64_t a = Insert(Named("a", {"walk"}), clip);
+  Insert(Named("b", {"run"}), clip);
+  const int64_t c = Insert(Named("c", {"run", "walk"}), clip);
+  Insert(Named("d"), clip);
+
+  const absl::StatusOr<ClipPage> walks = Db().ListClips({}, "walk");
+  ASSERT_TRUE(walks.ok()) << walks.status();
+  ASSERT_EQ(walks->clips.size(), 2u);
+  EXPECT_EQ(walks->clips[0].clip_id, a);
+  EXPECT_EQ(walks->clips[1].clip_id, c);
+  EXPECT_THAT(walks->clips[1].tags, ::testing::ElementsAre("run", "walk"));
+  EXPECT_EQ(walks->next_page_token, "");
+  EXPECT_EQ(Db().ListClips({}, "jump")->clips.size(), 0u);
+  EXPECT_EQ(Db().ListClips({})->clips.size(), 4u);
+}
+
+TEST_F(StorageTest, PaginationVisitsEveryClipOnce) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 2);
+  std::vector<int64_t> inserted;
+  for (int i = 0; i < 250; ++i) {
+    inserted.push_back(
+        Insert(Named(absl::StrCat("clip_", i), {i % 3 == 0 ? "third" : "other"}), clip));
+  }
+
+  // Every page of `page_size` under `tag`, following the tokens to the end.
+  auto all_pages = [&](int page_size, const std::string& tag) {
+    std::vector<std::vector<int64_t>> pages;
+    Page page = Sized(page_size);
+    do {
+      const absl::StatusOr<ClipPage> result = Db().ListClips(page, tag);
+      EXPECT_TRUE(result.ok()) << result.status();
+      if (!result.ok() || pages.size() > 20) break;
+      pages.emplace_back();
+      for (const ClipRecord& record : result->clips) pages.back().push_back(record.clip_id);
+      page.page_token = result->next_page_token;
+    } while (!page.page_token.empty());
+    return pages;
+  };
+
+  const std::vector<std::vector<int64_t>> pages = all_pages(100, "");
+  ASSERT_EQ(pages.size(), 3u);
+  EXPECT_EQ(pages[0].size(), 100u);
+  EXPECT_EQ(pages[1].size(), 100u);
+  EXPECT_EQ(pages[2].size(), 50u);
+  std::vector<int64_t> seen;
+  for (const auto& page : pages) seen.insert(seen.end(), page.begin(), page.end());
+  EXPECT_EQ(seen, inserted);  // in id order, no duplicates, no gaps
+
+  std::vector<int64_t> thirds;
+  for (size_t i = 0; i < inserted.size(); i += 3) thirds.push_back(inserted[i]);
+  std::vector<int64_t> tagged;
+  for (const auto& page : all_pages(30, "third"))
+    tagged.insert(tagged.end(), page.begin(), page.end());
+  EXPECT_EQ(tagged, thirds);
+
+  EXPECT_EQ(Db().ListClips(Sized(0))->clips.size(), 100u);
+  EXPECT_EQ(Db().ListClips(Sized(1000))->clips.size(), 250u);
+  EXPECT_EQ(Db().ListClips(Sized(250))->next_page_token, "");
+  for (const int size : {-1, 1001}) {
+    EXPECT_EQ(Db().ListClips(Sized(size)).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+  for (const std::string token : {"abc", "-5", "12x", " 12", "+3", "0", "99999999999999999999"}) {
+    EXPECT_EQ(Db().ListClips({.page_token = token}).status().code(),
+              absl::StatusCode::kInvalidArgument)
+        << token;
+  }
+}
+
+TEST_F(StorageTest, ClipsOfOneTopologyShareASkeleton) {
+  const std::shared_ptr<const Skeleton> chain = testing::ChainSkeleton();
+  const std::shared_ptr<const Skeleton> taller = Rescaled(*chain, 1.3);
+  const std::shared_ptr<const Skeleton> other = Renamed(*chain, "tip");
+  EXPECT_EQ(*Db().FindSkeleton(*chain), -1);
+
+  const int64_t a = Insert(Named("a"), Motion(chain, 4));
+  const int64_t b = Insert(Named("b"), Motion(taller, 4));
+  const int64_t c = Insert(Named("c"), Motion(other, 4));
+  const int64_t skeleton = Db().GetClipRecord(a)->skeleton_id;
+  EXPECT_EQ(Db().GetClipRecord(b)->skeleton_id, skeleton);
+  EXPECT_NE(Db().GetClipRecord(c)->skeleton_id, skeleton);
+  EXPECT_EQ(*Db().FindSkeleton(*taller), skeleton);
+  EXPECT_EQ(*Db().FindSkeleton(*other), Db().GetClipRecord(c)->skeleton_id);
+  EXPECT_EQ(CountsNow().skeletons, 2);
+  EXPECT_THAT(*Db().ClipsOfSkeleton(skeleton), ::testing::ElementsAre(a, b));
+
+  // Each clip keeps its own offsets.
+  ExpectSameLayout(Db().GetClip(a)->clip.skeleton(), *chain);
+  ExpectSameLayout(Db().GetClip(b)->clip.skeleton(), *taller);
+}
+
+TEST_F(StorageSpaceTest, SpacesAndProjectionsRoundTrip) {
+  const int64_t walk = Insert(Named("walk"), walk_);
+  const int64_t wave = Insert(Named("wave"), wave_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  const Projection walk_projection = ProjectionOf(walk, walk_);
+  const Projection wave_projection = ProjectionOf(wave, wave_);
+  const absl::StatusOr<int64_t> space_id =
+      Db().InsertSpace(SpaceNamed("body", skeleton), space_, {wave_projection, walk_projection});
+  ASSERT_TRUE(space_id.ok()) << space_id.status();
+
+  const absl::StatusOr<SpaceRecord> record = Db().GetSpaceRecord("body");
+  ASSERT_TRUE(record.ok()) << record.status();
+  EXPECT_EQ(record->space_id, *space_id);
+  EXPECT_EQ(record->skeleton_id, skeleton);
+  EXPECT_EQ(record->version, 3);
+  EXPECT_EQ(record->build_report_json, R"({"dims": 8})");
+  EXPECT_GT(record->created_unix_ms, 0);
+  const absl::StatusOr<MotionSpace> space = Db().GetSpace(*space_id);
+  ASSERT_TRUE(space.ok()) << space.status();
+  EXPECT_EQ(SerializeSpace(*space), SerializeSpace(space_));
+  ASSERT_EQ(Db().ListSpaces()->size(), 1u);
+  EXPECT_EQ(Db().ListSpaces()->front().name, "body");
+
+  // A clip ingested later brings its projection into the skeleton's space.
+  const Clip run = testing::SyntheticClip(Rescaled(*skeleton_, 0.9), {.frames = 40, .seed = 3});
+  const Projection run_projection = ProjectionOf(0, run);
+  const int64_t run_id = Insert(Named("run"), run, {{*space_id, run_projection}});
+
+  const absl::StatusOr<std::vector<Projection>> loaded = Db().LoadProjections(*space_id);
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  ASSERT_EQ(loaded->size(), 3u);
+  EXPECT_EQ((*loaded)[0].clip_id, walk);
+  EXPECT_EQ((*loaded)[0].coordinates, walk_projection.coordinates);
+  EXPECT_EQ((*loaded)[1].clip_id, wave);
+  EXPECT_EQ((*loaded)[1].coordinates, wave_projection.coordinates);
+  EXPECT_EQ((*loaded)[2].clip_id, run_id);
+  EXPECT_EQ((*loaded)[2].coordinates, run_projection.coordinates);
+
+  const Counts counts = CountsNow();
+  EXPECT_EQ(counts.spaces, 1);
+  EXPECT_EQ(counts.projections, 3);
+  EXPECT_EQ(counts.frames, 90 + 70 + 40);
+}
+
+TEST_F(StorageSpaceTest, EveryClipOfASkeletonHasAProjectionInEachOfItsSpaces) {
+  const int64_t walk = Insert(Named("walk"), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  // A space must come with the projections of all its skeleton's clips...
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("body", skeleton), space_, {}).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  const int64_t space_id =
+      *Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)});
+  // ... and a clip with its projection into each space of its skeleton.
+  const Counts before = CountsNow();
+  const absl::StatusOr<int64_t> missing = Db().InsertClip(Named("wave"), wave_, {});
+  EXPECT_EQ(missing.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(missing.status().message(), HasSubstr("'body'"));
+  // More columns than the space has dimensions.
+  Projection wide = ProjectionOf(0, wave_);
+  wide.coordinates = RowMatrixXf::Zero(10, space_.dims() + 1);
+  EXPECT_EQ(Db().InsertClip(Named("wave"), wave_, {{space_id, wide}}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  // A space of another topology, and a clip of another topology.
+  const Clip chain = Motion(testing::ChainSkeleton(), 3);
+  EXPECT_EQ(
+      Db().InsertClip(Named("chain"), chain, {{space_id, ProjectionOf(0, wave_)}}).status().code(),
+      absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  const int64_t chain_id = Insert(Named("chain"), chain);
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("other", skeleton), space_,
+                             {ProjectionOf(walk, walk_), ProjectionOf(chain_id, walk_)})
+                .status()
+                .code(),
+            absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(
+      Db().InsertSpace(SpaceNamed("other", Db().GetClipRecord(chain_id)->skeleton_id), space_, {})
+          .status()
+          .code(),
+      absl::StatusCode::kFailedPrecondition);
+}
+
+TEST_F(StorageSpaceTest, DeletesCascade) {
+  const int64_t walk = Insert(Named("walk", {"a", "b"}), walk_);
+  const int64_t wave = Insert(Named("wave", {"a"}), wave_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  const int64_t space_id = *Db().InsertSpace(
+      SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_), ProjectionOf(wave, wave_)});
+  // Labels have no API yet: a manual label, one propagated from it in the space, and one on
+  // the other clip.
+  std::unique_ptr<SqliteConnection> raw = Raw();
+  ASSERT_TRUE(
+      raw->Execute(absl::StrCat(
+                       "INSERT INTO labels (clip_id, first_frame, last_frame, descriptor, value, "
+                       "origin, created_unix_ms) VALUES (",
+                       walk,
+                       ", 0, 10, 'kick', 1.0, 'manual', 0);"
+                       "INSERT INTO labels (clip_id, first_frame, last_frame, descriptor, value, "
+                       "origin, source_label_id, space_id, score, job_id, created_unix_ms) "
+                       "VALUES (",
+                       wave, ", 5, 9, 'kick', 0.7, 'propagated', last_insert_rowid(), ", space_id,
+                       ", 0.2, 'job-1', 0)"))
+          .ok());
+  // The schema refuses values outside [0, 1] and unknown origins.
+  EXPECT_FALSE(raw->Execute(absl::StrCat("INSERT INTO labels (clip_id, first_frame, last_frame, "
+                                         "descriptor, value, origin, created_unix_ms) VALUES (",
+                                         walk, ", 0, 1, 'x', 1.5, 'manual', 0)"))
+                   .ok());
+  EXPECT_FALSE(raw->Execute(absl::StrCat("INSERT INTO labels (clip_id, first_frame, last_frame, "
+                                         "descriptor, value, origin, created_unix_ms) VALUES (",
+                                         walk, ", 0, 1, 'x', 0.5, 'guessed', 0)"))
+                   .ok());
+  raw.reset();
+  EXPECT_EQ(CountsNow().labels, 2);
+
+  // Deleting the space keeps the labels found in it, and drops its projections.
+  ASSERT_TRUE(Db().DeleteSpace("body").ok());
+  Counts counts = CountsNow();
+  EXPECT_EQ(counts.spaces, 0);
+  EXPECT_EQ(counts.projections, 0);
+  EXPECT_EQ(counts.labels, 2);
+  EXPECT_EQ(Db().GetSpace(space_id).status().code(), absl::StatusCode::kNotFound);
+
+  // Deleting the labelled clip drops its tags, its label and the label propagated from it.
+  ASSERT_TRUE(Db().DeleteClip(walk).ok());
+  counts = CountsNow();
+  EXPECT_EQ(counts.clips, 1);
+  EXPECT_EQ(counts.labels, 0);
+  EXPECT_EQ(Db().GetClip(walk).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().ListClips({}, "b")->clips.size(), 0u);
+  EXPECT_EQ(Db().ListClips({}, "a")->clips.size(), 1u);
+
+  // Projections go with their clip.
+  const int64_t space2 =
+      *Db().InsertSpace(SpaceNamed("body2", skeleton), space_, {ProjectionOf(wave, wave_)});
+  ASSERT_TRUE(Db().DeleteClip(wave).ok());
+  EXPECT_EQ(CountsNow().projections, 0);
+  EXPECT_EQ(Db().LoadProjections(space2)->size(), 0u);
+  // Ids are not reused.
+  EXPECT_GT(Insert(Named("walk"), walk_, {{space2, ProjectionOf(0, walk_)}}), wave);
+}
+
+TEST_F(StorageSpaceTest, RejectedWritesChangeNothing) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 6);
+  const int64_t walk = Insert(Named("walk"), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  ASSERT_TRUE(
+      Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)}).ok());
+  Insert(Named("chain_01"), clip);
+  const Counts before = CountsNow();
+  Close();
+  const std::string file_before = FileBytes();
+
+  const absl::StatusOr<int64_t> duplicate = Db().InsertClip(Named("chain_01"), clip, {});
+  EXPECT_EQ(duplicate.status().code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(duplicate.status().message(), "a clip named 'chain_01' already exists");
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)})
+                .status()
+                .code(),
+            absl::StatusCode::kAlreadyExists);
+
+  const absl::StatusOr<StoredClip> missing = Db().GetClip(4242);
+  EXPECT_EQ(missing.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(missing.status().message(), "clip 4242 not found");
+  EXPECT_EQ(Db().GetClipRecord(4242).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().DeleteClip(4242).code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().DeleteSpace("nope").code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().GetSpaceRecord("nope").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().GetSpace(4242).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().LoadProjections(4242).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().ClipsOfSkeleton(4242).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("new", 4242), space_, {}).status().code(),
+            absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("new", skeleton), space_, {ProjectionOf(4242, walk_)})
+                .status()
+                .code(),
+            absl::StatusCode::kNotFound);
+
+  const std::vector<ClipRecord> bad_records = {
+      Named(""), Named(std::string(513, 'n')), Named("t", {""}),
+      Named("t", {std::string(129, 't')}), Named("t", std::vector<std::string>(65, "x"))};
+  for (const ClipRecord& record : bad_records) {
+    EXPECT_EQ(Db().InsertClip(record, clip, {}).status().code(), absl::StatusCode::kInvalidArgument)
+        << record.name;
+  }
+  // Beyond float32, and non-finite projections.
+  RowMatrixXd far = clip.positions();
+  far(0, 0) = 1e300;
+  const Clip far_clip =
+      *Clip::Create(clip.shared_skeleton(), clip.frame_time(), clip.rotations(), far);
+  EXPECT_EQ(Db().InsertClip(Named("far"), far_clip, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  Projection nan = ProjectionOf(walk, walk_);
+  nan.coordinates(1, 1) = NAN;
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("nan", skeleton), space_, {nan}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  SpaceRecord version0 = SpaceNamed("v0", skeleton);
+  version0.version = 0;
+  EXPECT_EQ(Db().InsertSpace(version0, space_, {ProjectionOf(walk, walk_)}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(Db().InsertSpace(SpaceNamed("", skeleton), space_, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  Close();
+  EXPECT_EQ(FileBytes(), file_before);
+}
+
+TEST_F(StorageTest, FailureMidTransactionLeavesNoRow) {
+  const Counts before = CountsNow();
+  Projection projection;
+  projection.coordinates = RowMatrixXf::Ones(3, 2);
+  // The clip row, its skeleton and tags are written before the projection's space is found
+  // missing; all of it rolls back.
+  const absl::StatusOr<int64_t> id = Db().InsertClip(
+      Named("walk", {"a"}), Motion(testing::ChainSkeleton(), 3), {{999, projection}});
+  EXPECT_EQ(id.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(id.status().message(), "space 999 not found");
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  EXPECT_EQ(Db().ListClips({})->clips.size(), 0u);
+  EXPECT_EQ(*Db().FindSkeleton(*testing::ChainSkeleton()), -1);
+  EXPECT_GT(Insert(Named("walk"), Motion(testing::ChainSkeleton(), 3)), 0);
+}
+
+TEST_F(StorageSpaceTest, ReopenKeepsEverything) {
+  const int64_t walk = Insert(Named("walk", {"x"}), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  const Projection projection = ProjectionOf(walk, walk_);
+  const int64_t space_id = *Db().InsertSpace(SpaceNamed("body", skeleton), space_, {projection});
+  const Counts before = CountsNow();
+  Close();
+  EXPECT_FALSE(std::filesystem::exists(path_ + "-wal"));  // checkpointed on close
+
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  const absl::StatusOr<StoredClip> stored = Db().GetClip(walk);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  ExpectSameFrames(walk_, stored->clip);
+  EXPECT_THAT(stored->record.tags, ::testing::ElementsAre("x"));
+  EXPECT_EQ(SerializeSpace(*Db().GetSpace(space_id)), SerializeSpace(space_));
+  EXPECT_EQ(Db().LoadProjections(space_id)->front().coordinates, projection.coordinates);
+  EXPECT_EQ(*Raw()->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+}
+
+TEST_F(StorageTest, NewerSchemaVersionIsRefused) {
+  Insert(Named("walk"), Motion(testing::ChainSkeleton(), 3));
+  Close();
+  ASSERT_TRUE(
+      Raw()->Execute(absl::StrCat("PRAGMA user_version = ", LatestSchemaVersion() + 1)).ok());
+  const absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_);
+  EXPECT_EQ(db.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(db.status().message(), HasSubstr("newer"));
+}
+
+TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {
+  { std::ofstream(path_) << "name,frames\nwalk,120\n"; }
+  const std::string bytes = FileBytes();
+  const absl::StatusOr<std::unique_ptr<Database>> text = Database::Open(path_);
+  EXPECT_EQ(text.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(text.status().message(), HasSubstr("not a SQLite database"));
+  EXPECT_EQ(FileBytes(), bytes);
+  EXPECT_FALSE(std::filesystem::exists(path_ + "-wal"));
+  std::filesystem::remove(path_);
+
+  // Another application's SQLite database.
+  ASSERT_TRUE(SqliteConnection::Open(path_, SqliteConnection::Mode::kReadWriteCreate, 0)
+                  .value()
+                  ->Execute("CREATE TABLE songs (title TEXT)")
+                  .ok());
+  const std::string sqlite_bytes = FileBytes();
+  EXPECT_EQ(Database::Open(path_).status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_EQ(FileBytes(), sqlite_bytes);
+
+  EXPECT_EQ(
+      Database::Open((dir_ / "absent.db").string(), {.create_if_missing = false}).status().code(),
+      absl::StatusCode::kNotFound);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "absent.db"));
+}
+
+TEST_F(StorageTest, DamagedFileFailsToOpen) {
+  for (int i = 0; i < 40; ++i)
+    Insert(Named(absl::StrCat("clip_", i), {"tag"}), Motion(testing::ChainSkeleton(), 200, i));
+  Close();
+  const std::string bytes = FileBytes();
+  constexpr size_t kPage = 4096;
+  ASSERT_GT(bytes.size(), 20 * kPage);
+  {
+    // Garbage over a few whole pages in the middle: page headers and pointers included.
+    std::fstream file(path_, std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp((bytes.size() / kPage / 2) * kPage);
+    const std::string garbage(4 * kPage, '\xA5');
+    file.write(garbage.data(), garbage.size());
+  }
+  const absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_);
+  ASSERT_FALSE(db.ok());
+  EXPECT_EQ(db.status().code(), absl::StatusCode::kFailedPrecondition) << db.status();
+  EXPECT_THAT(db.status().message(), HasSubstr("integrity"));
+}
+
+TEST_F(StorageTest, LockedDatabaseIsUnavailableToWritersOnly) {
+  Insert(Named("walk"), Motion(testing::ChainSkeleton(), 3));
+  Close();
+  absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_, {.busy_timeout_ms = 50});
+  ASSERT_TRUE(db.ok()) << db.status();
+  // Another process's writer, as far as SQLite can tell.
+  std::unique_ptr<SqliteConnection> other = Raw();
+  ASSERT_TRUE(other->Execute("BEGIN IMMEDIATE; DELETE FROM clip_tags").ok());
+  const absl::StatusOr<int64_t> id =
+      (*db)->InsertClip(Named("run"), Motion(testing::ChainSkeleton(), 3), {});
+  EXPECT_EQ(id.status().code(), absl::StatusCode::kUnavailable) << id.status();
+  // Readers do not wait for the writer.
+  const absl::StatusOr<Counts> counts = (*db)->GetCounts();
+  ASSERT_TRUE(counts.ok()) << counts.status();
+  EXPECT_EQ(counts->clips, 1);
+  ASSERT_TRUE(other->Execute("ROLLBACK").ok());
+  EXPECT_TRUE((*db)->InsertClip(Named("run"), Motion(testing::ChainSkeleton(), 3), {}).ok());
+}
+
+TEST_F(StorageTest, ReadersRunBesideAWriter) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 30);
+  const int64_t first = Insert(Named("seed", {"t"}), clip);
+  std::atomic<bool> stop = false;
+  std::atomic<int> failures = 0;
+  std::atomic<int> reads = 0;
+  std::vector<std::thread> threads;
+  for (int w = 0; w < 2; ++w) {
+    threads.emplace_back([&, w] {
+      for (int i = 0; !stop; ++i) {
+        if (!Db().InsertClip(Named(absl::StrCat("w", w, "_", i), {"t"}), clip, {}).ok()) ++failures;
+      }
+    });
+  }
+  for (int r = 0; r < 4; ++r) {
+    threads.emplace_back([&] {
+      int64_t last_count = 0;
+      while (!stop) {
+        const absl::StatusOr<Counts> counts = Db().GetCounts();
+        const absl::StatusOr<StoredClip> stored = Db().GetClip(first);
+        const absl::StatusOr<ClipPage> page = Db().ListClips(Sized(50), "t");
+        if (!counts.ok() || !stored.ok() || !page.ok() || counts->clips < last_count ||
+            counts->frames != 30 * counts->clips) {
+          ++failures;
+        } else {
+          last_count = counts->clips;
+        }
+        ++reads;
+      }
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  stop = true;
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(failures, 0);
+  EXPECT_GT(reads, 20);
+  EXPECT_GT(CountsNow().clips, 5);
+}
+
+// A writer SIGKILLed between and during commits: after reopening, the file passes its check,
+// every acknowledged clip is there whole, and no clip is there in part.
+TEST_F(StorageSpaceTest, KilledWriterLosesNoAcknowledgedClip) {
+  const int64_t walk = Insert(Named("walk", {"a", "b"}), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  const int64_t space_id =
+      *Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)});
+  Close();
+  const Clip big = testing::SyntheticClip(skeleton_, {.frames = 600, .seed = 4});
+  const Projection projection = ProjectionOf(0, big);
+
+  int pipe_fds[2];
+  ASSERT_EQ(pipe(pipe_fds), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // The child writes until killed; it must never return into the test framework.
+    close(pipe_fds[0]);
+    absl::StatusOr<std::unique_ptr<Database>> db =
+        Database::Open(path_, {.integrity_check = false});
+    if (!db.ok()) _exit(2);
+    for (int i = 0;; ++i) {
+      const absl::StatusOr<int64_t> id =
+          (*db)->InsertClip(Named(absl::StrCat("k", i), {"a", "b"}), big, {{space_id, projection}});
+      if (!id.ok() || write(pipe_fds[1], &*id, sizeof(int64_t)) != sizeof(int64_t)) _exit(3);
+    }
+  }
+  close(pipe_fds[1]);
+  constexpr size_t kAcknowledged = 40;
+  std::vector<int64_t> acknowledged;
+  int64_t id = 0;
+  while (acknowledged.size() < kAcknowledged && read(pipe_fds[0], &id, sizeof(id)) == sizeof(id)) {
+    acknowledged.push_back(id);
+  }
+  kill(child, SIGKILL);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "child exited with " << WEXITSTATUS(status);
+  // Ids written before the signal landed were acknowledged too.
+  while (read(pipe_fds[0], &id, sizeof(id)) == sizeof(id)) acknowledged.push_back(id);
+  close(pipe_fds[0]);
+  ASSERT_GE(acknowledged.size(), kAcknowledged);
+
+  EXPECT_EQ(*Raw()->QueryText("PRAGMA quick_check"), "ok");
+  const Counts counts = CountsNow();  // Open ran quick_check too
+  // Every acknowledged clip, the first one, and at most the one committed but not yet reported.
+  EXPECT_GE(counts.clips, static_cast<int64_t>(acknowledged.size()) + 1);
+  EXPECT_LE(counts.clips, static_cast<int64_t>(acknowledged.size()) + 2);
+  EXPECT_EQ(counts.projections, counts.clips);
+  for (const int64_t clip_id : acknowledged) {
+    const absl::StatusOr<StoredClip> stored = Db().GetClip(clip_id);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+    EXPECT_EQ(stored->clip.frame_count(), 600);
+    EXPECT_EQ(stored->record.tags.size(), 2u);
+  }
+  const absl::StatusOr<std::vector<Projection>> projections = Db().LoadProjections(space_id);
+  ASSERT_TRUE(projections.ok()) << projections.status();
+  EXPECT_EQ(static_cast<int64_t>(projections->size()), counts.clips);
+  std::unique_ptr<SqliteConnection> raw = Raw();
+  EXPECT_EQ(
+      *raw->QueryInt64("SELECT count(*) FROM clips WHERE "
+                       "length(rotations) != 16 * frame_count * joint_count OR "
+                       "length(positions) != 12 * frame_count * position_joint_count OR "
+                       "(SELECT count(*) FROM clip_tags t WHERE t.clip_id = clips.clip_id) != 2"),
+      0);
+}
+
+}  // namespace
+}  // namespace motiondb::storage
