@@ -150,17 +150,19 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
               static_cast<long long>(bench.queries[0].coordinates.rows()));
   std::printf("generate %.2f s, space+project %.2f s, index build %.3f s\n", bench.generate_s,
               bench.project_s, bench.build_s);
-  std::printf("memory: indexed coordinates (%d dims, float32) %.1f MiB; kd-tree %.1f MiB = "
-              "%.2fx; stored coordinates (16 dims) %.1f MiB; RSS growth during build %.1f MiB\n",
-              library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
-              library.tree_bytes() / 1048576.0 / indexed_mib,
-              library.coordinate_bytes() / 1048576.0, bench.build_rss_mib);
+  std::printf(
+      "memory: indexed coordinates (%d dims, float32) %.1f MiB; kd-tree %.1f MiB = "
+      "%.2fx; stored coordinates (16 dims) %.1f MiB; RSS growth during build %.1f MiB\n",
+      library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
+      library.tree_bytes() / 1048576.0 / indexed_mib, library.coordinate_bytes() / 1048576.0,
+      bench.build_rss_mib);
   MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, {}, false, queries, 3));
-  std::printf("fast : p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f ranking "
-              "%.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results\n",
-              Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99), fast.seeds_ms,
-              fast.clusters_ms, fast.warps_ms, fast.ranking_ms, fast.seeds, fast.clusters,
-              fast.warps, fast.results);
+  std::printf(
+      "fast : p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f ranking "
+      "%.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results\n",
+      Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99), fast.seeds_ms,
+      fast.clusters_ms, fast.warps_ms, fast.ranking_ms, fast.seeds, fast.clusters, fast.warps,
+      fast.results);
   MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, exact_queries, 1));
   std::printf("exact: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
@@ -180,9 +182,10 @@ absl::Status Sweeps(int queries) {
                 Percentile(fast.latencies, 0.5), Percentile(exact.latencies, 0.5));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(70, 120, -1, queries));
-  std::printf("\n120 Hz, %d dims:\n\n| neighbours | clusters | results | fast p50 (ms) |\n"
-              "|---|---|---|---|\n",
-              bench.library->dims());
+  std::printf(
+      "\n120 Hz, %d dims:\n\n| neighbours | clusters | results | fast p50 (ms) |\n"
+      "|---|---|---|---|\n",
+      bench.library->dims());
   for (int k : {100, 250, 500, 1000, 1500, 2500, 5000}) {
     SearchParams params;
     params.neighbours = k;
@@ -220,9 +223,9 @@ absl::Status Main(const cli::CommandLine& line) {
 }  // namespace motiondb
 
 int main(int argc, char** argv) {
-  const absl::StatusOr<motiondb::cli::CommandLine> line = motiondb::cli::CommandLine::Parse(
-      std::vector<std::string>(argv + 1, argv + argc), {"scenario", "queries", "exact-queries"},
-      {});
+  const absl::StatusOr<motiondb::cli::CommandLine> line =
+      motiondb::cli::CommandLine::Parse(std::vector<std::string>(argv + 1, argv + argc),
+                                        {"scenario", "queries", "exact-queries"}, {});
   const absl::Status status = line.ok() ? motiondb::Main(*line) : line.status();
   if (!status.ok()) {
     std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());

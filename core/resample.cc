@@ -20,7 +20,9 @@ absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
   }
   const int n = clip.frame_count();
   const double span = (n - 1) * clip.frame_time();
-  const double samples = std::floor(span * target_fps + 1e-9) + 1;
+  // A sample within 1% of a frame past the end takes the last frame: files write the frame time
+  // rounded (0.0333333 for 1/30 s), and the last frame should not be lost to that rounding.
+  const double samples = std::floor(span * target_fps + 0.01) + 1;
   if (samples > kMaxOutputFrames) {
     return absl::ResourceExhaustedError(
         absl::StrCat("resampling would produce ", samples, " frames"));
@@ -32,7 +34,7 @@ absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
   RowMatrixXd out_rotations(count, rotations.cols());
   RowMatrixXd out_positions(count, positions.cols());
   for (int k = 0; k < count; ++k) {
-    double u = k / target_fps / clip.frame_time();
+    double u = std::min(k / target_fps / clip.frame_time(), n - 1.0);
     if (std::abs(u - std::round(u)) < 1e-9) u = std::round(u);  // land exactly on source frames
     const int i = std::min(static_cast<int>(u), n - 1);
     const int next = std::min(i + 1, n - 1);

@@ -82,6 +82,17 @@ TEST(Resample, TakesTheShorterArcWhenStoredSignsFlip) {
   }
 }
 
+TEST(Resample, RoundedFrameTimeKeepsTheLastFrame) {
+  // 0.0333333 s is 1/30 rounded down: 120 frames span 3.9666627 s, just short of 119/30.
+  const Clip clip = MakeClip(
+      ChainSkeleton(), 120, 0.0333333, [](int f, int) { return TurnAt(f / 30.0); },
+      [](int, int) { return Eigen::Vector3d::Zero(); });
+  absl::StatusOr<Clip> out = Resample(clip, 30.0);
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(out->frame_count(), 120);
+  EXPECT_LT(AngleBetween(out->rotation(119, 1), clip.rotation(119, 1)), 1e-9);
+}
+
 TEST(Resample, SingleFrameStaysOneFrame) {
   absl::StatusOr<Clip> out = Resample(UniformMotion(30.0, 1), 120.0);
   ASSERT_TRUE(out.ok());
