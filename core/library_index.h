@@ -31,7 +31,7 @@ struct LibraryIndexOptions {
   // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
   int ann_dims = 10;
   // Points per kd-tree leaf.
-  int leaf_size = 16;
+  int leaf_size = 32;
 };
 
 struct Neighbour {
