@@ -14,6 +14,14 @@ int RunConvert(const std::vector<std::string>& args);
 int RunSpace(const std::vector<std::string>& args);
 int RunProject(const std::vector<std::string>& args);
 
+// Server commands (client/server_connection.h: --server, --token, --tls-ca, --timeout).
+int RunIngest(const std::vector<std::string>& args);
+int RunClips(const std::vector<std::string>& args);
+int RunClip(const std::vector<std::string>& args);
+int RunExport(const std::vector<std::string>& args);
+int RunRemoteSpace(const std::vector<std::string>& args);  // space create|list|show|delete
+int RunSearch(const std::vector<std::string>& args);
+int RunInfo(const std::vector<std::string>& args);
 
 }  // namespace motiondb::cli
 

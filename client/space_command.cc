@@ -190,6 +190,7 @@ absl::Status Build(const CommandLine& line) {
 }  // namespace
 
 int RunSpace(const std::vector<std::string>& args) {
+  if (args.empty() || args[0] != "build") return RunRemoteSpace(args);
   const absl::StatusOr<CommandLine> line =
       CommandLine::Parse(args, {"train", "out", "rate", "weights", "yaw-rate-weight", "metric"},
                          {"keep-heading", "json"});

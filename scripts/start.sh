@@ -1,14 +1,50 @@
 #!/usr/bin/env bash
-# One command for a newcomer: installs missing Debian packages, builds, and runs motiondb.
-# Until the server lands (issue 5), "runs" means: the offline CLI inspects a few real BVH files
-# (Debian's assimp-testmodels) and prints where the binary is.
+# One command for a newcomer: installs missing Debian packages, builds, and starts the
+# motiondb server with its embedded default storage (./motiondb.sqlite, 127.0.0.1:50051).
+#
+#   scripts/start.sh           start the server (Ctrl-C stops it gracefully)
+#   scripts/start.sh --demo    ... and load a small demo library into it first: the BVH files of
+#                              Debian's assimp-testmodels, and ../shared/mocap/bandai2-normal
+#                              when it is there, with a space called "demo" to search in
+# Extra arguments after the options go to motiondb-server (e.g. --listen 0.0.0.0:50051).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+demo=0
+if [[ "${1:-}" == "--demo" ]]; then
+  demo=1
+  shift
+fi
 "$root/scripts/install-deps.sh"
 "$root/scripts/build.sh"
+server="$root/build/server/motiondb-server"
 cli="$root/build/client/motiondb"
+
+"$server" --db "${MOTIONDB_DB:-./motiondb.sqlite}" "$@" &
+pid=$!
+trap 'kill -TERM "$pid" 2>/dev/null || true' INT TERM
+for _ in $(seq 100); do
+  "$cli" info --timeout 1 >/dev/null 2>&1 && break
+  kill -0 "$pid" 2>/dev/null || { wait "$pid"; exit $?; }
+  sleep 0.2
+done
+"$cli" info
+
+if ((demo)); then
+  echo "Loading the demo library..."
+  "$cli" ingest /usr/share/assimp/models/BVH/*.bvh --tag demo || true
+  bandai="$root/../shared/mocap/bandai2-normal"
+  if [[ -d "$bandai" ]]; then
+    "$cli" ingest "$bandai" --tag bandai || true
+    first=$("$cli" clips --tag bandai --json | /usr/bin/python3 -c \
+      'import json,sys; c=json.load(sys.stdin)["clips"]; print(c[0]["clip_id"] if c else "")')
+    if [[ -n "$first" ]]; then
+      skeleton=$("$cli" clip show "$first" --json | /usr/bin/python3 -c \
+        'import json,sys; print(json.load(sys.stdin)["skeleton_id"])')
+      "$cli" space create demo --skeleton "$skeleton" || true
+      echo "Try: $cli search --space demo --clip $first"
+    fi
+  fi
+fi
 echo
-echo "Built $cli. Inspecting the demo BVH files from assimp-testmodels:"
-"$cli" inspect /usr/share/assimp/models/BVH/*.bvh
-echo
-echo "Next: $cli help    (the gRPC server is not built yet; see README.md)"
+echo "motiondb-server is running (pid $pid). Use $cli help; Ctrl-C stops the server."
+wait "$pid"

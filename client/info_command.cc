@@ -1,0 +1,58 @@
+// motiondb info [--json]: the server's version, contents and resident indices. Exits 0 only
+// when the server answers, so it doubles as a health probe (docker/).
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_format.h"
+#include "client/commands.h"
+#include "client/server_connection.h"
+#include "core/status_macros.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
+
+namespace motiondb::cli {
+namespace {
+
+absl::Status Info(const CommandLine& line, const ServerConnection& connection) {
+  if (!line.positionals().empty()) return absl::InvalidArgumentError("unexpected arguments");
+  const auto stub = v1::ServerService::NewStub(connection.channel());
+  v1::ServerInfo info;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->GetServerInfo(context, v1::GetServerInfoRequest(), &info);
+  }));
+  const v1::DatabaseCounts& c = info.counts();
+  if (line.flag("json")) {
+    nlohmann::json indices = nlohmann::json::array();
+    for (const v1::SpaceIndexInfo& index : info.indices()) indices.push_back(index.space());
+    std::cout << nlohmann::json{{"version", info.version()},
+                                {"uptime_s", info.uptime_s()},
+                                {"clips", c.clips()},
+                                {"frames", c.frames()},
+                                {"skeletons", c.skeletons()},
+                                {"spaces", c.spaces()},
+                                {"projections", c.projections()},
+                                {"index_bytes", info.index_bytes()},
+                                {"indexed_spaces", indices},
+                                {"auth_required", info.auth_required()},
+                                {"tls", info.tls()}}
+                     .dump()
+              << "\n";
+  } else {
+    absl::PrintF("motiondb-server %s at %s, up %.0f s\n", info.version(), connection.address(),
+                 info.uptime_s());
+    absl::PrintF("  %d clips (%d frames), %d skeletons, %d spaces, %d cached projections\n",
+                 c.clips(), c.frames(), c.skeletons(), c.spaces(), c.projections());
+    absl::PrintF("  resident indices: %d spaces, %.1f MiB\n", info.indices_size(),
+                 info.index_bytes() / 1048576.0);
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+int RunInfo(const std::vector<std::string>& args) {
+  return RunServerCommand("info", "motiondb info [--json] [--server ADDR] [--token T]", args, {},
+                          {"json"}, Info);
+}
+
+}  // namespace motiondb::cli

@@ -1,0 +1,130 @@
+#include "server/index_registry.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "core/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+// The kd-tree's dimensions: the search's default seed dimensions, or fewer for a small space.
+constexpr int kAnnDims = 10;
+
+// Copies of the clip's coordinates held by `index` (the index owns one block for all clips).
+RowMatrixXf CopyCoordinates(const LibraryIndex& index, int clip_index) {
+  const CoordinateView view = index.clip_coordinates(clip_index);
+  RowMatrixXf copy(view.rows, index.dims());
+  for (int64_t r = 0; r < view.rows; ++r) {
+    std::copy(view.row(r), view.row(r) + index.dims(), copy.row(r).data());
+  }
+  return copy;
+}
+
+// Every clip of `base`, except `skip_id`, as clips to index again.
+std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
+  std::vector<IndexedClip> clips;
+  if (!base.index) return clips;
+  for (int c = 0; c < base.index->clip_count(); ++c) {
+    const int64_t id = base.index->clip(c).clip_id;
+    if (id == skip_id) continue;
+    clips.push_back({id, base.clips.at(id), CopyCoordinates(*base.index, c)});
+  }
+  return clips;
+}
+
+}  // namespace
+
+FrameConversion SpaceSnapshot::Conversion(int64_t clip_id) const {
+  const IndexedClipInfo& info = clips.at(clip_id);
+  const LibraryIndex::ClipEntry& entry = index->clip(index->FindClip(clip_id));
+  return FrameConversion(info.fps, info.frame_count, space->sample_rate(), entry.frame_count);
+}
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
+    storage::SpaceRecord record, std::shared_ptr<const MotionSpace> space,
+    std::vector<IndexedClip> clips) {
+  auto snapshot = std::make_shared<SpaceSnapshot>();
+  snapshot->record = std::move(record);
+  snapshot->space = std::move(space);
+  if (clips.empty()) return snapshot;
+  std::sort(clips.begin(), clips.end(),
+            [](const IndexedClip& a, const IndexedClip& b) { return a.clip_id < b.clip_id; });
+  std::vector<LibraryClip> library;
+  library.reserve(clips.size());
+  for (IndexedClip& clip : clips) {
+    library.push_back({clip.clip_id, clip.info.name, clip.info.tags, std::move(clip.coordinates)});
+    snapshot->clips.emplace(clip.clip_id, std::move(clip.info));
+  }
+  LibraryIndexOptions options;
+  options.ann_dims = std::min(kAnnDims, snapshot->space->dims());
+  MOTIONDB_ASSIGN_OR_RETURN(
+      std::unique_ptr<LibraryIndex> index,
+      LibraryIndex::Build(std::move(library), snapshot->space->sample_rate(), options));
+  snapshot->index = std::move(index);
+  return snapshot;
+}
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
+                                                                      IndexedClip clip) {
+  std::vector<IndexedClip> clips = ClipsOf(base, clip.clip_id);
+  clips.push_back(std::move(clip));
+  return BuildSnapshot(base.record, base.space, std::move(clips));
+}
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithoutClip(const SpaceSnapshot& base,
+                                                                         int64_t clip_id) {
+  if (!base.clips.contains(clip_id)) {
+    return std::shared_ptr<const SpaceSnapshot>(std::make_shared<SpaceSnapshot>(base));
+  }
+  return BuildSnapshot(base.record, base.space, ClipsOf(base, clip_id));
+}
+
+std::shared_ptr<const SpaceSnapshot> IndexRegistry::Find(const std::string& name) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = spaces_.find(name);
+  return it == spaces_.end() ? nullptr : it->second;
+}
+
+std::vector<std::shared_ptr<const SpaceSnapshot>> IndexRegistry::All() const {
+  std::vector<std::shared_ptr<const SpaceSnapshot>> all;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [name, snapshot] : spaces_) all.push_back(snapshot);
+  }
+  std::sort(all.begin(), all.end(),
+            [](const auto& a, const auto& b) { return a->record.space_id < b->record.space_id; });
+  return all;
+}
+
+std::vector<std::shared_ptr<const SpaceSnapshot>> IndexRegistry::OfSkeleton(
+    int64_t skeleton_id) const {
+  std::vector<std::shared_ptr<const SpaceSnapshot>> spaces = All();
+  std::erase_if(spaces, [&](const auto& s) { return s->record.skeleton_id != skeleton_id; });
+  return spaces;
+}
+
+void IndexRegistry::Put(std::shared_ptr<const SpaceSnapshot> snapshot) {
+  // The old snapshot is released outside the lock: freeing a large index takes a while, and
+  // readers holding it keep it alive anyway.
+  std::shared_ptr<const SpaceSnapshot> old;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::shared_ptr<const SpaceSnapshot>& slot = spaces_[snapshot->record.name];
+    old = std::move(slot);
+    slot = std::move(snapshot);
+  }
+}
+
+void IndexRegistry::Remove(const std::string& name) {
+  std::shared_ptr<const SpaceSnapshot> old;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = spaces_.find(name);
+    if (it == spaces_.end()) return;
+    old = std::move(it->second);
+    spaces_.erase(it);
+  }
+}
+
+}  // namespace motiondb::server

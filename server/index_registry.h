@@ -1,0 +1,85 @@
+// The resident search indices, one immutable snapshot per space. Readers take a snapshot (a
+// shared_ptr copied under a short lock) and search it without further locking; writers build a
+// new snapshot aside (from the old one's coordinates plus or minus a clip, never re-reading the
+// database) and swap it in. A search therefore never waits for an ingest or a rebuild, and
+// always sees one consistent library.
+#ifndef MOTIONDB_SERVER_INDEX_REGISTRY_H_
+#define MOTIONDB_SERVER_INDEX_REGISTRY_H_
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "core/library_index.h"
+#include "core/motion_space.h"
+#include "server/frame_conversion.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+// What the search needs to know about an indexed clip beyond its coordinates.
+struct IndexedClipInfo {
+  std::string name;
+  std::vector<std::string> tags;
+  double fps = 0;       // original rate
+  int frame_count = 0;  // original frames
+};
+
+// A clip to index: its info and its projection (frames at the space rate x the space's dims,
+// pre-scaled by the metric, as storage::Projection holds it).
+struct IndexedClip {
+  int64_t clip_id = 0;
+  IndexedClipInfo info;
+  RowMatrixXf coordinates;
+};
+
+struct SpaceSnapshot {
+  storage::SpaceRecord record;
+  std::shared_ptr<const MotionSpace> space;
+  // Null when the space's skeleton has no clips left.
+  std::shared_ptr<const LibraryIndex> index;
+  absl::flat_hash_map<int64_t, IndexedClipInfo> clips;
+
+  // The indexed clip's frame mapping; the clip must be indexed.
+  FrameConversion Conversion(int64_t clip_id) const;
+  int64_t coordinate_bytes() const { return index ? index->coordinate_bytes() : 0; }
+  int64_t tree_bytes() const { return index ? index->tree_bytes() : 0; }
+};
+
+// Snapshot construction; pure functions.
+// A snapshot of `clips` (any order; indexed in clip id order).
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
+    storage::SpaceRecord record, std::shared_ptr<const MotionSpace> space,
+    std::vector<IndexedClip> clips);
+// `base` with `clip` added (or replaced, when its id is indexed already).
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
+                                                                      IndexedClip clip);
+// `base` without the clip; `base` itself when the clip is not indexed.
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithoutClip(const SpaceSnapshot& base,
+                                                                         int64_t clip_id);
+
+// Thread-safe.
+class IndexRegistry {
+ public:
+  // Null when no space has that name.
+  std::shared_ptr<const SpaceSnapshot> Find(const std::string& name) const;
+  // Every space, in space id order.
+  std::vector<std::shared_ptr<const SpaceSnapshot>> All() const;
+  std::vector<std::shared_ptr<const SpaceSnapshot>> OfSkeleton(int64_t skeleton_id) const;
+  // Adds the snapshot, or replaces the one of the same name.
+  void Put(std::shared_ptr<const SpaceSnapshot> snapshot);
+  void Remove(const std::string& name);
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const SpaceSnapshot>> spaces_;
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_INDEX_REGISTRY_H_

@@ -1,0 +1,38 @@
+// What motiondb-server is told on its command line (server/main.cc parses the flags).
+#ifndef MOTIONDB_SERVER_SERVER_OPTIONS_H_
+#define MOTIONDB_SERVER_SERVER_OPTIONS_H_
+
+#include <cstdint>
+#include <string>
+
+namespace motiondb::server {
+
+struct ServerOptions {
+  // The SQLite file; created when missing (--db).
+  std::string db_path = "./motiondb.sqlite";
+  // host:port to listen on; port 0 picks a free one, reported by MotionDbServer::port()
+  // (--listen).
+  std::string listen = "127.0.0.1:50051";
+  // Most calls handled at once; further calls are refused with RESOURCE_EXHAUSTED rather than
+  // queued (gRPC's sync-server thread quota). 0: no limit (--threads).
+  int threads = 0;
+  // Largest request message, in MiB: gRPC itself refuses larger ones with RESOURCE_EXHAUSTED
+  // before any handler runs (--max-message-mb).
+  int max_message_mb = 256;
+  // Largest BVH file accepted by IngestClip, IngestClipStream (all chunks together) and BVH
+  // queries, in bytes; larger ones fail with RESOURCE_EXHAUSTED (--max-bvh-mb, in MiB).
+  int64_t max_bvh_bytes = int64_t{1} << 30;
+  // When non-empty, every call must carry the metadata "authorization: Bearer <token>"
+  // (read from --auth-token-file).
+  std::string auth_token;
+  // PEM certificate chain and private key: both serve TLS, neither plain text (read from
+  // --tls-cert and --tls-key).
+  std::string tls_cert_pem;
+  std::string tls_key_pem;
+  // One line per call on stderr (server/request_logger.h).
+  bool log_requests = true;
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_SERVER_OPTIONS_H_

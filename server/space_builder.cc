@@ -1,0 +1,181 @@
+#include "server/space_builder.h"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+#include "core/search_coordinates.h"
+#include "core/status_macros.h"
+#include "server/frame_conversion.h"
+#include "server/space_report.h"
+
+namespace motiondb::server {
+namespace {
+
+int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+absl::StatusOr<storage::ClipRecord> TrainingRecord(storage::Database& database, size_t index,
+                                                   int64_t clip_id) {
+  absl::StatusOr<storage::ClipRecord> record = database.GetClipRecord(clip_id);
+  if (absl::IsNotFound(record.status())) {
+    return absl::NotFoundError(absl::StrCat("training[", index, "]: no clip with id ", clip_id));
+  }
+  return record;
+}
+
+// The skeleton the space is built on, from the request's training clips, its skeleton_id, or
+// the database's only skeleton.
+absl::StatusOr<int64_t> ResolveSkeleton(storage::Database& database, const SpaceRequest& request) {
+  if (!request.training.empty()) {
+    std::optional<int64_t> skeleton;
+    int64_t first_clip = 0;
+    for (size_t i = 0; i < request.training.size(); ++i) {
+      MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record,
+                                TrainingRecord(database, i, request.training[i].clip_id));
+      if (!skeleton) {
+        skeleton = record.skeleton_id;
+        first_clip = record.clip_id;
+      } else if (record.skeleton_id != *skeleton) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "training clips are of different skeletons: clip ", first_clip, " is on skeleton ",
+            *skeleton, ", clip ", record.clip_id, " on skeleton ", record.skeleton_id));
+      }
+    }
+    if (request.skeleton_id && *request.skeleton_id != *skeleton) {
+      return absl::FailedPreconditionError(absl::StrCat("the training clips are on skeleton ",
+                                                        *skeleton, ", not on skeleton_id ",
+                                                        *request.skeleton_id));
+    }
+    return *skeleton;
+  }
+  if (request.skeleton_id) return *request.skeleton_id;
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Counts counts, database.GetCounts());
+  if (counts.skeletons > 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the database holds ", counts.skeletons, " skeletons: give skeleton_id or training clips"));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipPage page, database.ListClips(storage::Page{1, ""}));
+  if (page.clips.empty()) {
+    return absl::FailedPreconditionError("the database holds no clips to train a space on");
+  }
+  return page.clips.front().skeleton_id;
+}
+
+// Samples Resample() makes of `frames` frames: every k with k / rate within the span.
+int64_t SampleCount(int frames, double fps, double rate) {
+  return static_cast<int64_t>(std::floor((frames - 1) / fps * rate + 1e-9)) + 1;
+}
+
+}  // namespace
+
+absl::Status ValidateSpaceName(const std::string& name) {
+  if (name.empty() || name.size() > 128) {
+    return absl::InvalidArgumentError("name: a space name has 1 to 128 characters");
+  }
+  for (const char c : name) {
+    const bool allowed = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                         (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
+    if (!allowed) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("name: '", name, "' may only contain letters, digits, '.', '_' and '-'"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCache& facts,
+                                      const SpaceRequest& request,
+                                      const std::function<bool()>& should_stop) {
+  const auto start = std::chrono::steady_clock::now();
+  auto check_stop = [&]() -> absl::Status {
+    if (should_stop && should_stop()) return absl::CancelledError("space build cancelled");
+    return absl::OkStatus();
+  };
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, ResolveSkeleton(database, request));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> clip_ids,
+                            database.ClipsOfSkeleton(skeleton_id));
+  if (clip_ids.empty()) {
+    return absl::NotFoundError(absl::StrCat("skeleton ", skeleton_id, " has no clips"));
+  }
+
+  // Training clips are kept loaded: they are trained on, measured, and projected.
+  std::vector<TrainingRange> ranges = request.training;
+  if (ranges.empty()) {
+    for (const int64_t id : clip_ids) ranges.push_back({id, std::nullopt, std::nullopt});
+  }
+  std::map<int64_t, storage::StoredClip> loaded;
+  std::vector<ClipRange> training;
+  v1::SpaceBuildReport report;
+  int64_t training_frames = 0;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    MOTIONDB_RETURN_IF_ERROR(check_stop());
+    auto it = loaded.find(ranges[i].clip_id);
+    if (it == loaded.end()) {
+      MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(ranges[i].clip_id));
+      it = loaded.emplace(ranges[i].clip_id, std::move(stored)).first;
+    }
+    const Clip& clip = it->second.clip;
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const FrameRange frames,
+        ResolveFrameRange(ranges[i].first_frame, ranges[i].last_frame, clip.frame_count(),
+                          absl::StrCat("training[", i, "]")));
+    training.push_back({it->second.record.name, clip, frames});
+    v1::ClipRange* used = report.add_training();
+    used->set_clip_id(ranges[i].clip_id);
+    used->set_first_frame(frames.first);
+    used->set_last_frame(frames.last);
+    training_frames += SampleCount(frames.size(), clip.fps(), request.options.sample_rate);
+  }
+
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built, MotionSpace::Build(training, request.options));
+  auto space = std::make_shared<const MotionSpace>(std::move(built));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
+                            space->RepresentationalError(training));
+  training.clear();
+
+  BuiltSpace result;
+  for (const int64_t id : clip_ids) {
+    MOTIONDB_RETURN_IF_ERROR(check_stop());
+    // A training clip is projected from memory and then released; others are loaded now.
+    absl::StatusOr<storage::StoredClip> loaded_clip = absl::NotFoundError("");
+    if (auto it = loaded.find(id); it != loaded.end()) {
+      loaded_clip = std::move(it->second);
+      loaded.erase(it);
+    } else {
+      loaded_clip = database.GetClip(id);
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, std::move(loaded_clip));
+    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space, stored.clip));
+    facts.Put(id, ClipFacts::Of(stored.clip));
+    result.clips.push_back(
+        {id,
+         {stored.record.name, stored.record.tags, stored.clip.fps(), stored.clip.frame_count()},
+         std::move(coordinates)});
+  }
+
+  // The training list was filled above; the rest describes the finished space.
+  v1::SpaceBuildReport description = DescribeSpace(*space);
+  description.mutable_training()->Swap(report.mutable_training());
+  report = std::move(description);
+  report.set_weight_preset(ToProto(request.options.weights.preset));
+  report.set_training_frames(training_frames);
+  AddReconstructionErrors(errors, &report);
+  report.set_projected_clips(static_cast<int64_t>(result.clips.size()));
+  report.set_build_ms(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+
+  result.record.name = request.name;
+  result.record.skeleton_id = skeleton_id;
+  result.record.version = 1;
+  result.record.created_unix_ms = NowUnixMs();
+  result.record.build_report_json = ReportToJson(report);
+  result.space = std::move(space);
+  return result;
+}
+
+}  // namespace motiondb::server

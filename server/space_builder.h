@@ -1,0 +1,54 @@
+// Building a space from the database (SpaceService.CreateSpace): resolve the skeleton and the
+// training ranges, learn the space, measure its reconstruction error, and project every clip of
+// the skeleton into it. Writes nothing: server/library.h stores the result.
+#ifndef MOTIONDB_SERVER_SPACE_BUILDER_H_
+#define MOTIONDB_SERVER_SPACE_BUILDER_H_
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/motion_space.h"
+#include "server/clip_facts.h"
+#include "server/index_registry.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+// Frames of a stored clip at its own rate; unset bounds are the clip's ends.
+struct TrainingRange {
+  int64_t clip_id = 0;
+  std::optional<int> first_frame;
+  std::optional<int> last_frame;
+};
+
+struct SpaceRequest {
+  std::string name;
+  // The skeleton; optional when `training` is given or the database holds one skeleton.
+  std::optional<int64_t> skeleton_id;
+  // Empty: every clip of the skeleton, whole.
+  std::vector<TrainingRange> training;
+  SpaceOptions options;
+};
+
+struct BuiltSpace {
+  storage::SpaceRecord record;  // without space_id; the report as JSON
+  std::shared_ptr<const MotionSpace> space;
+  std::vector<IndexedClip> clips;  // every clip of the skeleton, projected
+};
+
+// Letters, digits, '.', '_' and '-', 1 to 128 of them: safe in URLs, file names and logs.
+absl::Status ValidateSpaceName(const std::string& name);
+
+// `should_stop` is polled between clips; when it returns true the build ends with CANCELLED.
+absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCache& facts,
+                                      const SpaceRequest& request,
+                                      const std::function<bool()>& should_stop);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_SPACE_BUILDER_H_

@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""The server, driven by a client written against generated Python stubs (python3-grpcio).
+
+Starts the real motiondb-server on a free loopback port with a temporary database.
+usage: client_test.py SERVER_BINARY EXAMPLE_SCRIPT   (PYTHONPATH must hold the stubs)
+"""
+import math
+import os
+import pathlib
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import grpc
+
+from motiondb.v1 import clip_service_pb2, clip_service_pb2_grpc
+from motiondb.v1 import common_pb2
+from motiondb.v1 import search_service_pb2, search_service_pb2_grpc
+from motiondb.v1 import server_service_pb2, server_service_pb2_grpc
+from motiondb.v1 import space_service_pb2, space_service_pb2_grpc
+
+SERVER = EXAMPLE = None
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):
+    """A small 3-joint skeleton raising its arm once: a valid BVH written here."""
+    rows = []
+    for f in range(frames):
+        t = f / (frames - 1)
+        angle = lift * 120.0 * math.sin(math.pi * t) ** 2
+        rows.append(f"0 90 0 {phase:.3f} 0 0 0 {angle:.4f} 0 {angle / 3:.4f} 0 0")
+    return ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n"
+            " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+            " JOINT Shoulder\n {\n  OFFSET 10 40 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "  JOINT Elbow\n  {\n   OFFSET 25 0 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "   End Site\n   {\n    OFFSET 25 0 0\n   }\n  }\n }\n}\n"
+            f"MOTION\nFrames: {frames}\nFrame Time: 0.0333333\n" + "\n".join(rows) + "\n")
+
+
+class ServerTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        cls.port = free_port()
+        cls.address = f"127.0.0.1:{cls.port}"
+        cls.server = subprocess.Popen(
+            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", cls.address],
+            stdout=subprocess.DEVNULL, stderr=open(os.path.join(cls.dir.name, "server.log"), "w"))
+        cls.channel = grpc.insecure_channel(cls.address)
+        grpc.channel_ready_future(cls.channel).result(timeout=30)
+        cls.clips = clip_service_pb2_grpc.ClipServiceStub(cls.channel)
+        cls.spaces = space_service_pb2_grpc.SpaceServiceStub(cls.channel)
+        cls.search = search_service_pb2_grpc.SearchServiceStub(cls.channel)
+        cls.info = server_service_pb2_grpc.ServerServiceStub(cls.channel)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.channel.close()
+        cls.server.send_signal(signal.SIGTERM)
+        code = cls.server.wait(timeout=30)
+        cls.dir.cleanup()
+        assert code == 0, f"motiondb-server exited with {code} after SIGTERM"
+
+    def ingest(self, name, text, tags=()):
+        return self.clips.IngestClip(clip_service_pb2.IngestClipRequest(
+            file_name=name, bvh=text.encode(), tags=list(tags)), timeout=30)
+
+    def test_1_ingest_space_and_search(self):
+        ids = [self.ingest(f"raise_{i}.bvh", arm_raise_bvh(80 + 5 * i, 0.8 + 0.1 * i), ["raise"])
+               .clip.clip_id for i in range(4)]
+        ids.append(self.ingest("still.bvh", arm_raise_bvh(80, 0.0), ["still"]).clip.clip_id)
+        listed = self.clips.ListClips(clip_service_pb2.ListClipsRequest(tag="raise"), timeout=10)
+        self.assertEqual([c.name for c in listed.clips], [f"raise_{i}" for i in range(4)])
+        clip = self.clips.GetClip(clip_service_pb2.GetClipRequest(clip_id=ids[0]), timeout=10)
+        self.assertEqual(clip.frame_count, 80)
+        self.assertAlmostEqual(clip.fps, 30.0, places=3)
+
+        space = self.spaces.CreateSpace(space_service_pb2.CreateSpaceRequest(
+            name="arms", skeleton_id=clip.skeleton_id), timeout=60)
+        self.assertGreater(space.report.dims, 0)
+        self.assertAlmostEqual(sum(space.report.explained_variance), 1.0, places=6)
+
+        response = self.search.Search(search_service_pb2.SearchRequest(
+            space="arms", clip=common_pb2.ClipRange(clip_id=ids[1]), max_results=10), timeout=30)
+        self.assertGreater(len(response.results), 0)
+        self.assertEqual(response.results[0].clip_id, ids[1], "a clip finds itself first")
+        self.assertNotIn(ids[-1], [r.clip_id for r in response.results[:4]])
+        self.assertGreaterEqual(response.timings.total_ms, 0)
+
+        exported = self.clips.ExportClip(clip_service_pb2.ExportClipRequest(
+            clip=common_pb2.ClipRange(clip_id=ids[0], first_frame=10, last_frame=19)), timeout=10)
+        self.assertIn(b"Frames: 10", exported.bvh)
+
+    def test_2_errors_have_real_codes(self):
+        def code(call):
+            with self.assertRaises(grpc.RpcError) as raised:
+                call()
+            return raised.exception.code(), raised.exception.details()
+
+        status, details = code(lambda: self.ingest("bad.bvh", "HIERARCHY\nROOT a\n{\nOFFSET 0 0\n"))
+        self.assertEqual(status, grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("line", details)
+        status, _ = code(lambda: self.clips.GetClip(
+            clip_service_pb2.GetClipRequest(clip_id=999999), timeout=10))
+        self.assertEqual(status, grpc.StatusCode.NOT_FOUND)
+        status, _ = code(lambda: self.search.Search(search_service_pb2.SearchRequest(
+            space="no-such-space", clip=common_pb2.ClipRange(clip_id=1)), timeout=10))
+        self.assertEqual(status, grpc.StatusCode.NOT_FOUND)
+
+    def test_3_example_script_runs(self):
+        with tempfile.TemporaryDirectory() as work:
+            files = []
+            for i in range(2):
+                path = pathlib.Path(work) / f"example_{i}.bvh"
+                path.write_text(arm_raise_bvh(70 + 10 * i))
+                files.append(str(path))
+            run = subprocess.run([sys.executable, EXAMPLE, "--server", self.address,
+                                  "--space", "arms", *files],
+                                 capture_output=True, text=True, timeout=120)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            self.assertIn("results in", run.stdout)
+
+    def test_4_server_info(self):
+        info = self.info.GetServerInfo(server_service_pb2.GetServerInfoRequest(), timeout=10)
+        self.assertTrue(info.version)
+        self.assertGreaterEqual(info.counts.clips, 5)
+
+
+if __name__ == "__main__":
+    SERVER, EXAMPLE = sys.argv[1], sys.argv[2]
+    unittest.main(argv=sys.argv[:1], verbosity=2)

@@ -1,0 +1,1151 @@
+// Integration tests of motiondb-server: the real binary on a free loopback port with a temporary
+// database, driven through the generated gRPC stubs as a client would.
+#include <signal.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <google/protobuf/descriptor.pb.h>
+#include <google/protobuf/unknown_field_set.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <gtest/gtest.h>
+
+#include "core/bvh_reader.h"
+#include "core/bvh_writer.h"
+#include "core/synthetic_library.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/search_service.grpc.pb.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
+#include "motiondb/v1/space_service.grpc.pb.h"
+#include "tests/clip_builder.h"
+#include "tests/server_process.h"
+#include "tests/test_data.h"
+
+namespace motiondb {
+namespace {
+
+namespace v1 = ::motiondb::v1;
+using ::testing::HasSubstr;
+using testing::ServerProcess;
+
+// ---------------------------------------------------------------------------------------------
+// Test data.
+
+// A small library of the synthetic humanoid (21 joints) with arm raises and shrugs at 50 fps,
+// in clips of about 20 s; generated once.
+const SyntheticLibrary& Humanoid() {
+  static const SyntheticLibrary* const library = [] {
+    SyntheticLibraryOptions options;
+    options.seed = 7;
+    options.script = {{SyntheticAction::kRightArmRaise, 4},
+                      {SyntheticAction::kLeftArmRaise, 4},
+                      {SyntheticAction::kBothArmsRaise, 3},
+                      {SyntheticAction::kShrug, 3}};
+    options.max_clip_duration_s = 20;
+    options.threads = 2;
+    absl::StatusOr<SyntheticLibrary> generated = GenerateSyntheticLibrary(options);
+    EXPECT_TRUE(generated.ok()) << generated.status();
+    return new SyntheticLibrary(*std::move(generated));
+  }();
+  return *library;
+}
+
+std::string BvhText(const Clip& clip) {
+  absl::StatusOr<std::string> text = WriteBvh(clip);
+  EXPECT_TRUE(text.ok()) << text.status();
+  return text.ok() ? *text : "";
+}
+
+// A 3-joint chain (another skeleton than the humanoid's) turning slowly, 61 frames at 30 fps.
+Clip ChainClip(double speed = 0.02) {
+  return testing::MakeClip(
+      testing::ChainSkeleton(), 61, 1.0 / 30,
+      [speed](int f, int j) {
+        return Quat(Eigen::AngleAxisd(speed * f * (j + 1), Eigen::Vector3d::UnitY()));
+      },
+      [](int f, int) { return Eigen::Vector3d(0.1 * f, 90, 0); });
+}
+
+// ---------------------------------------------------------------------------------------------
+// A client of one server.
+
+class Client {
+ public:
+  explicit Client(std::shared_ptr<grpc::Channel> channel, std::string token = "")
+      : channel_(std::move(channel)),
+        token_(std::move(token)),
+        clips_(v1::ClipService::NewStub(channel_)),
+        spaces_(v1::SpaceService::NewStub(channel_)),
+        search_(v1::SearchService::NewStub(channel_)),
+        server_(v1::ServerService::NewStub(channel_)) {}
+
+  // A call context carrying the token and a deadline (generous by default: a test that hangs
+  // should fail, not stall the suite).
+  std::unique_ptr<grpc::ClientContext> Context(
+      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) const {
+    auto context = std::make_unique<grpc::ClientContext>();
+    context->set_deadline(std::chrono::system_clock::now() + deadline);
+    if (!token_.empty()) context->AddMetadata("authorization", "Bearer " + token_);
+    return context;
+  }
+
+  grpc::Status Ingest(const std::string& file_name, const std::string& bvh,
+                      v1::IngestClipResponse* response, std::vector<std::string> tags = {}) {
+    v1::IngestClipRequest request;
+    request.set_file_name(file_name);
+    request.set_bvh(bvh);
+    for (const std::string& tag : tags) request.add_tags(tag);
+    return clips_->IngestClip(Context().get(), request, response);
+  }
+  // The new clip's id, or -1 after a failed expectation.
+  int64_t IngestOrFail(const std::string& file_name, const std::string& bvh,
+                       std::vector<std::string> tags = {}) {
+    v1::IngestClipResponse response;
+    const grpc::Status status = Ingest(file_name, bvh, &response, std::move(tags));
+    EXPECT_TRUE(status.ok()) << file_name << ": " << status.error_message();
+    return status.ok() ? response.clip().clip_id() : -1;
+  }
+
+  grpc::Status CreateSpace(const v1::CreateSpaceRequest& request, v1::Space* space) {
+    return spaces_->CreateSpace(Context().get(), request, space);
+  }
+  grpc::Status Search(const v1::SearchRequest& request, v1::SearchResponse* response,
+                      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) {
+    return search_->Search(Context(deadline).get(), request, response);
+  }
+
+  v1::ClipService::Stub& clips() { return *clips_; }
+  v1::SpaceService::Stub& spaces() { return *spaces_; }
+  v1::SearchService::Stub& search() { return *search_; }
+  v1::ServerService::Stub& server() { return *server_; }
+  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
+
+ private:
+  std::shared_ptr<grpc::Channel> channel_;
+  std::string token_;
+  std::unique_ptr<v1::ClipService::Stub> clips_;
+  std::unique_ptr<v1::SpaceService::Stub> spaces_;
+  std::unique_ptr<v1::SearchService::Stub> search_;
+  std::unique_ptr<v1::ServerService::Stub> server_;
+};
+
+v1::SearchRequest ClipQuery(const std::string& space, int64_t clip_id, int first, int last) {
+  v1::SearchRequest request;
+  request.set_space(space);
+  request.mutable_clip()->set_clip_id(clip_id);
+  request.mutable_clip()->set_first_frame(first);
+  request.mutable_clip()->set_last_frame(last);
+  return request;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fixture: a temporary folder with the database; servers started on it.
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::path(::testing::TempDir()) /
+           ("server_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    db_ = (dir_ / "motiondb.sqlite").string();
+  }
+  void TearDown() override {
+    if (HasFailure()) {
+      for (const auto& server : servers_) {
+        std::cerr << "---- server log ----\n" << server->Log() << "--------------------\n";
+      }
+    }
+    servers_.clear();
+    std::filesystem::remove_all(dir_);
+  }
+
+  // Starts a server on the test's database with `args`; null after a failed assertion.
+  ServerProcess* StartServer(std::vector<std::string> args = {}, const std::string& token = "",
+                             bool tls = false) {
+    args.insert(args.begin(), {"--db", db_});
+    auto server = std::make_unique<ServerProcess>();
+    std::string error;
+    if (!server->Start(args, &error)) {
+      ADD_FAILURE() << error;
+      return nullptr;
+    }
+    if (!tls && !testing::WaitUntilServing(testing::InsecureChannel(server->address()), token)) {
+      ADD_FAILURE() << "the server never reported SERVING:\n" << server->Log();
+      return nullptr;
+    }
+    servers_.push_back(std::move(server));
+    return servers_.back().get();
+  }
+
+  std::string WriteFile(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+
+  // Ingests the synthetic humanoid library ("humanoid_0".. with tags "synthetic" and "clip<i>");
+  // returns the clip ids.
+  std::vector<int64_t> IngestHumanoid(Client& client) {
+    std::vector<int64_t> ids;
+    const SyntheticLibrary& library = Humanoid();
+    for (size_t i = 0; i < library.clips.size(); ++i) {
+      ids.push_back(client.IngestOrFail("humanoid_" + std::to_string(i) + ".bvh",
+                                        BvhText(library.clips[i]),
+                                        {"synthetic", "clip" + std::to_string(i)}));
+    }
+    return ids;
+  }
+
+  // Creates the space "body" on every humanoid clip.
+  v1::Space CreateHumanoidSpace(Client& client, const std::string& name = "body") {
+    v1::CreateSpaceRequest request;
+    request.set_name(name);
+    v1::Space space;
+    const grpc::Status status = client.CreateSpace(request, &space);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return space;
+  }
+
+  std::filesystem::path dir_;
+  std::string db_;
+  std::vector<std::unique_ptr<ServerProcess>> servers_;
+};
+
+// The first right-arm raise of the humanoid library: its clip index and frames (50 fps).
+const SyntheticSegment& FirstRaise() { return Humanoid().segments.front(); }
+
+// ---------------------------------------------------------------------------------------------
+// Clips.
+
+TEST_F(ServerTest, IngestListGetExportRoundTrip) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+
+  const Clip walk = ChainClip();
+  v1::IngestClipResponse ingested;
+  ASSERT_TRUE(client.Ingest("takes/Walk.BVH", BvhText(walk), &ingested, {"walk", "test"}).ok());
+  EXPECT_EQ(ingested.clip().name(), "Walk");
+  EXPECT_EQ(ingested.clip().source_file(), "takes/Walk.BVH");
+  EXPECT_EQ(ingested.clip().frame_count(), 61);
+  EXPECT_NEAR(ingested.clip().fps(), 30.0, 1e-6);
+  EXPECT_NEAR(ingested.clip().duration_s(), 61.0 / 30, 1e-6);
+  EXPECT_EQ(ingested.clip().joint_count(), 3);
+  EXPECT_THAT(ingested.clip().tags(), ::testing::UnorderedElementsAre("walk", "test"));
+  EXPECT_TRUE(ingested.projected_spaces().empty());
+  const int64_t walk_id = ingested.clip().clip_id();
+
+  // A name override, and a file whose Frames: header disagrees with its rows (a warning).
+  v1::IngestClipRequest renamed;
+  renamed.set_file_name("x.bvh");
+  renamed.set_name("turn");
+  std::string text = BvhText(ChainClip(0.05));
+  text.replace(text.find("Frames: 61"), 10, "Frames: 70");
+  renamed.set_bvh(text);
+  v1::IngestClipResponse turn;
+  ASSERT_TRUE(client.clips().IngestClip(client.Context().get(), renamed, &turn).ok());
+  EXPECT_EQ(turn.clip().name(), "turn");
+  EXPECT_EQ(turn.warnings_size(), 1);
+
+  // Lists page through everything in id order, and filter by tag.
+  v1::ListClipsRequest list;
+  list.set_page_size(1);
+  v1::ListClipsResponse page;
+  ASSERT_TRUE(client.clips().ListClips(client.Context().get(), list, &page).ok());
+  ASSERT_EQ(page.clips_size(), 1);
+  EXPECT_EQ(page.clips(0).clip_id(), walk_id);
+  EXPECT_EQ(page.clips(0).frame_count(), 61);
+  EXPECT_FALSE(page.next_page_token().empty());
+  list.set_page_token(page.next_page_token());
+  ASSERT_TRUE(client.clips().ListClips(client.Context().get(), list, &page).ok());
+  ASSERT_EQ(page.clips_size(), 1);
+  EXPECT_EQ(page.clips(0).name(), "turn");
+  v1::ListClipsRequest tagged;
+  tagged.set_tag("walk");
+  ASSERT_TRUE(client.clips().ListClips(client.Context().get(), tagged, &page).ok());
+  ASSERT_EQ(page.clips_size(), 1);
+  EXPECT_EQ(page.clips(0).clip_id(), walk_id);
+  EXPECT_TRUE(page.next_page_token().empty());
+
+  v1::GetClipRequest get;
+  get.set_clip_id(walk_id);
+  v1::Clip clip;
+  ASSERT_TRUE(client.clips().GetClip(client.Context().get(), get, &clip).ok());
+  EXPECT_THAT(clip.joint_names(), ::testing::ElementsAre("root", "child", "leaf"));
+  EXPECT_GT(clip.skeleton_id(), 0);
+  EXPECT_EQ(clip.skeleton_id(), turn.clip().skeleton_id());
+
+  // The export reads back as the clip, whole and as a range.
+  v1::ExportClipRequest export_request;
+  export_request.mutable_clip()->set_clip_id(walk_id);
+  v1::ExportClipResponse exported;
+  ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), export_request, &exported).ok());
+  EXPECT_EQ(exported.file_name(), "Walk.bvh");
+  absl::StatusOr<BvhReadResult> back = ReadBvh(exported.bvh());
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->clip.frame_count(), 61);
+  EXPECT_LT(testing::MaxRotationError(back->clip, walk), 1e-4);
+  export_request.mutable_clip()->set_first_frame(10);
+  export_request.mutable_clip()->set_last_frame(19);
+  ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), export_request, &exported).ok());
+  EXPECT_EQ(exported.file_name(), "Walk_10-19.bvh");
+  back = ReadBvh(exported.bvh());
+  ASSERT_TRUE(back.ok()) << back.status();
+  absl::StatusOr<Clip> expected = walk.Slice({10, 19});
+  ASSERT_TRUE(expected.ok());
+  ASSERT_EQ(back->clip.frame_count(), 10);
+  EXPECT_LT(testing::MaxRotationError(back->clip, *expected), 1e-4);
+
+  v1::DeleteClipRequest remove;
+  remove.set_clip_id(walk_id);
+  v1::DeleteClipResponse removed;
+  ASSERT_TRUE(client.clips().DeleteClip(client.Context().get(), remove, &removed).ok());
+  EXPECT_EQ(client.clips().GetClip(client.Context().get(), get, &clip).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  // One log line per call: method, status, latency.
+  EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ClipService/IngestClip OK "));
+  EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ClipService/GetClip NOT_FOUND "));
+}
+
+TEST_F(ServerTest, IngestsRealBvhFilesStreamedInChunks) {
+  const std::optional<std::filesystem::path> dir = testing::AssimpBvhDir();
+  if (!dir) GTEST_SKIP() << "assimp-testmodels is not installed; skipped";
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+
+  const std::string text = testing::ReadFileOrDie(*dir / "01_01.bvh");
+  auto context = client.Context();
+  v1::IngestClipResponse response;
+  auto writer = client.clips().IngestClipStream(context.get(), &response);
+  v1::IngestClipStreamRequest header;
+  header.set_file_name("01_01.bvh");
+  header.add_tags("cmu");
+  ASSERT_TRUE(writer->Write(header));
+  constexpr size_t kChunk = 256 * 1024;
+  for (size_t at = 0; at < text.size(); at += kChunk) {
+    v1::IngestClipStreamRequest chunk;
+    chunk.set_chunk(text.substr(at, kChunk));
+    ASSERT_TRUE(writer->Write(chunk));
+  }
+  ASSERT_TRUE(writer->WritesDone());
+  const grpc::Status status = writer->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.clip().name(), "01_01");
+  EXPECT_EQ(response.clip().frame_count(), 2752);
+  EXPECT_EQ(response.clip().joint_count(), 31);
+  EXPECT_THAT(response.clip().tags(), ::testing::ElementsAre("cmu"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spaces and search.
+
+TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  ASSERT_GE(ids.size(), 2u);
+
+  const v1::Space space = CreateHumanoidSpace(client);
+  EXPECT_EQ(space.name(), "body");
+  const v1::SpaceBuildReport& report = space.report();
+  EXPECT_EQ(report.joint_count(), 21);
+  EXPECT_EQ(report.dims(), 21 * 3 + 1);  // every joint, plus the yaw rate
+  EXPECT_EQ(report.explained_variance_size(), report.dims());
+  EXPECT_EQ(report.training_size(), static_cast<int>(ids.size()));
+  EXPECT_EQ(report.projected_clips(), static_cast<int64_t>(ids.size()));
+  EXPECT_FALSE(report.reconstruction_error().empty());
+  EXPECT_EQ(report.metric(), v1::SPACE_METRIC_UNIT);
+  EXPECT_EQ(report.weight_preset(), v1::WEIGHT_PRESET_MASS);
+  EXPECT_EQ(space.index().clips(), static_cast<int64_t>(ids.size()));
+  EXPECT_GT(space.index().coordinate_bytes(), 0);
+
+  // GetSpace returns the stored report; ListSpaces lists it.
+  v1::GetSpaceRequest get;
+  get.set_name("body");
+  v1::Space got;
+  ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &got).ok());
+  EXPECT_EQ(got.report().SerializeAsString(), report.SerializeAsString());
+  v1::ListSpacesResponse spaces;
+  ASSERT_TRUE(
+      client.spaces().ListSpaces(client.Context().get(), v1::ListSpacesRequest(), &spaces).ok());
+  ASSERT_EQ(spaces.spaces_size(), 1);
+  EXPECT_EQ(spaces.spaces(0).space_id(), space.space_id());
+
+  // A clip ingested now is projected into the space at once.
+  v1::IngestClipResponse late;
+  ASSERT_TRUE(client.Ingest("late.bvh", BvhText(Humanoid().clips[1]), &late).ok());
+  EXPECT_THAT(late.projected_spaces(), ::testing::ElementsAre("body"));
+
+  // The first right-arm raise, queried as a stored range, finds itself first with score ~0.
+  const SyntheticSegment& raise = FirstRaise();
+  const int64_t raise_clip = ids[raise.clip];
+  v1::SearchRequest query = ClipQuery("body", raise_clip, raise.first_frame, raise.last_frame);
+  query.set_return_path(true);
+  v1::SearchResponse found;
+  grpc::Status status = client.Search(query, &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(found.results_size(), 3);
+  const v1::SearchResult& best = found.results(0);
+  EXPECT_EQ(best.clip_id(), raise_clip);
+  EXPECT_NEAR(best.start_frame(), raise.first_frame, 2);
+  EXPECT_NEAR(best.end_frame(), raise.last_frame, 2);
+  EXPECT_LT(best.score(), 1e-3);
+  EXPECT_NEAR(best.start_s(), raise.first_frame / 50.0, 0.05);
+  EXPECT_GE(best.seed_frame(), best.start_frame());
+  EXPECT_LE(best.seed_frame(), best.end_frame());
+  EXPECT_EQ(best.path_size(), found.counts().query_frames());
+  EXPECT_GE(found.characteristic_frame(), raise.first_frame);
+  EXPECT_LE(found.characteristic_frame(), raise.last_frame);
+  EXPECT_GT(found.counts().seeds(), 0);
+  EXPECT_GT(found.counts().warps(), 0);
+  EXPECT_GT(found.timings().total_ms(), 0);
+  for (int i = 1; i < found.results_size(); ++i) {
+    EXPECT_LE(found.results(i - 1).score(), found.results(i).score());
+  }
+  // The other right-arm raises come next: every top result is one.
+  int raises_found = 0;
+  for (const SyntheticSegment& segment : Humanoid().segments) {
+    if (segment.action != SyntheticAction::kRightArmRaise) continue;
+    for (int i = 0; i < 4 && i < found.results_size(); ++i) {
+      const v1::SearchResult& r = found.results(i);
+      if (r.clip_id() == ids[segment.clip] && r.start_frame() <= segment.last_frame &&
+          r.end_frame() >= segment.first_frame) {
+        ++raises_found;
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(raises_found, 4);
+
+  // The same range uploaded as BVH gives the same results.
+  v1::SearchRequest uploaded = query;
+  uploaded.mutable_bvh()->set_bvh(BvhText(Humanoid().clips[raise.clip]));
+  uploaded.mutable_bvh()->set_first_frame(raise.first_frame);
+  uploaded.mutable_bvh()->set_last_frame(raise.last_frame);
+  v1::SearchResponse found_uploaded;
+  status = client.Search(uploaded, &found_uploaded);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(found_uploaded.results_size(), found.results_size());
+  for (int i = 0; i < found.results_size(); ++i) {
+    EXPECT_EQ(found_uploaded.results(i).clip_id(), found.results(i).clip_id());
+    EXPECT_EQ(found_uploaded.results(i).start_frame(), found.results(i).start_frame());
+    EXPECT_NEAR(found_uploaded.results(i).score(), found.results(i).score(), 1e-4);
+  }
+
+  // Filters, a given characteristic frame, and exact mode.
+  v1::SearchRequest filtered = query;
+  filtered.add_tags("clip" + std::to_string(raise.clip));
+  filtered.set_characteristic_frame((raise.peak_first_frame + raise.peak_last_frame) / 2);
+  ASSERT_TRUE(client.Search(filtered, &found).ok());
+  ASSERT_GE(found.results_size(), 1);
+  for (const v1::SearchResult& r : found.results()) EXPECT_EQ(r.clip_id(), raise_clip);
+  EXPECT_NEAR(found.characteristic_frame(), filtered.characteristic_frame(), 1);
+  v1::SearchRequest exact = query;
+  exact.set_exact(true);
+  exact.set_max_results(3);
+  ASSERT_TRUE(client.Search(exact, &found).ok());
+  ASSERT_EQ(found.results_size(), 3);
+  EXPECT_EQ(found.results(0).clip_id(), raise_clip);
+  EXPECT_LT(found.results(0).score(), 1e-3);
+  EXPECT_EQ(found.results(0).seed_frame(), -1);
+
+  // A batch: per-item status.
+  v1::SearchBatchRequest batch;
+  *batch.add_requests() = query;
+  *batch.add_requests() = ClipQuery("no-such-space", raise_clip, 0, 10);
+  v1::SearchBatchResponse batch_response;
+  ASSERT_TRUE(client.search().SearchBatch(client.Context().get(), batch, &batch_response).ok());
+  ASSERT_EQ(batch_response.items_size(), 2);
+  EXPECT_EQ(batch_response.items(0).code(), 0);
+  EXPECT_EQ(batch_response.items(0).response().results(0).clip_id(), raise_clip);
+  EXPECT_EQ(batch_response.items(1).code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(batch_response.items(1).message(), HasSubstr("requests[1]"));
+
+  // The motion curve: frames x dims float32 at 30 Hz.
+  v1::GetCurveRequest curve_request;
+  curve_request.set_space("body");
+  curve_request.mutable_clip()->set_clip_id(raise_clip);
+  v1::GetCurveResponse curve;
+  ASSERT_TRUE(client.spaces().GetCurve(client.Context().get(), curve_request, &curve).ok());
+  EXPECT_EQ(curve.dims(), 3);
+  const Clip& source = Humanoid().clips[raise.clip];
+  EXPECT_NEAR(curve.frames(), (source.frame_count() - 1) * 30.0 / 50 + 1, 1.0);
+  ASSERT_EQ(curve.coordinates().size(), static_cast<size_t>(curve.frames()) * 3 * 4);
+  std::vector<float> values(curve.frames() * 3);
+  std::memcpy(values.data(), curve.coordinates().data(), curve.coordinates().size());
+  const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
+  EXPECT_GT(*highest - *lowest, 0.1f);  // the arm raises move the curve
+  // A range is the matching rows of the whole curve.
+  curve_request.mutable_clip()->set_first_frame(raise.first_frame);
+  curve_request.mutable_clip()->set_last_frame(raise.last_frame);
+  curve_request.set_dims(5);
+  v1::GetCurveResponse part;
+  ASSERT_TRUE(client.spaces().GetCurve(client.Context().get(), curve_request, &part).ok());
+  EXPECT_EQ(part.dims(), 5);
+  EXPECT_EQ(part.first_frame(), raise.first_frame);
+  const int first_row = static_cast<int>(std::lround(raise.first_frame * 30.0 / 50));
+  float first_value;
+  std::memcpy(&first_value, part.coordinates().data(), 4);
+  EXPECT_FLOAT_EQ(first_value, values[first_row * 3]);
+
+  // Server info.
+  v1::ServerInfo info;
+  ASSERT_TRUE(client.server()
+                  .GetServerInfo(client.Context().get(), v1::GetServerInfoRequest(), &info)
+                  .ok());
+  EXPECT_EQ(info.version(), "0.1.0");
+  EXPECT_EQ(info.counts().clips(), static_cast<int64_t>(ids.size()) + 1);
+  EXPECT_EQ(info.counts().spaces(), 1);
+  ASSERT_EQ(info.indices_size(), 1);
+  EXPECT_EQ(info.indices(0).space(), "body");
+  EXPECT_EQ(info.index_bytes(),
+            info.indices(0).index().coordinate_bytes() + info.indices(0).index().tree_bytes());
+  EXPECT_FALSE(info.auth_required());
+
+  // Deleting a clip drops it from the index; deleting the space removes it.
+  v1::DeleteClipRequest remove;
+  remove.set_clip_id(late.clip().clip_id());
+  v1::DeleteClipResponse removed;
+  ASSERT_TRUE(client.clips().DeleteClip(client.Context().get(), remove, &removed).ok());
+  ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &got).ok());
+  EXPECT_EQ(got.index().clips(), static_cast<int64_t>(ids.size()));
+  v1::DeleteSpaceRequest drop;
+  drop.set_name("body");
+  v1::DeleteSpaceResponse dropped;
+  ASSERT_TRUE(client.spaces().DeleteSpace(client.Context().get(), drop, &dropped).ok());
+  EXPECT_EQ(client.Search(query, &found).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(ServerTest, RealClipsSearchAndSkeletonMismatch) {
+  const std::optional<std::filesystem::path> dir = testing::AssimpBvhDir();
+  if (!dir) GTEST_SKIP() << "assimp-testmodels is not installed; skipped";
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("01_01.bvh", testing::ReadFileOrDie(*dir / "01_01.bvh"));
+  const int64_t other =
+      client.IngestOrFail("01_03.bvh", testing::ReadFileOrDie(*dir / "01_03.bvh"));
+  const std::string boxing_text = testing::ReadFileOrDie(*dir / "Boxing_Toes.bvh");
+  const int64_t boxing = client.IngestOrFail("Boxing_Toes.bvh", boxing_text);
+
+  // Two skeletons: a space needs to be told which.
+  v1::CreateSpaceRequest create;
+  create.set_name("cmu");
+  v1::Space space;
+  grpc::Status status = client.CreateSpace(create, &space);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("skeleton_id"));
+  v1::ClipRange* training = create.add_training();
+  training->set_clip_id(walk);
+  training->set_first_frame(0);
+  training->set_last_frame(1999);
+  create.set_keep_heading(true);
+  create.set_weight_preset(v1::WEIGHT_PRESET_UNIFORM);
+  (*create.mutable_weight_overrides())["Hips"] = 2.0;
+  status = client.CreateSpace(create, &space);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(space.report().dims(), 31 * 3);
+  EXPECT_FALSE(space.report().heading_removed());
+  EXPECT_EQ(space.report().projected_clips(), 2);  // both CMU clips, not the boxer
+  EXPECT_EQ(space.report().training(0).last_frame(), 1999);
+  EXPECT_EQ(space.report().joint_weights(0).joint(), "Hips");
+  EXPECT_DOUBLE_EQ(space.report().joint_weights(0).weight(), 2.0);
+
+  v1::SearchResponse found;
+  status = client.Search(ClipQuery("cmu", walk, 1000, 1240), &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(found.results_size(), 1);
+  EXPECT_EQ(found.results(0).clip_id(), walk);
+  EXPECT_NEAR(found.results(0).start_frame(), 1000, 4);  // 120 fps, sampled at 30 Hz
+  EXPECT_NEAR(found.results(0).end_frame(), 1240, 4);
+  EXPECT_LT(found.results(0).score(), 1e-3);
+  status = client.Search(ClipQuery("cmu", other, 0, 400), &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+
+  // The boxer's skeleton is not the space's: as a stored clip and as an upload.
+  status = client.Search(ClipQuery("cmu", boxing, 0, 100), &found);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(status.error_message(), HasSubstr("skeleton"));
+  v1::SearchRequest upload;
+  upload.set_space("cmu");
+  upload.mutable_bvh()->set_bvh(boxing_text);
+  status = client.Search(upload, &found);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(status.error_message(), HasSubstr("skeleton"));
+  // Training on clips of two skeletons.
+  v1::CreateSpaceRequest mixed;
+  mixed.set_name("mixed");
+  mixed.add_training()->set_clip_id(walk);
+  mixed.add_training()->set_clip_id(boxing);
+  EXPECT_EQ(client.CreateSpace(mixed, &space).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  v1::GetCurveRequest curve;
+  curve.set_space("cmu");
+  curve.mutable_clip()->set_clip_id(boxing);
+  v1::GetCurveResponse curve_response;
+  EXPECT_EQ(client.spaces().GetCurve(client.Context().get(), curve, &curve_response).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors.
+
+TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  v1::IngestClipResponse ingested;
+  v1::SearchResponse found;
+  v1::Space space;
+
+  // Malformed BVH: INVALID_ARGUMENT naming the file and line.
+  std::string truncated = BvhText(ChainClip());
+  truncated.resize(truncated.size() - 40);
+  grpc::Status status = client.Ingest("broken.bvh", truncated, &ingested);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), ::testing::MatchesRegex("broken\\.bvh: line [0-9]+: .*"));
+  status = client.Ingest("garbage.bvh", "HIERARCHY\nROOT\n", &ingested);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("line 2"));
+  EXPECT_EQ(client.Ingest("", BvhText(ChainClip()), &ingested).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  // A stream without a file name, and an empty stream.
+  for (const bool empty : {false, true}) {
+    auto context = client.Context();
+    auto writer = client.clips().IngestClipStream(context.get(), &ingested);
+    if (!empty) {
+      v1::IngestClipStreamRequest chunk;
+      chunk.set_chunk(BvhText(ChainClip()));
+      writer->Write(chunk);
+    }
+    writer->WritesDone();
+    status = writer->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("file_name"));
+  }
+  // A name taken: ALREADY_EXISTS.
+  EXPECT_EQ(client.Ingest("humanoid_0.bvh", BvhText(Humanoid().clips[0]), &ingested).error_code(),
+            grpc::StatusCode::ALREADY_EXISTS);
+
+  // Unknown ids and names: NOT_FOUND.
+  v1::GetClipRequest get;
+  get.set_clip_id(999999);
+  v1::Clip clip;
+  EXPECT_EQ(client.clips().GetClip(client.Context().get(), get, &clip).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::DeleteClipRequest remove;
+  remove.set_clip_id(999999);
+  v1::DeleteClipResponse removed;
+  EXPECT_EQ(client.clips().DeleteClip(client.Context().get(), remove, &removed).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::ExportClipRequest export_request;
+  export_request.mutable_clip()->set_clip_id(999999);
+  v1::ExportClipResponse exported;
+  EXPECT_EQ(
+      client.clips().ExportClip(client.Context().get(), export_request, &exported).error_code(),
+      grpc::StatusCode::NOT_FOUND);
+  v1::GetSpaceRequest get_space;
+  get_space.set_name("nowhere");
+  EXPECT_EQ(client.spaces().GetSpace(client.Context().get(), get_space, &space).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::DeleteSpaceRequest drop;
+  drop.set_name("nowhere");
+  v1::DeleteSpaceResponse dropped;
+  EXPECT_EQ(client.spaces().DeleteSpace(client.Context().get(), drop, &dropped).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(client.Search(ClipQuery("nowhere", ids[0], 0, 10), &found).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(client.Search(ClipQuery("body", 999999, 0, 10), &found).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::CreateSpaceRequest unknown_training;
+  unknown_training.set_name("t");
+  unknown_training.add_training()->set_clip_id(999999);
+  status = client.CreateSpace(unknown_training, &space);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(status.error_message(), HasSubstr("training[0]"));
+  v1::CreateSpaceRequest unknown_skeleton;
+  unknown_skeleton.set_name("t");
+  unknown_skeleton.set_skeleton_id(999999);
+  EXPECT_EQ(client.CreateSpace(unknown_skeleton, &space).error_code(), grpc::StatusCode::NOT_FOUND);
+
+  // Bad parameters: INVALID_ARGUMENT naming the field.
+  struct BadSearch {
+    std::function<void(v1::SearchRequest*)> change;
+    std::string field;
+  };
+  const std::vector<BadSearch> bad_searches = {
+      {[](v1::SearchRequest* r) { r->set_ann_dims(0); }, "ann_dims"},
+      {[](v1::SearchRequest* r) { r->set_dtw_dims(1000); }, "dtw_dims"},
+      {[](v1::SearchRequest* r) { r->set_neighbours(-5); }, "neighbours"},
+      {[](v1::SearchRequest* r) { r->set_slope_limit(0); }, "slope_limit"},
+      {[](v1::SearchRequest* r) { r->set_max_results(0); }, "max_results"},
+      {[](v1::SearchRequest* r) { r->set_max_overlap(2); }, "max_overlap"},
+      {[](v1::SearchRequest* r) { r->set_characteristic_frame(5000); }, "characteristic_frame"},
+      {[](v1::SearchRequest* r) { r->mutable_clip()->set_last_frame(100000); }, "last_frame"},
+      {[](v1::SearchRequest* r) { r->mutable_clip()->set_first_frame(-1); }, "first_frame"},
+      {[](v1::SearchRequest* r) { r->set_neutral(static_cast<v1::NeutralPose>(9)); }, "neutral"},
+      {[](v1::SearchRequest* r) { r->clear_clip(); }, "query"},
+      {[](v1::SearchRequest* r) { r->set_space(""); }, "space"},
+  };
+  for (const BadSearch& bad : bad_searches) {
+    v1::SearchRequest request = ClipQuery("body", ids[0], 10, 60);
+    bad.change(&request);
+    status = client.Search(request, &found);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << bad.field;
+    EXPECT_THAT(status.error_message(), HasSubstr(bad.field));
+  }
+  v1::SearchRequest bad_upload;
+  bad_upload.set_space("body");
+  bad_upload.mutable_bvh()->set_bvh("HIERARCHY\n");
+  status = client.Search(bad_upload, &found);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("line"));
+
+  struct BadSpace {
+    std::function<void(v1::CreateSpaceRequest*)> change;
+    grpc::StatusCode code;
+    std::string words;
+  };
+  const std::vector<BadSpace> bad_spaces = {
+      {[](v1::CreateSpaceRequest* r) { r->set_name(""); }, grpc::StatusCode::INVALID_ARGUMENT,
+       "name"},
+      {[](v1::CreateSpaceRequest* r) { r->set_name("a b"); }, grpc::StatusCode::INVALID_ARGUMENT,
+       "name"},
+      {[](v1::CreateSpaceRequest* r) { r->set_name("body"); }, grpc::StatusCode::ALREADY_EXISTS,
+       "body"},
+      {[](v1::CreateSpaceRequest* r) { r->set_sample_rate(-1); },
+       grpc::StatusCode::INVALID_ARGUMENT, "rate"},
+      {[](v1::CreateSpaceRequest* r) { r->set_weights_json("[1, 2]"); },
+       grpc::StatusCode::INVALID_ARGUMENT, "weights_json"},
+      {[](v1::CreateSpaceRequest* r) { (*r->mutable_weight_overrides())["NoSuchJoint"] = 1; },
+       grpc::StatusCode::INVALID_ARGUMENT, "NoSuchJoint"},
+      {[](v1::CreateSpaceRequest* r) {
+         (*r->mutable_weight_overrides())["Hips"] = 1;
+         r->set_weights_json("{\"Hips\": 2}");
+       },
+       grpc::StatusCode::INVALID_ARGUMENT, "weights_json"},
+      {[](v1::CreateSpaceRequest* r) { r->set_metric(static_cast<v1::SpaceMetric>(7)); },
+       grpc::StatusCode::INVALID_ARGUMENT, "metric"},
+      {[&](v1::CreateSpaceRequest* r) {
+         v1::ClipRange* range = r->add_training();
+         range->set_clip_id(ids[0]);
+         range->set_last_frame(1000000);
+       },
+       grpc::StatusCode::INVALID_ARGUMENT, "training[0].last_frame"},
+  };
+  for (const BadSpace& bad : bad_spaces) {
+    v1::CreateSpaceRequest request;
+    request.set_name("fresh");
+    bad.change(&request);
+    status = client.CreateSpace(request, &space);
+    EXPECT_EQ(status.error_code(), bad.code) << bad.words << ": " << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr(bad.words));
+  }
+  v1::GetCurveRequest curve;
+  curve.set_space("body");
+  curve.mutable_clip()->set_clip_id(ids[0]);
+  curve.set_dims(0);
+  v1::GetCurveResponse curve_response;
+  status = client.spaces().GetCurve(client.Context().get(), curve, &curve_response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("dims"));
+  v1::ListClipsRequest list;
+  list.set_page_token("not a token");
+  v1::ListClipsResponse page;
+  EXPECT_EQ(client.clips().ListClips(client.Context().get(), list, &page).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::ListSpacesRequest list_spaces;
+  list_spaces.set_page_token("x");
+  v1::ListSpacesResponse spaces;
+  EXPECT_EQ(client.spaces().ListSpaces(client.Context().get(), list_spaces, &spaces).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  // The search of a clip of another skeleton (the chain) in the humanoid space.
+  const int64_t chain = client.IngestOrFail("chain.bvh", BvhText(ChainClip()));
+  EXPECT_EQ(client.Search(ClipQuery("body", chain, 0, 10), &found).error_code(),
+            grpc::StatusCode::FAILED_PRECONDITION);
+}
+
+TEST_F(ServerTest, OversizeRequestsAreResourceExhausted) {
+  ServerProcess* server = StartServer({"--max-message-mb", "1", "--max-bvh-mb", "2"});
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  // Over the message limit: refused by gRPC before the handler.
+  v1::IngestClipResponse ingested;
+  grpc::Status status = client.Ingest("big.bvh", std::string(1500 * 1024, ' '), &ingested);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  // Streamed in messages under the limit, but over the BVH limit in total.
+  auto context = client.Context();
+  auto writer = client.clips().IngestClipStream(context.get(), &ingested);
+  v1::IngestClipStreamRequest chunk;
+  chunk.set_file_name("big.bvh");
+  chunk.set_chunk(std::string(900 * 1024, ' '));
+  for (int i = 0; i < 4 && writer->Write(chunk); ++i) chunk.clear_file_name();
+  writer->WritesDone();
+  status = writer->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("--max-bvh-mb"));
+  // Small requests still work.
+  EXPECT_TRUE(client.Ingest("small.bvh", BvhText(ChainClip()), &ingested).ok());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Authentication, TLS, reflection.
+
+// Calls /grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo with one request (raw
+// protobuf bytes) and returns the response's bytes. The reflection messages are not compiled
+// into the test (libgrpc++_reflection holds their generated code, without headers), so they are
+// read as unknown fields.
+grpc::Status Reflect(const std::shared_ptr<grpc::Channel>& channel, const std::string& token,
+                     const std::string& request, std::string* response) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+  const grpc::internal::RpcMethod method(
+      "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo",
+      grpc::internal::RpcMethod::BIDI_STREAMING, channel);
+  std::unique_ptr<grpc::ClientReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>> stream(
+      grpc::internal::ClientReaderWriterFactory<grpc::ByteBuffer, grpc::ByteBuffer>::Create(
+          channel.get(), method, &context));
+  grpc::Slice slice(request);
+  stream->Write(grpc::ByteBuffer(&slice, 1));
+  stream->WritesDone();
+  grpc::ByteBuffer reply;
+  if (stream->Read(&reply)) {
+    std::vector<grpc::Slice> slices;
+    (void)reply.Dump(&slices);
+    for (const grpc::Slice& s : slices) {
+      response->append(reinterpret_cast<const char*>(s.begin()), s.size());
+    }
+  }
+  return stream->Finish();
+}
+
+// Length-delimited fields `number` of a message's bytes.
+std::vector<std::string> Fields(const std::string& bytes, int number) {
+  google::protobuf::UnknownFieldSet fields;
+  std::vector<std::string> out;
+  if (!fields.ParseFromString(bytes)) return out;
+  for (int i = 0; i < fields.field_count(); ++i) {
+    if (fields.field(i).number() == number &&
+        fields.field(i).type() == google::protobuf::UnknownField::TYPE_LENGTH_DELIMITED) {
+      out.push_back(fields.field(i).length_delimited());
+    }
+  }
+  return out;
+}
+
+std::string StringField(int number, const std::string& value) {
+  std::string out(1, static_cast<char>(number << 3 | 2));
+  out.push_back(static_cast<char>(value.size()));  // short values only
+  return out + value;
+}
+
+TEST_F(ServerTest, ReflectionListsAndDescribesTheServices) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  const auto channel = testing::InsecureChannel(server->address());
+  // list_services (field 7) -> list_services_response (6) -> service (1) -> name (1).
+  std::string response;
+  grpc::Status status = Reflect(channel, "", StringField(7, "*"), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::vector<std::string> names;
+  for (const std::string& list : Fields(response, 6)) {
+    for (const std::string& service : Fields(list, 1)) {
+      for (const std::string& name : Fields(service, 1)) names.push_back(name);
+    }
+  }
+  EXPECT_THAT(names,
+              ::testing::IsSupersetOf({"motiondb.v1.ClipService", "motiondb.v1.SpaceService",
+                                       "motiondb.v1.SearchService", "motiondb.v1.ServerService",
+                                       "grpc.health.v1.Health"}));
+  // file_containing_symbol (4) -> file_descriptor_response (4) -> file_descriptor_proto (1).
+  for (const auto& [symbol, file] : std::vector<std::pair<std::string, std::string>>{
+           {"grpc.health.v1.Health", "grpc/health/v1/health.proto"},
+           {"motiondb.v1.SearchService", "motiondb/v1/search_service.proto"}}) {
+    response.clear();
+    status = Reflect(channel, "", StringField(4, symbol), &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    std::vector<std::string> files;
+    for (const std::string& descriptors : Fields(response, 4)) {
+      for (const std::string& bytes : Fields(descriptors, 1)) {
+        google::protobuf::FileDescriptorProto descriptor;
+        ASSERT_TRUE(descriptor.ParseFromString(bytes));
+        files.push_back(descriptor.name());
+      }
+    }
+    EXPECT_THAT(files, ::testing::Contains(file)) << symbol;
+  }
+}
+
+TEST_F(ServerTest, BearerTokenIsRequiredOnEveryCall) {
+  const std::string token_file = WriteFile("token", "s3cret-token\n");
+  ServerProcess* server = StartServer({"--auth-token-file", token_file}, "s3cret-token");
+  ASSERT_NE(server, nullptr);
+  const auto channel = testing::InsecureChannel(server->address());
+  const v1::GetServerInfoRequest request;
+  v1::ServerInfo info;
+  for (const std::string& token : {std::string(""), std::string("wrong"),
+                                   std::string("s3cret-tokenX"), std::string("s3cret-toke")}) {
+    Client client(channel, token);
+    const grpc::Status status =
+        client.server().GetServerInfo(client.Context().get(), request, &info);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAUTHENTICATED) << "'" << token << "'";
+  }
+  Client good(channel, "s3cret-token");
+  ASSERT_TRUE(good.server().GetServerInfo(good.Context().get(), request, &info).ok());
+  EXPECT_TRUE(info.auth_required());
+  // Health and reflection too.
+  auto health = grpc::health::v1::Health::NewStub(channel);
+  grpc::ClientContext context;
+  grpc::health::v1::HealthCheckResponse serving;
+  EXPECT_EQ(health->Check(&context, grpc::health::v1::HealthCheckRequest(), &serving).error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  std::string response;
+  EXPECT_EQ(Reflect(channel, "", StringField(7, "*"), &response).error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_TRUE(Reflect(channel, "s3cret-token", StringField(7, "*"), &response).ok());
+  EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ServerService/GetServerInfo UNAUTHENTICATED"));
+}
+
+TEST_F(ServerTest, ServesTls) {
+  if (std::system("command -v openssl >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "openssl is not installed; the TLS test needs it to make a certificate";
+  }
+  const std::string cert = (dir_ / "cert.pem").string();
+  const std::string key = (dir_ / "key.pem").string();
+  const std::string command =
+      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout '" +
+      key + "' -out '" + cert + "' >/dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const std::string token_file = WriteFile("token", "tls-token");
+  ServerProcess* server =
+      StartServer({"--tls-cert", cert, "--tls-key", key, "--auth-token-file", token_file},
+                  "tls-token", /*tls=*/true);
+  ASSERT_NE(server, nullptr);
+
+  grpc::SslCredentialsOptions ssl;
+  ssl.pem_root_certs = testing::ReadFileOrDie(cert);
+  grpc::ChannelArguments arguments;
+  arguments.SetSslTargetNameOverride("localhost");
+  Client client(grpc::CreateCustomChannel(server->address(), grpc::SslCredentials(ssl), arguments),
+                "tls-token");
+  v1::ServerInfo info;
+  const grpc::Status status =
+      client.server().GetServerInfo(client.Context().get(), v1::GetServerInfoRequest(), &info);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_TRUE(info.tls());
+  // A plain-text client cannot talk to it.
+  Client plain(testing::InsecureChannel(server->address()), "tls-token");
+  EXPECT_FALSE(plain.server()
+                   .GetServerInfo(plain.Context(std::chrono::milliseconds(2000)).get(),
+                                  v1::GetServerInfoRequest(), &info)
+                   .ok());
+  // One of the pair alone is a usage error.
+  ServerProcess half;
+  std::string error;
+  EXPECT_FALSE(half.Start({"--db", db_, "--tls-cert", cert}, &error));
+  EXPECT_THAT(error, HasSubstr("--tls-key"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lifecycle and concurrency.
+
+TEST_F(ServerTest, RestartKeepsEverything) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  v1::SearchRequest query;
+  v1::SearchResponse before;
+  v1::Space space_before;
+  v1::ListClipsResponse clips_before;
+  {
+    Client client(testing::InsecureChannel(server->address()));
+    const std::vector<int64_t> ids = IngestHumanoid(client);
+    space_before = CreateHumanoidSpace(client);
+    const SyntheticSegment& raise = FirstRaise();
+    query = ClipQuery("body", ids[raise.clip], raise.first_frame, raise.last_frame);
+    ASSERT_TRUE(client.Search(query, &before).ok());
+    ASSERT_TRUE(client.clips()
+                    .ListClips(client.Context().get(), v1::ListClipsRequest(), &clips_before)
+                    .ok());
+  }
+  EXPECT_EQ(server->Stop(SIGTERM), 0);
+  EXPECT_THAT(server->Log(), HasSubstr("received SIGTERM"));
+
+  server = StartServer();
+  ASSERT_NE(server, nullptr);
+  EXPECT_THAT(server->Log(), HasSubstr("loaded 1 space indices"));
+  {
+    Client client(testing::InsecureChannel(server->address()));
+    v1::ListClipsResponse clips_after;
+    ASSERT_TRUE(client.clips()
+                    .ListClips(client.Context().get(), v1::ListClipsRequest(), &clips_after)
+                    .ok());
+    EXPECT_EQ(clips_after.SerializeAsString(), clips_before.SerializeAsString());
+    v1::GetSpaceRequest get;
+    get.set_name("body");
+    v1::Space space_after;
+    ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &space_after).ok());
+    EXPECT_EQ(space_after.SerializeAsString(), space_before.SerializeAsString());
+    v1::SearchResponse after;
+    ASSERT_TRUE(client.Search(query, &after).ok());
+    ASSERT_EQ(after.results_size(), before.results_size());
+    for (int i = 0; i < before.results_size(); ++i) {
+      EXPECT_EQ(after.results(i).clip_id(), before.results(i).clip_id());
+      EXPECT_EQ(after.results(i).start_frame(), before.results(i).start_frame());
+      EXPECT_EQ(after.results(i).end_frame(), before.results(i).end_frame());
+      EXPECT_EQ(after.results(i).score(), before.results(i).score());
+    }
+  }
+  // Stopped with no client connected: an idle connection makes a graceful stop wait (up to
+  // 5 s in gRPC 1.51) for the client to acknowledge the GOAWAY.
+  EXPECT_EQ(server->Stop(SIGINT), 0);
+}
+
+TEST_F(ServerTest, ConcurrentSearchesDuringIngestAllSucceed) {
+  ServerProcess* server = StartServer({"--threads", "8"});
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  const SyntheticSegment& raise = FirstRaise();
+  const v1::SearchRequest query =
+      ClipQuery("body", ids[raise.clip], raise.first_frame, raise.last_frame);
+  v1::SearchResponse baseline;
+  ASSERT_TRUE(client.Search(query, &baseline).ok());
+
+  std::atomic<bool> ingesting{true};
+  std::atomic<int> searches{0};
+  std::vector<std::string> failures[4];
+  std::vector<std::thread> searchers;
+  for (int t = 0; t < 4; ++t) {
+    searchers.emplace_back([&, t] {
+      Client own(testing::InsecureChannel(server->address()));
+      int64_t library_frames = 0;
+      // At least a few searches each, and on until the ingests are done.
+      for (int i = 0; i < 5 || ingesting; ++i) {
+        v1::SearchResponse found;
+        const grpc::Status status = own.Search(query, &found);
+        ++searches;
+        if (!status.ok()) {
+          failures[t].push_back(status.error_message());
+          continue;
+        }
+        // Every answer comes from one whole snapshot: the query finds itself first, and the
+        // library only grows.
+        if (found.results_size() == 0 || found.results(0).clip_id() != ids[raise.clip] ||
+            found.results(0).score() > 1e-3) {
+          failures[t].push_back("the query did not find itself first");
+        }
+        if (found.counts().library_frames() < library_frames) {
+          failures[t].push_back("the library shrank");
+        }
+        library_frames = found.counts().library_frames();
+      }
+    });
+  }
+  for (int i = 0; i < 6; ++i) {
+    client.IngestOrFail("extra_" + std::to_string(i) + ".bvh",
+                        BvhText(Humanoid().clips[i % Humanoid().clips.size()]));
+  }
+  ingesting = false;
+  for (std::thread& thread : searchers) thread.join();
+  for (const auto& failed : failures) EXPECT_THAT(failed, ::testing::IsEmpty());
+  EXPECT_GE(searches.load(), 20);
+
+  v1::SearchResponse final_answer;
+  ASSERT_TRUE(client.Search(query, &final_answer).ok());
+  v1::GetSpaceRequest get;
+  get.set_name("body");
+  v1::Space space;
+  ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &space).ok());
+  EXPECT_EQ(space.index().clips(), static_cast<int64_t>(ids.size()) + 6);
+  EXPECT_EQ(final_answer.counts().library_frames(), space.index().frames());
+  EXPECT_GT(final_answer.counts().library_frames(), baseline.counts().library_frames());
+}
+
+TEST_F(ServerTest, DeadlineStopsALongExactSearch) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  // A longer library: the whole thesis script, about five minutes at 50 fps.
+  SyntheticLibraryOptions options;
+  options.seed = 3;
+  options.threads = 2;
+  options.max_clip_duration_s = 60;
+  absl::StatusOr<SyntheticLibrary> library = GenerateSyntheticLibrary(options);
+  ASSERT_TRUE(library.ok()) << library.status();
+  std::vector<int64_t> ids;
+  for (size_t i = 0; i < library->clips.size(); ++i) {
+    ids.push_back(
+        client.IngestOrFail("long_" + std::to_string(i) + ".bvh", BvhText(library->clips[i])));
+  }
+  CreateHumanoidSpace(client);
+  // A long query with every dimension in the warp makes the exhaustive search slow.
+  v1::SearchRequest query = ClipQuery("body", ids[0], 0, library->clips[0].frame_count() / 2);
+  query.set_exact(true);
+  query.set_dtw_dims(64);
+  query.set_slope_limit(4);
+  const auto start = std::chrono::steady_clock::now();
+  v1::SearchResponse found;
+  grpc::Status status = client.Search(query, &found);
+  const double full_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::cerr << "exact search without a deadline: " << full_ms << " ms\n";
+
+  const auto deadline = std::chrono::milliseconds(static_cast<int>(std::max(20.0, full_ms / 5)));
+  const auto start_late = std::chrono::steady_clock::now();
+  status = client.Search(query, &found, deadline);
+  const double late_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_late)
+          .count();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  // The server stops working too, well before the search would have ended: its log line for the
+  // call says so, with the time it took.
+  std::smatch line;
+  const std::regex logged("/motiondb.v1.SearchService/Search DEADLINE_EXCEEDED ([0-9.]+)ms");
+  std::string log;
+  for (int i = 0; i < 100 && !std::regex_search(log, line, logged); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    log = server->Log();
+  }
+  ASSERT_TRUE(std::regex_search(log, line, logged)) << log;
+  const double server_ms = std::stod(line[1]);
+  EXPECT_LT(server_ms, deadline.count() + (full_ms - deadline.count()) / 2);
+  std::cerr << "with a " << deadline.count() << " ms deadline: the client waited " << late_ms
+            << " ms, the server worked " << server_ms << " ms\n";
+
+  // A client that cancels: the server stops too, and logs CANCELLED.
+  auto context = client.Context();
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(deadline);
+    context->TryCancel();
+  });
+  status = client.search().Search(context.get(), query, &found);
+  canceller.join();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::CANCELLED);
+  const std::regex cancelled("/motiondb.v1.SearchService/Search CANCELLED ([0-9.]+)ms");
+  for (int i = 0; i < 100 && !std::regex_search(log, line, cancelled); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    log = server->Log();
+  }
+  ASSERT_TRUE(std::regex_search(log, line, cancelled)) << log;
+  EXPECT_LT(std::stod(line[1]), deadline.count() + (full_ms - deadline.count()) / 2);
+}
+
+}  // namespace
+}  // namespace motiondb
