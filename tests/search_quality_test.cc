@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/exact_search.h"
 #include "core/motion_search.h"
 #include "core/retrieval_evaluation.h"
 #include "core/search_coordinates.h"
@@ -113,6 +114,40 @@ TEST_F(SyntheticValidation, FirstInstanceRanksItsWholeClassFirst) {
       EXPECT_LT(last_same_rank, first_other_rank);
     }
   }
+}
+
+// The fast search's recall@10 against the exact search, over the first instance of each class
+// as the query (characteristic point at its peak). Measured 37 of 50 (0.74), short of the 0.9
+// target: every instance the fast search returns is of the right class, but a warp forced
+// through its seed scores a little worse than the free optimum, which reorders the 15-20 nearly
+// equal instances of a class. This guards the measured level until candidates are refined by a
+// local unanchored warp (see bench/RESULTS.md).
+TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
+  int found = 0, total = 0;
+  for (SyntheticAction action :
+       {SyntheticAction::kRightArmRaise, SyntheticAction::kLeftArmRaise,
+        SyntheticAction::kBothArmsRaise, SyntheticAction::kShrug, SyntheticAction::kSlouch}) {
+    const auto first = std::find_if(synthetic_->segments.begin(), synthetic_->segments.end(),
+                                    [&](const SyntheticSegment& s) { return s.action == action; });
+    const Clip& clip = synthetic_->clips[first->clip];
+    const RowMatrixXf query =
+        *SearchCoordinates(*space_, *clip.Slice({first->first_frame, first->last_frame}));
+    SearchParams params;
+    params.max_results = 10;
+    params.characteristic_frame = static_cast<int>(std::min<int64_t>(
+        query.rows() - 1, std::llround((first->peak_first_frame - first->first_frame) *
+                                       space_->sample_rate() * clip.frame_time())));
+    const SearchResponse exact = *ExactSearch(*library_, CoordinateView::Of(query), params);
+    const SearchResponse fast = *Search(*library_, CoordinateView::Of(query), params);
+    for (const SearchResult& e : exact.results) {
+      ++total;
+      found += std::any_of(fast.results.begin(), fast.results.end(), [&](const SearchResult& f) {
+        return Overlaps(e, f, 0.5) || Overlaps(f, e, 0.5);
+      });
+    }
+  }
+  ASSERT_EQ(total, 50);
+  EXPECT_GE(found, 37) << found << " of " << total;
 }
 
 class BandaiQuality : public ::testing::Test {
