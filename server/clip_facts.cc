@@ -11,10 +11,10 @@ absl::StatusOr<ClipFacts> ClipFactsCache::Get(int64_t clip_id) {
     if (const auto it = facts_.find(clip_id); it != facts_.end()) return it->second;
     erasures = erasures_;
   }
-  // Loaded outside the lock: two callers may load the same clip once each, which is harmless,
-  // while holding the lock would make every lookup wait for a slow load.
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, database_.GetClip(clip_id));
-  const ClipFacts facts = ClipFacts::Of(stored.clip);
+  // Read outside the lock: two callers may read the same record once each, which is harmless,
+  // while holding the lock would make every lookup wait for the database.
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record, database_.GetClipRecord(clip_id));
+  const ClipFacts facts = ClipFacts::Of(record);
   std::lock_guard<std::mutex> lock(mutex_);
   // A clip deleted meanwhile must not come back (SQLite may reuse its id for the next clip).
   if (erasures == erasures_) facts_[clip_id] = facts;

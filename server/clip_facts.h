@@ -23,6 +23,9 @@ struct ClipFacts {
   static ClipFacts Of(const Clip& clip) {
     return {clip.fps(), clip.frame_count(), clip.skeleton().joint_count()};
   }
+  static ClipFacts Of(const storage::ClipRecord& record) {
+    return {1.0 / record.frame_time, static_cast<int>(record.frame_count), record.joint_count};
+  }
 };
 
 // Thread-safe.
@@ -30,7 +33,7 @@ class ClipFactsCache {
  public:
   explicit ClipFactsCache(storage::Database& database) : database_(database) {}
 
-  // From the cache, or by loading the clip (NOT_FOUND when it does not exist).
+  // From the cache, or from the clip's stored record (NOT_FOUND when it does not exist).
   absl::StatusOr<ClipFacts> Get(int64_t clip_id);
   void Put(int64_t clip_id, const ClipFacts& facts);
   void Erase(int64_t clip_id);

@@ -37,7 +37,8 @@ constexpr int kMaxIdleReaders = 8;
 
 // Column lists shared by the statements that fill records (ReadClipRecord, ReadSpaceRecord).
 constexpr absl::string_view kClipRecordColumns =
-    "c.clip_id, c.name, c.source_file, c.skeleton_id, c.created_unix_ms";
+    "c.clip_id, c.name, c.source_file, c.skeleton_id, c.created_unix_ms, c.frame_time, "
+    "c.frame_count, c.joint_count";
 constexpr absl::string_view kSpaceRecordColumns =
     "space_id, name, skeleton_id, version, created_unix_ms, build_report_json";
 
@@ -149,6 +150,9 @@ ClipRecord ReadClipRecord(const SqliteStatement& row, int first = 0) {
   record.source_file = row.ColumnText(first + 2);
   record.skeleton_id = row.ColumnInt64(first + 3);
   record.created_unix_ms = row.ColumnInt64(first + 4);
+  record.frame_time = row.ColumnDouble(first + 5);
+  record.frame_count = row.ColumnInt64(first + 6);
+  record.joint_count = static_cast<int>(row.ColumnInt64(first + 7));
   return record;
 }
 
@@ -451,16 +455,15 @@ absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id) {
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement query,
         db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns,
-                                ", c.frame_time, c.frame_count, c.joint_count, "
-                                "c.position_joint_count, c.layout, c.rotations, c.positions "
+                                ", c.position_joint_count, c.layout, c.rotations, c.positions "
                                 "FROM clips c WHERE c.clip_id = ?")));
     MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindInt64(1, clip_id).Step());
     if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
     const std::string context = absl::StrCat("stored clip ", clip_id, ": ");
     ClipRecord record = ReadClipRecord(query);
-    const double frame_time = query.ColumnDouble(5);
-    const int64_t frames = query.ColumnInt64(6);
-    const int64_t joints = query.ColumnInt64(7);
+    const double frame_time = record.frame_time;
+    const int64_t frames = record.frame_count;
+    const int64_t joints = record.joint_count;
     const int64_t position_joints = query.ColumnInt64(8);
     absl::StatusOr<std::shared_ptr<const Skeleton>> skeleton =
         ParseSkeletonLayout(query.ColumnBlob(9));

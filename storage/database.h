@@ -49,6 +49,11 @@ struct ClipRecord {
   std::vector<std::string> tags;  // a set: stored sorted and without repeats
   int64_t skeleton_id = 0;        // clips with identical joint names and parents share one
   int64_t created_unix_ms = 0;    // 0 on insert: the time of the insert
+  // Filled on read (InsertClip takes them from the clip): what a listing needs without
+  // decoding the frames.
+  double frame_time = 0;
+  int64_t frame_count = 0;
+  int joint_count = 0;
 };
 
 struct StoredClip {
