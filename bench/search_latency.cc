@@ -106,7 +106,8 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
 struct Run {
   std::vector<double> latencies;
   double seeds = 0, clusters = 0, warps = 0, results = 0;
-  double seeds_ms = 0, clusters_ms = 0, warps_ms = 0, ranking_ms = 0;
+  double seeds_ms = 0, clusters_ms = 0, warps_ms = 0, refine_ms = 0, ranking_ms = 0;
+  std::vector<SearchResponse> responses;  // per query of the first pass
 };
 
 absl::StatusOr<Run> RunQueries(const Bench& bench, SearchParams params, bool exact, int count,
@@ -128,15 +129,35 @@ absl::StatusOr<Run> RunQueries(const Bench& bench, SearchParams params, bool exa
       run.seeds_ms += s.seeds_ms;
       run.clusters_ms += s.clusters_ms;
       run.warps_ms += s.warps_ms;
+      run.refine_ms += s.refine_ms;
       run.ranking_ms += s.ranking_ms;
+      if (r == 0) run.responses.push_back(response);
     }
   }
   const double n = std::max<size_t>(1, run.latencies.size());
   for (double* v : {&run.seeds, &run.clusters, &run.warps, &run.results, &run.seeds_ms,
-                    &run.clusters_ms, &run.warps_ms, &run.ranking_ms}) {
+                    &run.clusters_ms, &run.warps_ms, &run.refine_ms, &run.ranking_ms}) {
     *v /= n;
   }
   return run;
+}
+
+// The share of the exact search's first ten results (over the queries both ran) that overlap
+// one of the fast search's first ten by half.
+double RecallAtTen(const Run& fast, const Run& exact) {
+  int found = 0, total = 0;
+  for (size_t q = 0; q < exact.responses.size() && q < fast.responses.size(); ++q) {
+    const std::vector<SearchResult>& f = fast.responses[q].results;
+    const size_t fast_top = std::min<size_t>(10, f.size());
+    for (size_t i = 0; i < 10 && i < exact.responses[q].results.size(); ++i) {
+      const SearchResult& e = exact.responses[q].results[i];
+      ++total;
+      found += std::any_of(f.begin(), f.begin() + fast_top, [&](const SearchResult& r) {
+        return Overlaps(e, r, 0.5) || Overlaps(r, e, 0.5);
+      });
+    }
+  }
+  return total > 0 ? static_cast<double>(found) / total : 0.0;
 }
 
 absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
@@ -156,14 +177,21 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
       library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
       library.tree_bytes() / 1048576.0 / indexed_mib, library.coordinate_bytes() / 1048576.0,
       bench.build_rss_mib);
+  SearchParams thesis;
+  thesis.refine = false;
   MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, {}, false, queries, 3));
-  std::printf(
-      "fast : p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f ranking "
-      "%.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results\n",
-      Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99), fast.seeds_ms,
-      fast.clusters_ms, fast.warps_ms, fast.ranking_ms, fast.seeds, fast.clusters, fast.warps,
-      fast.results);
+  MOTIONDB_ASSIGN_OR_RETURN(const Run unrefined, RunQueries(bench, thesis, false, queries, 3));
   MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, exact_queries, 1));
+  for (const auto& [label, run] :
+       {std::pair<const char*, const Run&>{"fast", fast}, {"fast, no refinement", unrefined}}) {
+    std::printf(
+        "%s: p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f refine %.3f "
+        "ranking %.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results | recall@10 vs "
+        "exact %.3f\n",
+        label, Percentile(run.latencies, 0.5), Percentile(run.latencies, 0.99), run.seeds_ms,
+        run.clusters_ms, run.warps_ms, run.refine_ms, run.ranking_ms, run.seeds, run.clusters,
+        run.warps, run.results, RecallAtTen(run, exact));
+  }
   std::printf("exact: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
               exact.latencies.size(), exact.results);

@@ -7,6 +7,7 @@
 // usage: search_quality [--folder DIR] [--metric unit|eigen] [--weights mass|uniform]
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
+//          [--no-refine]
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -53,6 +54,7 @@ absl::Status Run(const cli::CommandLine& line) {
   params.neutral = neutral == "origin"     ? NeutralPose::kOrigin
                    : neutral == "boundary" ? NeutralPose::kBoundaryMean
                                            : NeutralPose::kQueryMean;
+  params.refine = !line.flag("no-refine");
 
   const auto start = std::chrono::steady_clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledLibrary library,
@@ -68,10 +70,11 @@ absl::Status Run(const cli::CommandLine& line) {
               library.space->dims(), setup_s);
   std::printf(
       "metric %s, weights %s, neighbours %d, ann_dims %d, dtw_dims %d, slope %d, "
-      "neutral %s%s\n",
+      "neutral %s%s%s\n",
       metric.c_str(), std::string(WeightPresetName(space_options.weights.preset)).c_str(),
       params.neighbours, params.ann_dims, params.dtw_dims, params.slope_limit, neutral.c_str(),
-      space_options.pose.remove_heading ? "" : ", heading kept");
+      space_options.pose.remove_heading ? "" : ", heading kept",
+      params.refine ? "" : ", no refinement");
   std::printf("fast:  precision@%d %.3f over %d queries, latency p50 %.2f ms p99 %.2f ms\n",
               options.precision_at, report.precision, report.queries, report.latency_p50_ms,
               report.latency_p99_ms);
@@ -99,7 +102,7 @@ int main(int argc, char** argv) {
       std::vector<std::string>(argv + 1, argv + argc),
       {"folder", "metric", "weights", "rate", "neighbours", "ann-dims", "dtw-dims", "slope",
        "neutral", "exact-every", "yaw-weight"},
-      {"keep-heading"});
+      {"keep-heading", "no-refine"});
   const absl::Status status = line.ok() ? motiondb::Run(*line) : line.status();
   if (!status.ok()) {
     std::fprintf(stderr, "search_quality: %s\n", std::string(status.message()).c_str());

@@ -18,8 +18,8 @@ namespace {
 constexpr char kUsage[] =
     "motiondb search --space NAME (--clip ID [--from F --to T] | --bvh FILE [--from F --to T])\n"
     "    [--neighbours K] [--ann-dims N] [--dtw-dims N] [--epsilon E] [--slope S]\n"
-    "    [--char-frame F] [--neutral mean|boundary|origin] [--max N] [--exact] [--path]\n"
-    "    [--in-clip ID]... [--tag T]... [--json] [--server ADDR] [--token T]";
+    "    [--char-frame F] [--neutral mean|boundary|origin] [--max N] [--exact] [--no-refine]\n"
+    "    [--path] [--in-clip ID]... [--tag T]... [--json] [--server ADDR] [--token T]";
 
 // Larger than any query a studio will send; the server has its own limit.
 constexpr int64_t kMaxQueryBytes = int64_t{1} << 30;
@@ -81,6 +81,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const CommandLine& line) {
   }
   request.set_exact(line.flag("exact"));
   request.set_return_path(line.flag("path"));
+  if (line.flag("no-refine")) request.set_refine(false);
   return request;
 }
 
@@ -103,6 +104,7 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
             {"seeds_ms", t.seeds_ms()},
             {"clusters_ms", t.clusters_ms()},
             {"warps_ms", t.warps_ms()},
+            {"refine_ms", t.refine_ms()},
             {"ranking_ms", t.ranking_ms()},
             {"total_ms", t.total_ms()},
             {"request_ms", t.request_ms()}}},
@@ -136,10 +138,11 @@ absl::Status Search(const CommandLine& line, const ServerConnection& connection)
   }
   const v1::SearchTimings& t = response.timings();
   absl::PrintF(
-      "%d results in %.2f ms (seeds %.2f, clusters %.2f, warps %.2f ms; %d seeds, %d "
-      "clusters, %d warps)\n",
+      "%d results in %.2f ms (seeds %.2f, clusters %.2f, warps %.2f, refine %.2f ms; %d seeds, "
+      "%d clusters, %d warps)\n",
       response.results_size(), t.request_ms(), t.seeds_ms(), t.clusters_ms(), t.warps_ms(),
-      response.counts().seeds(), response.counts().clusters(), response.counts().warps());
+      t.refine_ms(), response.counts().seeds(), response.counts().clusters(),
+      response.counts().warps());
   return absl::OkStatus();
 }
 
@@ -150,7 +153,7 @@ int RunSearch(const std::vector<std::string>& args) {
       "search", kUsage, args,
       {"space", "clip", "bvh", "from", "to", "neighbours", "ann-dims", "dtw-dims", "epsilon",
        "slope", "char-frame", "neutral", "max", "tag", "in-clip"},
-      {"exact", "path", "json"}, Search);
+      {"exact", "path", "no-refine", "json"}, Search);
 }
 
 }  // namespace motiondb::cli

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/band_warp.h"
 #include "core/search_query.h"
 #include "core/status_macros.h"
 #include "core/time_warp.h"
@@ -16,6 +17,13 @@ using Clock = std::chrono::steady_clock;
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
+
+// Refinement: candidates considered per result returned, the band's half-width in seconds
+// (at least kMinRefineRadius frames), and how often a band may be re-centred.
+constexpr int kRefinePoolFactor = 2;
+constexpr double kRefineRadiusS = 0.1;
+constexpr int kMinRefineRadius = 2;
+constexpr int kRefineRounds = 4;
 
 struct Seed {
   int clip;
@@ -51,6 +59,24 @@ std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t sep
     run_start = i;
   }
   return representatives;
+}
+
+// Frees a candidate from its seed: the best warp in a band around its path, re-centred on the
+// new path while that touches the band's edge and improves.
+void Refine(CoordinateView query, CoordinateView clip, int anchor, int radius,
+            const WarpConstraints& constraints, BandWorkspace& workspace, SearchResult& candidate) {
+  for (int round = 0; round < kRefineRounds; ++round) {
+    bool touches_edge = false;
+    Warp warp =
+        BandWarp(query, clip, candidate.path, radius, constraints, workspace, &touches_edge);
+    if (!(warp.score < candidate.score)) return;
+    candidate.first_frame = warp.first;
+    candidate.last_frame = warp.last;
+    candidate.score = warp.score;
+    candidate.seed_frame = warp.path[anchor];
+    candidate.path = std::move(warp.path);
+    if (!touches_edge) return;
+  }
 }
 
 }  // namespace
@@ -123,13 +149,15 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
             [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
   WarpWorkspace workspace;
-  StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
+  // Refinement lowers scores, so it considers more candidates than it returns.
+  const int pool = params.refine ? params.max_results * kRefinePoolFactor : params.max_results;
+  StreamingTopResults top(pool, params.max_overlap, query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
     if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     const Seed& seed = order[i];
     std::optional<Warp> warp =
         AnchoredWarp(query, library.clip_coordinates(seed.clip), anchor, seed.frame, constraints,
-                     params.return_path, workspace, top.threshold());
+                     params.return_path || params.refine, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
     top.Offer(MakeResult(library, seed.clip, *std::move(warp), seed.frame));
@@ -137,7 +165,23 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stats.warps_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
-  response.results = RankResults(top.Take(), params.max_overlap, params.max_results);
+  std::vector<SearchResult> candidates = top.Take();
+  if (params.refine) {
+    const int radius = std::max<int>(
+        kMinRefineRadius, static_cast<int>(std::lround(kRefineRadiusS * library.rate())));
+    BandWorkspace band_workspace;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
+      SearchResult& candidate = candidates[i];
+      Refine(query, library.clip_coordinates(candidate.clip_index), anchor, radius, constraints,
+             band_workspace, candidate);
+      if (!params.return_path) candidate.path = {};
+    }
+  }
+  stats.refine_ms = MillisecondsSince(stage);
+
+  stage = Clock::now();
+  response.results = RankResults(std::move(candidates), params.max_overlap, params.max_results);
   stats.ranking_ms = MillisecondsSince(stage);
   stats.total_ms = MillisecondsSince(start);
   return response;

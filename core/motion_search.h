@@ -1,7 +1,9 @@
 // Query-by-example search in a library (thesis chapter 6, Algorithm 3): find the query's
 // characteristic pose, take its nearest library frames as seeds, cluster the seeds in time per
 // clip, warp the query through each cluster's best seed, and rank the warps by mean pose
-// distance with overlap suppression.
+// distance with overlap suppression. One step beyond the thesis (SearchParams::refine): the
+// best warps are freed from their seeds by a banded warp around each (core/band_warp.h), so
+// that their scores, and so their order, are those of the exact search.
 #ifndef MOTIONDB_CORE_MOTION_SEARCH_H_
 #define MOTIONDB_CORE_MOTION_SEARCH_H_
 

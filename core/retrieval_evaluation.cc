@@ -50,6 +50,7 @@ absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
     report.mean_stage_ms["seeds"] += fast.stats.seeds_ms;
     report.mean_stage_ms["clusters"] += fast.stats.clusters_ms;
     report.mean_stage_ms["warps"] += fast.stats.warps_ms;
+    report.mean_stage_ms["refine"] += fast.stats.refine_ms;
     report.mean_stage_ms["ranking"] += fast.stats.ranking_ms;
     const double precision = Precision(fast.results, labels, labels[q], options.precision_at);
     report.precision += precision;

@@ -35,7 +35,7 @@ struct RetrievalReport {
   double latency_p99_ms = 0;
   double exact_latency_p50_ms = 0;
   std::map<std::string, double> precision_by_label;
-  std::map<std::string, double> mean_stage_ms;  // seeds, clusters, warps, ranking
+  std::map<std::string, double> mean_stage_ms;  // seeds, clusters, warps, refine, ranking
 };
 
 // `labels[c]` is clip c's label. Queries are the clips' own library coordinates.

@@ -16,8 +16,10 @@ struct SearchResult {
   int64_t last_frame = 0;   // inclusive, at the space rate
   double start_s = 0;
   double end_s = 0;
-  double score = 0;           // mean pose distance along the warp; lower is better
-  int64_t seed_frame = -1;    // the clip frame the warp was anchored at (-1 in exact mode)
+  double score = 0;  // mean pose distance along the warp; lower is better
+  // The clip frame matched to the characteristic query frame: the seed the warp was anchored
+  // at, or where refinement moved it (-1 in exact mode).
+  int64_t seed_frame = -1;
   std::vector<int64_t> path;  // clip frame per query frame, when requested
 };
 
@@ -32,6 +34,7 @@ struct SearchStats {
   double seeds_ms = 0;
   double clusters_ms = 0;
   double warps_ms = 0;
+  double refine_ms = 0;
   double ranking_ms = 0;
   double total_ms = 0;
 };

@@ -4,36 +4,12 @@
 #include <cmath>
 #include <limits>
 
+#include "core/dims_major_frames.h"
+
 namespace motiondb {
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
-
-// The clip frames a half-warp can reach, dims-major (frame_of(o) = anchor + direction * o), so
-// that each row's distances are contiguous loops the compiler vectorises.
-void TransposeSpan(CoordinateView clip, int64_t anchor, int direction, int64_t span, int dims,
-                   std::vector<float>& out) {
-  out.resize(static_cast<size_t>(span) * dims);
-  for (int64_t o = 0; o < span; ++o) {
-    const float* x = clip.row(anchor + direction * o);
-    for (int k = 0; k < dims; ++k) out[k * span + o] = x[k];
-  }
-}
-
-// Distances from `q` to the transposed frames at offsets first .. first + count - 1.
-void RowDistances(const float* q, const std::vector<float>& frames, int64_t span, int dims,
-                  int64_t first, int64_t count, float* out) {
-  std::fill(out, out + count, 0.0f);
-  for (int k = 0; k < dims; ++k) {
-    const float* x = frames.data() + k * span + first;
-    const float qk = q[k];
-    for (int64_t i = 0; i < count; ++i) {
-      const float d = qk - x[i];
-      out[i] += d * d;
-    }
-  }
-  for (int64_t i = 0; i < count; ++i) out[i] = std::sqrt(out[i]);
-}
 
 struct HalfWarp {
   double cost = 0;               // sum of distances over the half's rows, anchor included
@@ -69,7 +45,7 @@ std::optional<HalfWarp> WarpHalf(CoordinateView query, CoordinateView clip, int 
   std::vector<float>& best = ws.best_of_cell;  // per previous-row cell: min over its states
   std::vector<float>& distances = ws.cost[1];
   const int64_t span = high(rows - 1) + 1;
-  TransposeSpan(clip, clip_anchor, direction, span, constraints.dims, ws.frames);
+  CopyDimsMajor(clip, clip_anchor, direction, span, constraints.dims, ws.frames);
   // Any valid path bounds the optimum, and no cell at or above its cost can lead to a better
   // half (costs only grow). The greedy path, taking the cheapest allowed step on every row,
   // follows the valley closely, so the cells that survive hug the best paths, and each row only
@@ -150,8 +126,8 @@ std::optional<HalfWarp> WarpHalf(CoordinateView query, CoordinateView clip, int 
                 kInfinity);
     }
     distances.resize(count);
-    RowDistances(query.row(query_anchor + direction * r), ws.frames, span, constraints.dims, first,
-                 count, distances.data());
+    DistancesToCopied(query.row(query_anchor + direction * r), ws.frames, span, constraints.dims,
+                      first, count, distances.data());
     // Advance 1..s, from any state, ends in state 0: row[o] = d[o] + min_a best[o - a].
     float* cells = row + (first - row_low);
     const float* base = best.data() + (first - prev_low + s);

@@ -124,6 +124,7 @@ absl::StatusOr<SearchParams> ToParams(const v1::SearchRequest& request, const Qu
   if (request.has_cluster_gap_s()) params.cluster_gap_s = request.cluster_gap_s();
   if (request.has_max_overlap()) params.max_overlap = request.max_overlap();
   params.return_path = request.return_path();
+  if (request.has_refine()) params.refine = request.refine();
   params.clip_ids.assign(request.clip_ids().begin(), request.clip_ids().end());
   params.tags.assign(request.tags().begin(), request.tags().end());
   MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, dims));
@@ -149,6 +150,7 @@ void FillStats(const SearchStats& stats, v1::SearchResponse* response) {
   timings->set_seeds_ms(stats.seeds_ms);
   timings->set_clusters_ms(stats.clusters_ms);
   timings->set_warps_ms(stats.warps_ms);
+  timings->set_refine_ms(stats.refine_ms);
   timings->set_ranking_ms(stats.ranking_ms);
   timings->set_total_ms(stats.total_ms);
   v1::SearchCounts* counts = response->mutable_counts();

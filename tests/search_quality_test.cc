@@ -117,11 +117,9 @@ TEST_F(SyntheticValidation, FirstInstanceRanksItsWholeClassFirst) {
 }
 
 // The fast search's recall@10 against the exact search, over the first instance of each class
-// as the query (characteristic point at its peak). Measured 37 of 50 (0.74), short of the 0.9
-// target: every instance the fast search returns is of the right class, but a warp forced
-// through its seed scores a little worse than the free optimum, which reorders the 15-20 nearly
-// equal instances of a class. This guards the measured level until candidates are refined by a
-// local unanchored warp (see bench/RESULTS.md).
+// as the query (characteristic point at its peak): at least 0.9. Measured 47 of 50 with
+// refinement; 37 of 50 without it, because a warp forced through its seed scores a little worse
+// than the free optimum, which reorders the 15-20 nearly equal instances of a class.
 TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
   int found = 0, total = 0;
   for (SyntheticAction action :
@@ -147,7 +145,7 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
     }
   }
   ASSERT_EQ(total, 50);
-  EXPECT_GE(found, 37) << found << " of " << total;
+  EXPECT_GE(found, 45) << found << " of " << total;
 }
 
 class BandaiQuality : public ::testing::Test {

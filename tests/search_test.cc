@@ -176,6 +176,46 @@ TEST_F(SearchTest, PathsAreReturnedOnRequest) {
   }
 }
 
+// Refinement frees each warp from its seed: scores only fall, the best result reaches the
+// exact optimum, and a refined path still passes the characteristic row at the reported frame
+// and has the reported score.
+TEST_F(SearchTest, RefinementOnlyImprovesAndKeepsPathsTrue) {
+  // The characteristic row is the pattern's row 24, so the seeds sit 4 frames late and the
+  // anchored warps cannot follow the copies exactly.
+  RowMatrixXf query = testing::Pattern(40, kDims);
+  query.row(20) = testing::Pattern(40, kDims).row(24);
+  const CoordinateView q = CoordinateView::Of(query);
+  SearchParams params;
+  params.characteristic_frame = 20;
+  params.neighbours = 200;
+  params.return_path = true;
+  params.refine = false;
+  const SearchResponse anchored = *Search(*library_, q, params);
+  params.refine = true;
+  const SearchResponse refined = *Search(*library_, q, params);
+  const SearchResponse exact = *ExactSearch(*library_, q, params);
+  ASSERT_FALSE(refined.results.empty());
+  EXPECT_LT(refined.results[0].score, anchored.results[0].score);
+  EXPECT_NEAR(refined.results[0].score, exact.results[0].score, 1e-5);
+  const int anchor = refined.stats.characteristic_frame;
+  for (const SearchResult& r : refined.results) {
+    ASSERT_EQ(r.path.size(), 40u);
+    EXPECT_EQ(r.path.front(), r.first_frame);
+    EXPECT_EQ(r.path.back(), r.last_frame);
+    EXPECT_EQ(r.path[anchor], r.seed_frame);
+    const CoordinateView clip = library_->clip_coordinates(r.clip_index);
+    double sum = 0;
+    for (int i = 0; i < 40; ++i) {
+      if (i > 0) {
+        EXPECT_GE(r.path[i] - r.path[i - 1], 0);
+        EXPECT_LE(r.path[i] - r.path[i - 1], params.slope_limit);
+      }
+      sum += Distance(query.row(i).data(), clip.row(r.path[i]), params.dtw_dims);
+    }
+    EXPECT_NEAR(sum / 40, r.score, 1e-5);
+  }
+}
+
 TEST_F(SearchTest, FiltersByClipIdAndTag) {
   SearchParams params;
   params.clip_ids = {101};

@@ -4,6 +4,8 @@
 #include <numbers>
 #include <random>
 
+#include "core/coordinate_view.h"
+
 namespace motiondb::testing {
 
 RowMatrixXf SmoothNoise(int64_t frames, int dims, uint32_t seed) {
@@ -36,6 +38,15 @@ RowMatrixXf Pattern(int frames, int dims) {
 
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at) {
   curve.middleRows(at, pattern.rows()) = pattern;
+}
+
+double MeanPathDistance(const RowMatrixXf& query, const RowMatrixXf& clip,
+                        const std::vector<int64_t>& path, int dims) {
+  double sum = 0;
+  for (int64_t i = 0; i < query.rows(); ++i) {
+    sum += Distance(query.row(i).data(), clip.row(path[i]).data(), dims);
+  }
+  return sum / static_cast<double>(query.rows());
 }
 
 }  // namespace motiondb::testing

@@ -20,6 +20,11 @@ RowMatrixXf Pattern(int frames, int dims);
 // Writes `pattern` into `curve` starting at `at`.
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at);
 
+// The mean distance over the first `dims` coordinates between each query row and the clip row
+// `path` gives it: a warp's score, recomputed from its path.
+double MeanPathDistance(const RowMatrixXf& query, const RowMatrixXf& clip,
+                        const std::vector<int64_t>& path, int dims);
+
 }  // namespace motiondb::testing
 
 #endif  // MOTIONDB_TESTS_SEARCH_TEST_DATA_H_

@@ -35,15 +35,6 @@ void Enumerate(const RowMatrixXf& q, const RowMatrixXf& x, int s, int dims, int 
   }
 }
 
-double MeanDistance(const RowMatrixXf& q, const RowMatrixXf& x, const std::vector<int64_t>& path,
-                    int dims) {
-  double sum = 0;
-  for (int i = 0; i < q.rows(); ++i) {
-    sum += Distance(q.row(i).data(), x.row(path[i]).data(), dims);
-  }
-  return sum / q.rows();
-}
-
 Best BruteForce(const RowMatrixXf& q, const RowMatrixXf& x, int anchor, int64_t at, int s,
                 int dims) {
   std::vector<int64_t> path(q.rows());
@@ -55,7 +46,7 @@ Best BruteForce(const RowMatrixXf& q, const RowMatrixXf& x, int anchor, int64_t 
     for (const auto& b : backward) {
       std::vector<int64_t> whole(q.rows());
       for (int i = 0; i < q.rows(); ++i) whole[i] = i < anchor ? b[i] : f[i];
-      const double score = MeanDistance(q, x, whole, dims);
+      const double score = testing::MeanPathDistance(q, x, whole, dims);
       if (score < best.score - 1e-9) best = {score, whole.front(), whole.back()};
     }
   }
@@ -99,7 +90,7 @@ TEST(AnchoredWarp, MatchesExhaustiveEnumeration) {
     }
     ASSERT_TRUE(warp.has_value()) << "trial " << trial;
     EXPECT_NEAR(warp->score, expected.score, 1e-5) << "trial " << trial;
-    EXPECT_NEAR(MeanDistance(q, x, warp->path, 3), warp->score, 1e-5);
+    EXPECT_NEAR(testing::MeanPathDistance(q, x, warp->path, 3), warp->score, 1e-5);
     ExpectValidPath(*warp, anchor, at, s, x.rows());
   }
 }
