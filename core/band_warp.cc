@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/dims_major_frames.h"
+#include "core/vector_clones.h"
 
 namespace motiondb {
 namespace {
@@ -17,9 +18,10 @@ constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // cost[(i * s + z) * padded + s + k]. Frames outside the clip are infinite. As the centre
 // advances 0..s frames per row, so does the band: a step of `advance` from the previous row's
 // cell k + shift - advance lands on cell k (shift: how far the band moved), a pause from k + shift.
-Warp BandWarp(CoordinateView query, CoordinateView clip, const std::vector<int64_t>& centre,
-              int radius, const WarpConstraints& constraints, BandWorkspace& ws,
-              bool* touches_edge) {
+MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
+                                     const std::vector<int64_t>& centre, int radius,
+                                     const WarpConstraints& constraints, BandWorkspace& ws,
+                                     bool* touches_edge) {
   const int s = constraints.slope_limit;
   const int64_t m = query.rows, width = 2 * radius + 1, padded = width + 2 * s;
   ws.row_first.resize(m);

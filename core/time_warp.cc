@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/dims_major_frames.h"
+#include "core/vector_clones.h"
 
 namespace motiondb {
 namespace {
@@ -24,10 +25,9 @@ struct HalfWarp {
 //   cost[z = 0][o] = d[o] + min over advance 1..s and any z' of cost_prev[z'][o - advance]
 //   cost[z > 0][o] = d[o] + cost_prev[z - 1][o]      (a pause: the clip frame repeats)
 // Cells reaching `budget` are dropped (early abandoning); nullopt when a whole row is.
-std::optional<HalfWarp> WarpHalf(CoordinateView query, CoordinateView clip, int query_anchor,
-                                 int64_t clip_anchor, int direction,
-                                 const WarpConstraints& constraints, bool with_path, float budget,
-                                 WarpWorkspace& ws) {
+MOTIONDB_VECTOR_CLONES std::optional<HalfWarp> WarpHalf(
+    CoordinateView query, CoordinateView clip, int query_anchor, int64_t clip_anchor, int direction,
+    const WarpConstraints& constraints, bool with_path, float budget, WarpWorkspace& ws) {
   const int s = constraints.slope_limit;
   const int rows = direction > 0 ? static_cast<int>(query.rows) - query_anchor : query_anchor + 1;
   const int64_t max_offset = direction > 0 ? clip.rows - 1 - clip_anchor : clip_anchor;

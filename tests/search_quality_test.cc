@@ -117,7 +117,7 @@ TEST_F(SyntheticValidation, FirstInstanceRanksItsWholeClassFirst) {
 }
 
 // The fast search's recall@10 against the exact search, over the first instance of each class
-// as the query (characteristic point at its peak): at least 0.9. Measured 47 of 50 with
+// as the query (characteristic point at its peak): at least 0.9. Measured 50 of 50 with
 // refinement; 37 of 50 without it, because a warp forced through its seed scores a little worse
 // than the free optimum, which reorders the 15-20 nearly equal instances of a class.
 TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
