@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string>
 
+#include "bench/measure.h"
 #include "client/command_line.h"
 #include "core/exact_search.h"
 #include "core/library_index.h"
@@ -25,16 +26,9 @@
 namespace motiondb {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double Percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[std::min(v.size() - 1, static_cast<size_t>(p * v.size()))];
-}
+using bench::Clock;
+using bench::Percentile;
+using bench::SecondsSince;
 
 // Resident memory now, in MiB.
 double ResidentMiB() {
@@ -65,7 +59,7 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
   options.fps = rate;
   options.target_duration_s = duration_s;
   MOTIONDB_ASSIGN_OR_RETURN(SyntheticLibrary generated, GenerateSyntheticLibrary(options));
-  bench.generate_s = Seconds(start);
+  bench.generate_s = SecondsSince(start);
 
   start = Clock::now();
   // The space is trained on the first clip (up to 10 minutes), as a studio trains on a
@@ -93,12 +87,12 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
     bench.queries.push_back({curve.middleRows(first, length), segment.peak_first_frame - first});
   }
   generated = SyntheticLibrary();  // the joint rotations are not needed any more
-  bench.project_s = Seconds(start);
+  bench.project_s = SecondsSince(start);
 
   const double rss_before = ResidentMiB();
   start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(bench.library, LibraryIndex::Build(std::move(clips), rate, {}));
-  bench.build_s = Seconds(start);
+  bench.build_s = SecondsSince(start);
   bench.build_rss_mib = ResidentMiB() - rss_before;
   return bench;
 }

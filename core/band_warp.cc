@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "core/dims_major_frames.h"
 #include "core/vector_clones.h"
@@ -10,6 +11,38 @@ namespace motiondb {
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// One row of the band from the previous one, padding included: `prev` and `row` point at state
+// 0's first cell, state z lies `padded` floats further, `d` holds the row's distances. S, the slope
+// limit, is fixed at compile time so that every step unrolls and the loop over the cells
+// vectorises.
+template <int S>
+MOTIONDB_VECTOR_CLONES void StepRow(const float* __restrict prev, int64_t padded, int64_t shift,
+                                    const float* __restrict d, int64_t width,
+                                    float* __restrict row) {
+  for (int64_t k = 0; k < width; ++k) {
+    // An advance of 1..S from any state ends in state 0; a pause from state z - 1 on the same
+    // frame ends in state z.
+    float best = kInfinity;
+    for (int advance = 1; advance <= S; ++advance) {
+      for (int z = 0; z < S; ++z) best = std::min(best, prev[z * padded + k + shift - advance]);
+    }
+    row[k] = best + d[k];
+    for (int z = 1; z < S; ++z) row[z * padded + k] = prev[(z - 1) * padded + k + shift] + d[k];
+  }
+  for (int z = 0; z < S; ++z) {
+    for (int p = 1; p <= S; ++p) row[z * padded - p] = row[z * padded + width - 1 + p] = kInfinity;
+  }
+}
+
+using StepRowFn = void (*)(const float*, int64_t, int64_t, const float*, int64_t, float*);
+
+template <int... S>
+StepRowFn StepRowFor(int slope_limit, std::integer_sequence<int, S...>) {
+  StepRowFn step = nullptr;
+  ((slope_limit == S + 1 ? (step = &StepRow<S + 1>, 0) : 0), ...);
+  return step;
+}
 
 }  // namespace
 
@@ -26,14 +59,9 @@ MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
   const int64_t m = query.rows, width = 2 * radius + 1, padded = width + 2 * s;
   ws.row_first.resize(m);
   for (int64_t i = 0; i < m; ++i) ws.row_first[i] = centre[i] - radius;
-  // Every band cell is written below; only the padding, and row 0's pause states, start infinite.
+  // Every cell of rows 1.. is written by StepRow; row 0 starts infinite but for its distances.
   ws.cost.resize(m * s * padded);
-  for (int64_t row = 0; row < m * s; ++row) {
-    float* cells = ws.cost.data() + row * padded;
-    std::fill(cells, cells + s, kInfinity);
-    std::fill(cells + s + width, cells + padded, kInfinity);
-  }
-  ws.best_of_cell.assign(padded, kInfinity);
+  std::fill(ws.cost.begin(), ws.cost.begin() + s * padded, kInfinity);
   ws.distances.resize(width);
   const auto cell = [&](int64_t i, int z) { return ws.cost.data() + (i * s + z) * padded + s; };
   // The clip frames the band covers, copied dims-major.
@@ -53,29 +81,11 @@ MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
 
   row_distances(0);
   std::copy(ws.distances.begin(), ws.distances.end(), cell(0, 0));
-  for (int z = 1; z < s; ++z) std::fill(cell(0, z), cell(0, z) + width, kInfinity);
-  float* best = ws.best_of_cell.data() + s;
+  const StepRowFn step = StepRowFor(s, std::make_integer_sequence<int, kMaxSlopeLimit>());
   for (int64_t i = 1; i < m; ++i) {
-    const int64_t shift = ws.row_first[i] - ws.row_first[i - 1];
-    std::copy(cell(i - 1, 0), cell(i - 1, 0) + width, best);
-    for (int z = 1; z < s; ++z) {
-      const float* state = cell(i - 1, z);
-      for (int64_t k = 0; k < width; ++k) best[k] = std::min(best[k], state[k]);
-    }
     row_distances(i);
-    const float* d = ws.distances.data();
-    float* advanced = cell(i, 0);
-    std::copy(best + shift - 1, best + shift - 1 + width, advanced);
-    for (int advance = 2; advance <= s; ++advance) {
-      const float* from = best + shift - advance;
-      for (int64_t k = 0; k < width; ++k) advanced[k] = std::min(advanced[k], from[k]);
-    }
-    for (int64_t k = 0; k < width; ++k) advanced[k] += d[k];
-    for (int z = 1; z < s; ++z) {
-      const float* from = cell(i - 1, z - 1) + shift;  // the pause: same frame, one more pause
-      float* paused = cell(i, z);
-      for (int64_t k = 0; k < width; ++k) paused[k] = from[k] + d[k];
-    }
+    step(cell(i - 1, 0), padded, ws.row_first[i] - ws.row_first[i - 1], ws.distances.data(), width,
+         cell(i, 0));
   }
 
   // The best end, then the path back from it, re-deriving each step from the stored costs.

@@ -18,7 +18,6 @@ namespace motiondb {
 // Reusable buffers for BandWarp; one per thread.
 struct BandWorkspace {
   std::vector<float> cost;  // per row: slope_limit states x (2 radius + 1) frames, padded
-  std::vector<float> best_of_cell;
   std::vector<float> distances;
   std::vector<float> frames;       // the clip frames the band covers, dims-major
   std::vector<int64_t> row_first;  // per row: the clip frame of the band's first cell

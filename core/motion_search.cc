@@ -4,10 +4,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/band_warp.h"
 #include "core/search_query.h"
 #include "core/status_macros.h"
 #include "core/time_warp.h"
+#include "core/warp_refinement.h"
 
 namespace motiondb {
 namespace {
@@ -18,14 +18,8 @@ double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// Refinement: candidates considered per result returned, the band's half-width in seconds
-// (at least kMinRefineRadius frames), and how often a band may be re-centred. Measured on the
-// synthetic set: a seed in a held pose can sit 0.8 s from where the best warp passes the
-// characteristic frame, so the band is wide and may move several times.
+// Refinement lowers scores, so it considers this many candidates per result returned.
 constexpr int kRefinePoolFactor = 2;
-constexpr double kRefineRadiusS = 0.3;
-constexpr int kMinRefineRadius = 2;
-constexpr int kRefineRounds = 8;
 
 struct Seed {
   int clip;
@@ -61,24 +55,6 @@ std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t sep
     run_start = i;
   }
   return representatives;
-}
-
-// Frees a candidate from its seed: the best warp in a band around its path, re-centred on the
-// new path while that touches the band's edge and improves.
-void Refine(CoordinateView query, CoordinateView clip, int anchor, int radius,
-            const WarpConstraints& constraints, BandWorkspace& workspace, SearchResult& candidate) {
-  for (int round = 0; round < kRefineRounds; ++round) {
-    bool touches_edge = false;
-    Warp warp =
-        BandWarp(query, clip, candidate.path, radius, constraints, workspace, &touches_edge);
-    if (!(warp.score < candidate.score)) return;
-    candidate.first_frame = warp.first;
-    candidate.last_frame = warp.last;
-    candidate.score = warp.score;
-    candidate.seed_frame = warp.path[anchor];
-    candidate.path = std::move(warp.path);
-    if (!touches_edge) return;
-  }
 }
 
 }  // namespace
@@ -151,7 +127,6 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
             [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
   WarpWorkspace workspace;
-  // Refinement lowers scores, so it considers more candidates than it returns.
   const int pool = params.refine ? params.max_results * kRefinePoolFactor : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
@@ -169,14 +144,12 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stage = Clock::now();
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
-    const int radius = std::max<int>(
-        kMinRefineRadius, static_cast<int>(std::lround(kRefineRadiusS * library.rate())));
     BandWorkspace band_workspace;
     for (size_t i = 0; i < candidates.size(); ++i) {
       if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
       SearchResult& candidate = candidates[i];
-      Refine(query, library.clip_coordinates(candidate.clip_index), anchor, radius, constraints,
-             band_workspace, candidate);
+      RefineCandidate(query, library.clip_coordinates(candidate.clip_index), anchor, library.rate(),
+                      constraints, band_workspace, candidate);
       if (!params.return_path) candidate.path = {};
     }
   }

@@ -1,6 +1,6 @@
-// Runs the real motiondb-server binary for integration tests: on a free loopback port (the
-// server picks it, --listen 127.0.0.1:0, and logs it), with its stderr captured to a file, and
-// stopped by a signal like an operator would.
+// Runs the real motiondb-server binary for integration tests and the server benchmark: on a
+// free loopback port (the server picks it, --listen 127.0.0.1:0, and logs it), with its stderr
+// captured to a file in the temporary directory, and stopped by a signal like an operator would.
 #ifndef MOTIONDB_TESTS_SERVER_PROCESS_H_
 #define MOTIONDB_TESTS_SERVER_PROCESS_H_
 
@@ -32,6 +32,7 @@ class ServerProcess {
   int Stop(int signal, std::chrono::seconds timeout = std::chrono::seconds(30));
 
   bool running() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
   int port() const { return port_; }
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
   // Everything the server wrote to stderr so far.
