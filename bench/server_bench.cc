@@ -32,6 +32,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "bench/measure.h"
 #include "client/command_line.h"
 #include "core/file_io.h"
@@ -124,9 +125,23 @@ absl::StatusOr<Throughput> Measure(int threads, double seconds, SearchFn search)
   return result;
 }
 
-void PrintThroughput(const std::string& label, const Throughput& t) {
-  std::printf("| %s | %.0f | %.2f | %.2f |\n", label.c_str(), t.qps,
-              Percentile(t.latencies_ms, 0.5), Percentile(t.latencies_ms, 0.99));
+// `server_ms`: the latencies the server logged for the same calls (empty in process).
+void PrintThroughput(const std::string& label, const Throughput& t,
+                     const std::vector<double>& server_ms = {}) {
+  std::printf("| %s | %.0f | %.2f | %.2f | %s |\n", label.c_str(), t.qps,
+              Percentile(t.latencies_ms, 0.5), Percentile(t.latencies_ms, 0.99),
+              server_ms.empty() ? "" : absl::StrFormat("%.2f", Percentile(server_ms, 0.5)).c_str());
+}
+
+// The latencies of the searches the server logged after the first `from` bytes of its log.
+std::vector<double> LoggedSearchMs(const std::string& log, size_t from) {
+  static const std::regex line("SearchService/Search OK ([0-9.]+)ms");
+  std::vector<double> ms;
+  for (auto it = std::sregex_iterator(log.begin() + from, log.end(), line);
+       it != std::sregex_iterator(); ++it) {
+    ms.push_back(std::stod((*it)[1]));
+  }
+  return ms;
 }
 
 v1::SearchRequest QueryOf(int64_t clip_id) {
@@ -219,13 +234,16 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
   std::printf("\nCreateSpace over the first half (%zu clips): %.2f s\n", half, create_s);
 
   std::printf("\n## Search, every clip in turn as the query, default parameters\n\n");
-  std::printf("| client | searches/s | p50 ms | p99 ms |\n|---|---:|---:|---:|\n");
+  std::printf(
+      "| client | searches/s | p50 ms | p99 ms | server-side p50 ms |\n"
+      "|---|---:|---:|---:|---:|\n");
   double best_served = 0;
   for (int clients : {1, 4, 16}) {
     std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
     for (int c = 0; c < clients; ++c) {
       stubs.push_back(v1::SearchService::NewStub(OwnConnection(server.address())));
     }
+    const size_t log_before = server.Log().size();
     MOTIONDB_ASSIGN_OR_RETURN(
         const Throughput served, Measure(clients, seconds, [&](int worker, int64_t k) {
           const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
@@ -233,7 +251,8 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
           grpc::ClientContext context;
           return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
         }));
-    PrintThroughput(absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients"), served);
+    PrintThroughput(absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients"), served,
+                    LoggedSearchMs(server.Log(), log_before));
     best_served = std::max(best_served, served.qps);
   }
   const double rss = StatusMiB(server.pid(), "VmRSS"), hwm = StatusMiB(server.pid(), "VmHWM");
