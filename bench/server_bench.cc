@@ -7,11 +7,12 @@
 //  2. searches per second and client-side p50/p99 latency with 1, 4 and 16 concurrent clients,
 //     each on its own connection, every stored clip in turn as the query, default parameters;
 //  3. the baseline: the same searches in process (server::RunSearch on the same database and
-//     resident indices, no gRPC) with 1 and 2 threads;
+//     indices loaded as the server loads them, no gRPC) with 1 and 2 threads, measured in turns
+//     interleaved with the served ones;
 //  4. the server's resident memory (VmRSS and its peak, VmHWM);
 //  5. start to serving with hours of cached projections (synthetic clips at 30 Hz, stored
 //     through the server's own library code): from exec to the first SERVING health answer,
-//     and the server's resident memory then.
+//     and the server's resident memory then; then ingest over gRPC into that library.
 //
 // usage: server_bench [--folder DIR] [--seconds S] [--hours H]
 #include <signal.h>
@@ -35,6 +36,7 @@
 #include "absl/strings/str_format.h"
 #include "bench/measure.h"
 #include "client/command_line.h"
+#include "core/bvh_writer.h"
 #include "core/file_io.h"
 #include "core/status_macros.h"
 #include "core/synthetic_library.h"
@@ -84,14 +86,14 @@ struct Throughput {
 };
 
 // `threads` workers call `search(worker, k)` for their k-th query until `seconds` have passed
-// (after a warm-up of a quarter second that is not counted).
+// (after a warm-up of a tenth of a second that is not counted).
 template <typename SearchFn>
 absl::StatusOr<Throughput> Measure(int threads, double seconds, SearchFn search) {
   std::atomic<bool> failed{false};
   std::string failure;
   std::vector<std::vector<double>> latencies(threads);
   std::vector<int64_t> counted(threads, 0);
-  const Clock::time_point warm = Clock::now() + std::chrono::milliseconds(250);
+  const Clock::time_point warm = Clock::now() + std::chrono::milliseconds(100);
   const Clock::time_point end =
       warm + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   std::vector<std::thread> workers;
@@ -126,6 +128,13 @@ absl::StatusOr<Throughput> Measure(int threads, double seconds, SearchFn search)
 }
 
 // `server_ms`: the latencies the server logged for the same calls (empty in process).
+// Adds one turn of `turns` to `total`.
+void Add(const Throughput& part, int turns, Throughput& total) {
+  total.qps += part.qps / turns;
+  total.latencies_ms.insert(total.latencies_ms.end(), part.latencies_ms.begin(),
+                            part.latencies_ms.end());
+}
+
 void PrintThroughput(const std::string& label, const Throughput& t,
                      const std::vector<double>& server_ms = {}) {
   std::printf("| %s | %.0f | %.2f | %.2f | %s |\n", label.c_str(), t.qps,
@@ -233,57 +242,123 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
       second_frames / second_s, (files.size() - half) / second_s);
   std::printf("\nCreateSpace over the first half (%zu clips): %.2f s\n", half, create_s);
 
-  std::printf("\n## Search, every clip in turn as the query, default parameters\n\n");
-  std::printf(
-      "| client | searches/s | p50 ms | p99 ms | server-side p50 ms |\n"
-      "|---|---:|---:|---:|---:|\n");
-  double best_served = 0;
-  for (int clients : {1, 4, 16}) {
-    std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
-    for (int c = 0; c < clients; ++c) {
-      stubs.push_back(v1::SearchService::NewStub(OwnConnection(server.address())));
-    }
-    const size_t log_before = server.Log().size();
-    MOTIONDB_ASSIGN_OR_RETURN(
-        const Throughput served, Measure(clients, seconds, [&](int worker, int64_t k) {
-          const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
-          v1::SearchResponse response;
-          grpc::ClientContext context;
-          return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
-        }));
-    PrintThroughput(absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients"), served,
-                    LoggedSearchMs(server.Log(), log_before));
-    best_served = std::max(best_served, served.qps);
+  // The server that did the ingests, before any restart: its index holds the recent clips in a
+  // second kd-tree (core/library_index.h).
+  std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
+  for (int c = 0; c < 4; ++c) {
+    stubs.push_back(v1::SearchService::NewStub(OwnConnection(server.address())));
   }
-  const double rss = StatusMiB(server.pid(), "VmRSS"), hwm = StatusMiB(server.pid(), "VmHWM");
-  const std::string log = server.Log();
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const Throughput after_ingest, Measure(4, 1.0, [&](int worker, int64_t k) {
+        const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
+        v1::SearchResponse response;
+        grpc::ClientContext context;
+        return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
+      }));
+  const double ingest_rss = StatusMiB(server.pid(), "VmRSS");
   if (server.Stop(SIGTERM) != 0) return absl::InternalError("the server did not stop cleanly");
 
-  // The baseline: the server's own search code on the same database, without gRPC.
+  // The baseline: the server's own search code on the same database and indices loaded as the
+  // server loads them, without gRPC.
   MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
                             storage::Database::Open(db));
   server::IndexRegistry registry;
   server::ClipFactsCache facts(*database);
   server::Library library(*database, registry, facts);
   MOTIONDB_RETURN_IF_ERROR(library.LoadIndices());
-  double best_in_process = 0;
+
+  // Served and in-process searching take turns of a second or so (the server started afresh for
+  // each turn, and stopped while the baseline runs), so that a change in the speed of the
+  // machine, which is shared, weighs on both alike.
+  struct Way {
+    std::string label;
+    int threads = 1;
+    bool served = false;
+    Throughput total;
+    std::vector<double> server_ms;  // as the server logged them
+  };
+  std::vector<Way> ways;
+  for (int clients : {1, 4, 16}) {
+    ways.push_back({absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients"),
+                    clients,
+                    true,
+                    {},
+                    {}});
+  }
   for (int threads : {1, 2}) {
-    MOTIONDB_ASSIGN_OR_RETURN(
-        const Throughput local, Measure(threads, seconds, [&](int worker, int64_t k) {
-          return server::RunSearch(QueryOf(ids[(worker * 7919 + k) % ids.size()]), registry,
-                                   *database, {}, [] { return false; })
-              .status();
-        }));
-    PrintThroughput(absl::StrCat("in process, ", threads, threads == 1 ? " thread" : " threads"),
-                    local);
-    best_in_process = std::max(best_in_process, local.qps);
+    ways.push_back({absl::StrCat("in process, ", threads, threads == 1 ? " thread" : " threads"),
+                    threads,
+                    false,
+                    {},
+                    {}});
+  }
+  const int turns = std::max(1, static_cast<int>(seconds));
+  double rss = 0, hwm = 0;
+  int64_t logged_requests = 0;
+  for (int turn = 0; turn < turns; ++turn) {
+    testing::ServerProcess turn_server;
+    if (!turn_server.Start({"--db", db}, &error)) return absl::InternalError(error);
+    if (!testing::WaitUntilServing(OwnConnection(turn_server.address()), "")) {
+      return absl::InternalError("the server did not start serving");
+    }
+    for (Way& way : ways) {
+      if (way.served != true) continue;
+      std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
+      for (int c = 0; c < way.threads; ++c) {
+        stubs.push_back(v1::SearchService::NewStub(OwnConnection(turn_server.address())));
+      }
+      const size_t log_before = turn_server.Log().size();
+      MOTIONDB_ASSIGN_OR_RETURN(
+          const Throughput part, Measure(way.threads, seconds / turns, [&](int worker, int64_t k) {
+            const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
+            v1::SearchResponse response;
+            grpc::ClientContext context;
+            return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
+          }));
+      Add(part, turns, way.total);
+      const std::vector<double> logged = LoggedSearchMs(turn_server.Log(), log_before);
+      way.server_ms.insert(way.server_ms.end(), logged.begin(), logged.end());
+    }
+    rss = StatusMiB(turn_server.pid(), "VmRSS");
+    hwm = StatusMiB(turn_server.pid(), "VmHWM");
+    const std::string log = turn_server.Log();
+    logged_requests += std::count(log.begin(), log.end(), '\n');
+    if (turn_server.Stop(SIGTERM) != 0) {
+      return absl::InternalError("the server did not stop cleanly");
+    }
+    for (Way& way : ways) {
+      if (way.served) continue;
+      MOTIONDB_ASSIGN_OR_RETURN(
+          const Throughput part, Measure(way.threads, seconds / turns, [&](int worker, int64_t k) {
+            return server::RunSearch(QueryOf(ids[(worker * 7919 + k) % ids.size()]), registry,
+                                     *database, {}, [] { return false; })
+                .status();
+          }));
+      Add(part, turns, way.total);
+    }
+  }
+  std::printf("\n## Search, every clip in turn as the query, default parameters\n\n");
+  std::printf(
+      "| client | searches/s | p50 ms | p99 ms | server-side p50 ms |\n"
+      "|---|---:|---:|---:|---:|\n");
+  double best_served = 0, best_in_process = 0;
+  for (const Way& way : ways) {
+    PrintThroughput(way.label, way.total, way.server_ms);
+    double& best = way.served ? best_served : best_in_process;
+    best = std::max(best, way.total.qps);
   }
   std::printf("\nserved / in-process throughput (best of each): %.2f\n",
               best_served / best_in_process);
-  std::printf("server resident memory after the searches: VmRSS %.0f MiB, peak VmHWM %.0f MiB\n",
-              rss, hwm);
-  std::printf("requests logged: %lld\n\n",
-              static_cast<long long>(std::count(log.begin(), log.end(), '\n')));
+  std::printf(
+      "the server that did the ingests, before a restart, 4 clients for 1 s: %.0f/s, "
+      "p50 %.2f ms\n",
+      after_ingest.qps, Percentile(after_ingest.latencies_ms, 0.5));
+  std::printf("server resident memory after the ingests: VmRSS %.0f MiB\n", ingest_rss);
+  std::printf(
+      "server resident memory after a turn of searches (restarted): VmRSS %.0f MiB, peak "
+      "VmHWM %.0f MiB\n",
+      rss, hwm);
+  std::printf("requests logged: %lld\n\n", static_cast<long long>(logged_requests));
   return absl::OkStatus();
 }
 
@@ -333,6 +408,32 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const double serving_s = SecondsSince(start);
   const double rss = StatusMiB(server.pid(), "VmRSS"), hwm = StatusMiB(server.pid(), "VmHWM");
   const std::string log = server.Log();
+
+  // Ingest into the large library: 10 clips of a minute, projected and indexed on arrival.
+  SyntheticLibraryOptions extra;
+  extra.seed = 2;
+  extra.fps = 30;
+  extra.target_duration_s = 600;
+  extra.max_clip_duration_s = 60;
+  MOTIONDB_ASSIGN_OR_RETURN(const SyntheticLibrary more, GenerateSyntheticLibrary(extra));
+  std::vector<std::string> texts;
+  int64_t more_frames = 0;
+  for (const Clip& clip : more.clips) {
+    MOTIONDB_ASSIGN_OR_RETURN(texts.emplace_back(), WriteBvh(clip));
+    more_frames += clip.frame_count();
+  }
+  auto clips = v1::ClipService::NewStub(OwnConnection(server.address()));
+  start = Clock::now();
+  for (size_t c = 0; c < texts.size(); ++c) {
+    v1::IngestClipRequest request;
+    request.set_file_name(absl::StrCat("extra_", c, ".bvh"));
+    request.set_bvh(texts[c]);
+    v1::IngestClipResponse response;
+    grpc::ClientContext context;
+    MOTIONDB_RETURN_IF_ERROR(
+        FromGrpc(clips->IngestClip(&context, request, &response), "IngestClip"));
+  }
+  const double ingest_s = SecondsSince(start);
   server.Stop(SIGTERM);
   std::smatch loaded;
   const std::string load_line =
@@ -344,6 +445,11 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
               load_line.c_str());
   std::printf("server resident memory when serving: VmRSS %.0f MiB, peak VmHWM %.0f MiB\n", rss,
               hwm);
+  std::printf(
+      "ingest into it over gRPC (each clip projected and indexed): %zu clips, %lld frames in "
+      "%.2f s = %.0f frames/s, %.0f ms per clip\n",
+      texts.size(), static_cast<long long>(more_frames), ingest_s, more_frames / ingest_s,
+      1000 * ingest_s / texts.size());
   return absl::OkStatus();
 }
 

@@ -1,10 +1,14 @@
 // The searchable library of one space: every clip's projection (pre-scaled so that Euclidean
-// distance is the space's pose metric) in one frames x dims block, the map between global frame
+// distance is the space's pose metric) in a frames x dims block, the map between global frame
 // numbers and (clip, frame), and a kd-tree over the first `ann_dims` coordinates that reads the
 // coordinates in place.
 //
-// Immutable after Build(); thread-safe for any number of concurrent readers. Not movable: the
-// kd-tree points into the coordinate block.
+// Clips added with WithClips() go into a second, smaller block with a kd-tree of its own, shared
+// with the index they were added to, so that adding a clip costs in proportion to the recent
+// additions rather than to the library (an ingest into hours of capture stays fast); once the
+// recent additions exceed a sixteenth of the frames, everything is built again as one block.
+//
+// Immutable once made; thread-safe for any number of concurrent readers.
 #ifndef MOTIONDB_CORE_LIBRARY_INDEX_H_
 #define MOTIONDB_CORE_LIBRARY_INDEX_H_
 
@@ -58,20 +62,25 @@ class LibraryIndex {
   LibraryIndex(const LibraryIndex&) = delete;
   LibraryIndex& operator=(const LibraryIndex&) = delete;
 
+  // This library with `clips` added after its own clips (same rules as Build(); their ids must
+  // be new), sharing this index's blocks and kd-trees.
+  absl::StatusOr<std::unique_ptr<LibraryIndex>> WithClips(std::vector<LibraryClip> clips) const;
+
   double rate() const { return rate_; }
-  int dims() const { return static_cast<int>(coordinates_.cols()); }
+  int dims() const { return dims_; }
   int ann_dims() const { return options_.ann_dims; }
-  int64_t total_frames() const { return coordinates_.rows(); }
+  int64_t total_frames() const { return total_frames_; }
   int clip_count() const { return static_cast<int>(clips_.size()); }
+  // 1 after a full build; 2 while recent additions are kept apart.
+  int block_count() const { return static_cast<int>(blocks_.size()); }
   const ClipEntry& clip(int index) const { return clips_[index]; }
   // Index of the clip with this id, or -1.
   int FindClip(int64_t clip_id) const;
   // The clip holding a global frame, and the frame's number within it.
   std::pair<int, int64_t> Locate(int64_t global_frame) const;
-  CoordinateView coordinates() const { return CoordinateView::Of(coordinates_); }
-  CoordinateView clip_coordinates(int index) const {
-    return coordinates().middle_rows(clips_[index].first_frame, clips_[index].frame_count);
-  }
+  CoordinateView clip_coordinates(int index) const;
+  // A copy of clip_coordinates(index), all dims.
+  RowMatrixXf CopyClipCoordinates(int index) const;
 
   // The k frames nearest to `point` over its first `dims` coordinates, nearest first. Uses the
   // kd-tree when dims == ann_dims() and every clip is allowed; otherwise an exact linear scan
@@ -79,19 +88,29 @@ class LibraryIndex {
   std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
                                  const std::vector<bool>& allowed_clips) const;
 
-  // Bytes held: the coordinate block and the kd-tree.
+  // Bytes held: the coordinate blocks and the kd-trees.
   int64_t coordinate_bytes() const;
   int64_t tree_bytes() const;
 
  private:
   class Tree;
-  LibraryIndex(double rate, const LibraryIndexOptions& options);
+  struct Block;
+  LibraryIndex(double rate, const LibraryIndexOptions& options, int dims);
+  // A block of `clips` (validated) after `first_frame` global frames, with its kd-tree; appends
+  // their entries.
+  void AddBlock(std::vector<LibraryClip> clips, int64_t first_frame);
+  // The k nearest over the kd-trees of every block, merged.
+  std::vector<Neighbour> TreeNearest(const float* point, int dims, int k, float epsilon) const;
 
   double rate_;
   LibraryIndexOptions options_;
-  RowMatrixXf coordinates_;
+  int dims_;
+  int64_t total_frames_ = 0;
+  // The first block holds the clips of the last full build; a second one, if any, those added
+  // since. Clips are numbered across blocks in order.
+  std::vector<std::shared_ptr<const Block>> blocks_;
   std::vector<ClipEntry> clips_;
-  std::unique_ptr<Tree> tree_;
+  std::vector<int> clip_block_;  // per clip: its block
 };
 
 }  // namespace motiondb

@@ -11,16 +11,6 @@ namespace {
 // The kd-tree's dimensions: the search's default seed dimensions, or fewer for a small space.
 constexpr int kAnnDims = 10;
 
-// Copies of the clip's coordinates held by `index` (the index owns one block for all clips).
-RowMatrixXf CopyCoordinates(const LibraryIndex& index, int clip_index) {
-  const CoordinateView view = index.clip_coordinates(clip_index);
-  RowMatrixXf copy(view.rows, index.dims());
-  for (int64_t r = 0; r < view.rows; ++r) {
-    std::copy(view.row(r), view.row(r) + index.dims(), copy.row(r).data());
-  }
-  return copy;
-}
-
 // Every clip of `base`, except `skip_id`, as clips to index again.
 std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
   std::vector<IndexedClip> clips;
@@ -28,7 +18,7 @@ std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
   for (int c = 0; c < base.index->clip_count(); ++c) {
     const int64_t id = base.index->clip(c).clip_id;
     if (id == skip_id) continue;
-    clips.push_back({id, base.clips.at(id), CopyCoordinates(*base.index, c)});
+    clips.push_back({id, base.clips.at(id), base.index->CopyClipCoordinates(c)});
   }
   return clips;
 }
@@ -67,6 +57,18 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
                                                                       IndexedClip clip) {
+  if (base.index && !base.clips.contains(clip.clip_id)) {
+    // A new clip: added beside the base's index, sharing its coordinates and kd-trees.
+    auto snapshot = std::make_shared<SpaceSnapshot>();
+    snapshot->record = base.record;
+    snapshot->space = base.space;
+    snapshot->clips = base.clips;
+    MOTIONDB_ASSIGN_OR_RETURN(snapshot->index,
+                              base.index->WithClips({{clip.clip_id, clip.info.name, clip.info.tags,
+                                                      std::move(clip.coordinates)}}));
+    snapshot->clips.emplace(clip.clip_id, std::move(clip.info));
+    return snapshot;
+  }
   std::vector<IndexedClip> clips = ClipsOf(base, clip.clip_id);
   clips.push_back(std::move(clip));
   return BuildSnapshot(base.record, base.space, std::move(clips));

@@ -76,35 +76,94 @@ TEST_F(SearchTest, LibraryMapsGlobalFramesToClips) {
   EXPECT_EQ(library_->FindClip(7), -1);
 }
 
-TEST_F(SearchTest, NearestAgreesWithBruteForce) {
+// A library frame by global number.
+const float* FrameRow(const LibraryIndex& library, int64_t frame) {
+  const auto [clip, local] = library.Locate(frame);
+  return library.clip_coordinates(clip).row(local);
+}
+
+// The k nearest frames over 10 dims, nearest first, by brute force, and as the index finds them
+// (kd-tree, kd-tree with a filter, linear scan).
+void ExpectNearestAgreesWithBruteForce(const LibraryIndex& library, int clips) {
   std::mt19937 rng(3);
-  const CoordinateView all = library_->coordinates();
   for (int trial = 0; trial < 20; ++trial) {
-    const float* point = all.row(rng() % library_->total_frames());
+    const float* point = FrameRow(library, rng() % library.total_frames());
     // Filters: none, all but one clip (kd-tree and post-filter), and one clip (linear scan).
-    for (const std::vector<bool>& allowed :
-         std::vector<std::vector<bool>>{{}, {true, false, true}, {false, true, false}}) {
+    std::vector<bool> all_but_one(clips, true), one(clips, false);
+    all_but_one[1] = false;
+    one[1] = true;
+    for (const std::vector<bool>& allowed : {std::vector<bool>(), all_but_one, one}) {
       std::vector<float> expected;
-      for (int64_t f = 0; f < all.rows; ++f) {
-        if (allowed.empty() || allowed[library_->Locate(f).first]) {
-          expected.push_back(Distance(point, all.row(f), 10));
+      for (int64_t f = 0; f < library.total_frames(); ++f) {
+        if (allowed.empty() || allowed[library.Locate(f).first]) {
+          expected.push_back(Distance(point, FrameRow(library, f), 10));
         }
       }
       std::sort(expected.begin(), expected.end());
-      const std::vector<Neighbour> found = library_->Nearest(point, 10, 50, 0.0f, allowed);
+      const std::vector<Neighbour> found = library.Nearest(point, 10, 50, 0.0f, allowed);
       ASSERT_EQ(found.size(), 50u);
       for (size_t i = 0; i < found.size(); ++i) {
         EXPECT_NEAR(found[i].distance, expected[i], 1e-4) << i;
-        EXPECT_NEAR(found[i].distance, Distance(point, all.row(found[i].frame), 10), 1e-4);
+        EXPECT_NEAR(found[i].distance, Distance(point, FrameRow(library, found[i].frame), 10),
+                    1e-4);
         if (!allowed.empty()) {
-          EXPECT_TRUE(allowed[library_->Locate(found[i].frame).first]);
+          EXPECT_TRUE(allowed[library.Locate(found[i].frame).first]);
         }
       }
     }
     // Other dimensions than the tree's are answered by a scan.
-    const std::vector<Neighbour> six = library_->Nearest(point, 6, 5, 0.0f, {});
+    const std::vector<Neighbour> six = library.Nearest(point, 6, 5, 0.0f, {});
     EXPECT_EQ(six[0].distance, 0.0f);
   }
+}
+
+TEST_F(SearchTest, NearestAgreesWithBruteForce) { ExpectNearestAgreesWithBruteForce(*library_, 3); }
+
+// Clips added one at a time go into a second block beside the first; the index answers exactly
+// as one built from all the clips at once, until the additions grow past a sixteenth of the
+// frames and it is built anew.
+TEST(LibraryIndexAdditions, AnswerAsABuildOfEveryClip) {
+  std::vector<LibraryClip> clips;
+  const std::vector<int64_t> lengths = {1500, 1500, 60, 50, 40, 1400};
+  for (size_t c = 0; c < lengths.size(); ++c) {
+    RowMatrixXf curve = testing::SmoothNoise(lengths[c], kDims, 80 + c);
+    if (c == 3) testing::Plant(curve, testing::Pattern(40, kDims), 5);
+    clips.push_back({static_cast<int64_t>(10 + c), "clip" + std::to_string(c), {}, curve});
+  }
+  std::unique_ptr<LibraryIndex> grown =
+      *LibraryIndex::Build({clips[0], clips[1]}, 30.0, LibraryIndexOptions());
+  for (size_t c = 2; c < clips.size(); ++c) {
+    SCOPED_TRACE("after clip " + std::to_string(c));
+    grown = *grown->WithClips({clips[c]});
+    // The three small clips share the second block; the large last one makes a full build.
+    EXPECT_EQ(grown->block_count(), c + 1 < clips.size() ? 2 : 1);
+    const std::vector<LibraryClip> so_far(clips.begin(), clips.begin() + c + 1);
+    const std::unique_ptr<LibraryIndex> built =
+        *LibraryIndex::Build(so_far, 30.0, LibraryIndexOptions());
+    ASSERT_EQ(grown->total_frames(), built->total_frames());
+    ASSERT_EQ(grown->clip_count(), built->clip_count());
+    for (int i = 0; i < built->clip_count(); ++i) {
+      EXPECT_EQ(grown->clip(i).clip_id, built->clip(i).clip_id);
+      EXPECT_EQ(grown->clip(i).first_frame, built->clip(i).first_frame);
+      EXPECT_EQ(grown->CopyClipCoordinates(i), built->CopyClipCoordinates(i));
+      EXPECT_EQ(grown->FindClip(built->clip(i).clip_id), i);
+    }
+    ExpectNearestAgreesWithBruteForce(*grown, grown->clip_count());
+    const RowMatrixXf query = testing::Pattern(40, kDims);
+    const SearchResponse from_grown = *Search(*grown, CoordinateView::Of(query), {});
+    const SearchResponse from_built = *Search(*built, CoordinateView::Of(query), {});
+    ASSERT_EQ(from_grown.results.size(), from_built.results.size());
+    for (size_t r = 0; r < from_built.results.size(); ++r) {
+      EXPECT_EQ(from_grown.results[r].clip_id, from_built.results[r].clip_id);
+      EXPECT_EQ(from_grown.results[r].first_frame, from_built.results[r].first_frame);
+      EXPECT_NEAR(from_grown.results[r].score, from_built.results[r].score, 1e-6);
+    }
+  }
+  EXPECT_THAT(grown->WithClips({clips[2]}).status().message(), HasSubstr("already"));
+  LibraryClip wrong = clips[2];
+  wrong.clip_id = 99;
+  wrong.coordinates = RowMatrixXf::Zero(5, kDims + 1);
+  EXPECT_FALSE(grown->WithClips({wrong}).ok());
 }
 
 TEST_F(SearchTest, TreeMemoryIsSmallBesideTheCoordinates) {

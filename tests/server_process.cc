@@ -40,10 +40,10 @@ ServerProcess::~ServerProcess() {
 bool ServerProcess::Start(const std::vector<std::string>& args, std::string* error,
                           std::chrono::seconds timeout) {
   static std::atomic<int> starts{0};
-  log_path_ = (std::filesystem::temp_directory_path() /
-               ("motiondb_server_" + std::to_string(::getpid()) + "_" +
-                std::to_string(starts++) + ".log"))
-                  .string();
+  log_path_ =
+      (std::filesystem::temp_directory_path() /
+       ("motiondb_server_" + std::to_string(::getpid()) + "_" + std::to_string(starts++) + ".log"))
+          .string();
   std::vector<std::string> argv_strings = {ServerPath(), "--listen", "127.0.0.1:0"};
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
