@@ -127,7 +127,6 @@ absl::StatusOr<Throughput> Measure(int threads, double seconds, SearchFn search)
   return result;
 }
 
-// `server_ms`: the latencies the server logged for the same calls (empty in process).
 // Adds one turn of `turns` to `total`.
 void Add(const Throughput& part, int turns, Throughput& total) {
   total.qps += part.qps / turns;
@@ -135,6 +134,7 @@ void Add(const Throughput& part, int turns, Throughput& total) {
                             part.latencies_ms.end());
 }
 
+// `server_ms`: the latencies the server logged for the same calls (empty in process).
 void PrintThroughput(const std::string& label, const Throughput& t,
                      const std::vector<double>& server_ms = {}) {
   std::printf("| %s | %.0f | %.2f | %.2f | %s |\n", label.c_str(), t.qps,
@@ -158,6 +158,22 @@ v1::SearchRequest QueryOf(int64_t clip_id) {
   request.set_space("bench");
   request.mutable_clip()->set_clip_id(clip_id);
   return request;
+}
+
+// Searches from `clients` clients, each on its own connection to `address`, every clip of `ids`
+// in turn as the query.
+absl::StatusOr<Throughput> MeasureServed(const std::string& address, int clients, double seconds,
+                                         const std::vector<int64_t>& ids) {
+  std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
+  for (int c = 0; c < clients; ++c) {
+    stubs.push_back(v1::SearchService::NewStub(OwnConnection(address)));
+  }
+  return Measure(clients, seconds, [&](int worker, int64_t k) {
+    const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
+    v1::SearchResponse response;
+    grpc::ClientContext context;
+    return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
+  });
 }
 
 absl::StatusOr<std::vector<std::filesystem::path>> BvhFiles(const std::filesystem::path& folder) {
@@ -244,17 +260,8 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
 
   // The server that did the ingests, before any restart: its index holds the recent clips in a
   // second kd-tree (core/library_index.h).
-  std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
-  for (int c = 0; c < 4; ++c) {
-    stubs.push_back(v1::SearchService::NewStub(OwnConnection(server.address())));
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const Throughput after_ingest, Measure(4, 1.0, [&](int worker, int64_t k) {
-        const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
-        v1::SearchResponse response;
-        grpc::ClientContext context;
-        return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
-      }));
+  MOTIONDB_ASSIGN_OR_RETURN(const Throughput after_ingest,
+                            MeasureServed(server.address(), 4, 1.0, ids));
   const double ingest_rss = StatusMiB(server.pid(), "VmRSS");
   if (server.Stop(SIGTERM) != 0) return absl::InternalError("the server did not stop cleanly");
 
@@ -294,7 +301,7 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
   }
   const int turns = std::max(1, static_cast<int>(seconds));
   double rss = 0, hwm = 0;
-  int64_t logged_requests = 0;
+  int64_t logged_searches = 0;
   for (int turn = 0; turn < turns; ++turn) {
     testing::ServerProcess turn_server;
     if (!turn_server.Start({"--db", db}, &error)) return absl::InternalError(error);
@@ -303,26 +310,17 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
     }
     for (Way& way : ways) {
       if (way.served != true) continue;
-      std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
-      for (int c = 0; c < way.threads; ++c) {
-        stubs.push_back(v1::SearchService::NewStub(OwnConnection(turn_server.address())));
-      }
       const size_t log_before = turn_server.Log().size();
       MOTIONDB_ASSIGN_OR_RETURN(
-          const Throughput part, Measure(way.threads, seconds / turns, [&](int worker, int64_t k) {
-            const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
-            v1::SearchResponse response;
-            grpc::ClientContext context;
-            return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
-          }));
+          const Throughput part,
+          MeasureServed(turn_server.address(), way.threads, seconds / turns, ids));
       Add(part, turns, way.total);
       const std::vector<double> logged = LoggedSearchMs(turn_server.Log(), log_before);
       way.server_ms.insert(way.server_ms.end(), logged.begin(), logged.end());
     }
     rss = StatusMiB(turn_server.pid(), "VmRSS");
     hwm = StatusMiB(turn_server.pid(), "VmHWM");
-    const std::string log = turn_server.Log();
-    logged_requests += std::count(log.begin(), log.end(), '\n');
+    logged_searches += static_cast<int64_t>(LoggedSearchMs(turn_server.Log(), 0).size());
     if (turn_server.Stop(SIGTERM) != 0) {
       return absl::InternalError("the server did not stop cleanly");
     }
@@ -358,7 +356,8 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
       "server resident memory after a turn of searches (restarted): VmRSS %.0f MiB, peak "
       "VmHWM %.0f MiB\n",
       rss, hwm);
-  std::printf("requests logged: %lld\n\n", static_cast<long long>(logged_requests));
+  std::printf("searches the server logged in the turns: %lld\n\n",
+              static_cast<long long>(logged_searches));
   return absl::OkStatus();
 }
 

@@ -63,7 +63,8 @@ class LibraryIndex {
   LibraryIndex& operator=(const LibraryIndex&) = delete;
 
   // This library with `clips` added after its own clips (same rules as Build(); their ids must
-  // be new), sharing this index's blocks and kd-trees.
+  // be new). Shares this index's first block and kd-tree; the second is built anew from the
+  // clips added since the last full build and these.
   absl::StatusOr<std::unique_ptr<LibraryIndex>> WithClips(std::vector<LibraryClip> clips) const;
 
   double rate() const { return rate_; }

@@ -2,8 +2,8 @@
 // characteristic pose, take its nearest library frames as seeds, cluster the seeds in time per
 // clip, warp the query through each cluster's best seed, and rank the warps by mean pose
 // distance with overlap suppression. One step beyond the thesis (SearchParams::refine): the
-// best warps are freed from their seeds by a banded warp around each (core/band_warp.h), so
-// that their scores, and so their order, are those of the exact search.
+// best warps are freed from their seeds, each moved to the best warp near it
+// (core/warp_refinement.h), so that nearly equal matches are ordered by their true scores.
 #ifndef MOTIONDB_CORE_MOTION_SEARCH_H_
 #define MOTIONDB_CORE_MOTION_SEARCH_H_
 

@@ -39,8 +39,9 @@ struct SearchParams {
   double cluster_gap_s = 0.1;
   // A result is dropped when it overlaps a better one by more than this fraction of its length.
   double max_overlap = 0.5;
-  // Re-warp each candidate without its seed anchor, in a window around it, before ranking: a
-  // warp forced through its seed can score a little worse than the best warp there.
+  // Move each candidate to the best warp near it, free of its seed, before ranking
+  // (core/warp_refinement.h): a warp pinned to a seed in a held pose can score far worse than
+  // the best warp beside it. false runs the thesis's algorithm as is.
   bool refine = true;
   // Return each result's warp path (one library frame per query frame).
   bool return_path = false;

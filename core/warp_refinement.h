@@ -2,9 +2,10 @@
 // seed can score far worse than the best warp beside it (a seed anywhere in a held pose pins the
 // warp there), enough to reorder nearly equal matches. The candidate is replaced by the best
 // warp near it, found by banded warps (core/band_warp.h) re-centred on their own best path while
-// that improves and touches the band's edge. Above 30 Hz the band first moves at 30 Hz (every
-// n-th frame of query and clip: 1/n^2 of the cells), then settles at the full rate in a narrow
-// band.
+// that improves and touches the band's edge. From 45 Hz the band first moves at about 30 Hz
+// (every n-th frame of query and clip, n = round(rate / 30): 1/n^2 of the cells), then settles
+// at the full rate in a narrow band around where the coarse pass ended. A local search: scores
+// only fall, but the best warp farther away than the band reaches is not found.
 #ifndef MOTIONDB_CORE_WARP_REFINEMENT_H_
 #define MOTIONDB_CORE_WARP_REFINEMENT_H_
 

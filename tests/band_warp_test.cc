@@ -100,6 +100,24 @@ TEST(BandWarp, AWideBandFindsTheBestWarpAnywhereInTheClip) {
   }
 }
 
+// A centre that pauses (as an upsampled coarse path does) moves the band by 0 frames on some
+// rows: the band still holds the best warp inside it.
+TEST(BandWarp, CentreWithPauses) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 30; ++trial) {
+    const int s = 2 + trial % 2;
+    const RowMatrixXf q = testing::SmoothNoise(6, 3, 700 + trial);
+    const RowMatrixXf x = testing::SmoothNoise(20, 3, 800 + trial);
+    std::vector<int64_t> centre(6, 3);
+    for (int i = 1; i < 6; ++i) centre[i] = centre[i - 1] + static_cast<int>(rng() % (s + 1));
+    BandWorkspace ws;
+    bool touches_edge = false;
+    const Warp warp = BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, 1 + trial % 3,
+                               {s, 3}, ws, &touches_edge);
+    EXPECT_NEAR(warp.score, BruteForce(q, x, s, centre, 1 + trial % 3), 1e-5) << trial;
+  }
+}
+
 TEST(BandWarp, FollowsAShiftedCopy) {
   // The pattern sits 3 frames later than the centre path says: a band of radius 3 finds it.
   const RowMatrixXf query = testing::Pattern(30, 4);

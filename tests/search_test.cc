@@ -262,12 +262,18 @@ TEST_F(SearchTest, RefinementOnlyImprovesAndKeepsPathsTrue) {
     EXPECT_EQ(r.path.front(), r.first_frame);
     EXPECT_EQ(r.path.back(), r.last_frame);
     EXPECT_EQ(r.path[anchor], r.seed_frame);
+    EXPECT_NEAR(r.start_s, r.first_frame / 30.0, 1e-9);
+    EXPECT_NEAR(r.end_s, r.last_frame / 30.0, 1e-9);
     const CoordinateView clip = library_->clip_coordinates(r.clip_index);
     double sum = 0;
+    int pauses = 0;
     for (int i = 0; i < 40; ++i) {
       if (i > 0) {
         EXPECT_GE(r.path[i] - r.path[i - 1], 0);
         EXPECT_LE(r.path[i] - r.path[i - 1], params.slope_limit);
+        pauses = r.path[i] == r.path[i - 1] ? pauses + 1 : 0;
+        // Refined paths are whole warps of the model; anchored ones pause once more at the seed.
+        EXPECT_LE(pauses, params.slope_limit - (r.path[anchor] == r.path[i] ? 0 : 1));
       }
       sum += Distance(query.row(i).data(), clip.row(r.path[i]), params.dtw_dims);
     }

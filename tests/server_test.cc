@@ -1180,6 +1180,7 @@ TEST_F(ServerTest, KillDuringIngestLosesNoAcknowledgedClipAndLeavesNoHalfClip) {
   for (int round = 0; round < 3; ++round) {
     SCOPED_TRACE("round " + std::to_string(round));
     std::atomic<int> acknowledged{0};
+    std::atomic<bool> stopped{false};  // the ingester met an error and returned
     std::map<std::string, int> acked;  // written by the ingester, read after the join
     std::string in_flight;
     int in_flight_frames = 0;
@@ -1208,12 +1209,19 @@ TEST_F(ServerTest, KillDuringIngestLosesNoAcknowledgedClipAndLeavesNoHalfClip) {
           if (written) writer->WritesDone();
           status = writer->Finish();
         }
-        if (!status.ok()) return;  // the server is gone
+        if (!status.ok()) {  // the server is gone (or, before the kill, a failure)
+          stopped = true;
+          return;
+        }
         acked[name] = response.clip().frame_count();
         ++acknowledged;
       }
     });
-    while (acknowledged < 4 + 2 * round) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (acknowledged < 4 + 2 * round && !stopped && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_FALSE(stopped) << "an ingest failed before the kill";
     std::this_thread::sleep_for(std::chrono::milliseconds(3 * round));
     EXPECT_EQ(server->Stop(SIGKILL), 128 + SIGKILL);
     ingester.join();
@@ -1234,8 +1242,9 @@ TEST_F(ServerTest, KillDuringIngestLosesNoAcknowledgedClipAndLeavesNoHalfClip) {
       any_id = clip.clip_id();
     }
     for (const auto& [name, frames] : expected_frames) {
-      EXPECT_EQ(stored_frames.count(name), 1u) << name << " was acknowledged but is missing";
-      EXPECT_EQ(stored_frames[name], frames) << name;
+      const auto stored_clip = stored_frames.find(name);
+      ASSERT_NE(stored_clip, stored_frames.end()) << name << " was acknowledged but is missing";
+      EXPECT_EQ(stored_clip->second, frames) << name;
     }
     // Besides those, only the clip in flight may have been stored, and then whole.
     for (const auto& [name, frames] : stored_frames) {
