@@ -18,30 +18,37 @@ fi
 "$root/scripts/build.sh"
 server="$root/build/server/motiondb-server"
 cli="$root/build/client/motiondb"
+# The CLI talks to wherever the server was told to listen (a wildcard host is reached locally).
+listen="127.0.0.1:50051"
+args=("$@")
+for ((i = 0; i + 1 < ${#args[@]}; i++)); do
+  [[ "${args[i]}" == "--listen" ]] && listen="${args[i + 1]}"
+done
+address="${listen/#0.0.0.0:/127.0.0.1:}"
 
 "$server" --db "${MOTIONDB_DB:-./motiondb.sqlite}" "$@" &
 pid=$!
 trap 'kill -TERM "$pid" 2>/dev/null || true' INT TERM
 for _ in $(seq 100); do
-  "$cli" info --timeout 1 >/dev/null 2>&1 && break
+  "$cli" info --server "$address" --timeout 1 >/dev/null 2>&1 && break
   kill -0 "$pid" 2>/dev/null || { wait "$pid"; exit $?; }
   sleep 0.2
 done
-"$cli" info
+"$cli" info --server "$address"
 
 if ((demo)); then
   echo "Loading the demo library..."
-  "$cli" ingest /usr/share/assimp/models/BVH/*.bvh --tag demo || true
+  "$cli" ingest /usr/share/assimp/models/BVH/*.bvh --tag demo --server "$address" || true
   bandai="$root/../shared/mocap/bandai2-normal"
   if [[ -d "$bandai" ]]; then
-    "$cli" ingest "$bandai" --tag bandai || true
-    first=$("$cli" clips --tag bandai --json | /usr/bin/python3 -c \
+    "$cli" ingest "$bandai" --tag bandai --server "$address" || true
+    first=$("$cli" clips --tag bandai --json --server "$address" | /usr/bin/python3 -c \
       'import json,sys; c=json.load(sys.stdin)["clips"]; print(c[0]["clip_id"] if c else "")')
     if [[ -n "$first" ]]; then
-      skeleton=$("$cli" clip show "$first" --json | /usr/bin/python3 -c \
+      skeleton=$("$cli" clip show "$first" --json --server "$address" | /usr/bin/python3 -c \
         'import json,sys; print(json.load(sys.stdin)["skeleton_id"])')
-      "$cli" space create demo --skeleton "$skeleton" || true
-      echo "Try: $cli search --space demo --clip $first"
+      "$cli" space create demo --skeleton "$skeleton" --server "$address" || true
+      echo "Try: $cli search --space demo --clip $first --server $address"
     fi
   fi
 fi
