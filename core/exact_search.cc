@@ -35,8 +35,8 @@ class ClipScan {
   }
 
   // Runs over every column, offering each end frame's best path to `top`.
-  absl::Status Run(int clip_index, const LibraryIndex& library, const SearchParams& params,
-                   StreamingTopResults& top, SearchStats& stats) {
+  absl::Status Run(int clip_index, const SearchParams& params, StreamingTopResults& top,
+                   SearchStats& stats) {
     for (int64_t j = 0; j < clip_.rows; ++j) {
       if (j % kBlock == 0) {
         if ((j / kBlock) % 256 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
@@ -56,7 +56,7 @@ class ClipScan {
       if (end_cost < kInfinity) {
         const Warp warp{
             ring_[j % ring_.size()].best_start, j, end_cost / static_cast<double>(m_), {}};
-        top.Offer(MakeResult(library, clip_index, warp, -1));
+        top.Offer(MakeResult(clip_index, warp, -1));
       }
     }
     return absl::OkStatus();
@@ -196,9 +196,9 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   for (int c = 0; c < library.clip_count(); ++c) {
     if (!allowed.empty() && !allowed[c]) continue;
     ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
-    MOTIONDB_RETURN_IF_ERROR(scan.Run(c, library, params, top, response.stats));
+    MOTIONDB_RETURN_IF_ERROR(scan.Run(c, params, top, response.stats));
   }
-  response.results = RankResults(top.Take(), params.max_overlap, params.max_results);
+  response.results = FinishResults(library, top.Take(), params);
   response.stats.warps_ms = response.stats.total_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return response;

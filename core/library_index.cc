@@ -157,8 +157,7 @@ absl::StatusOr<std::unique_ptr<LibraryIndex>> LibraryIndex::WithClips(
   std::unique_ptr<LibraryIndex> index(new LibraryIndex(rate_, options_, dims_));
   index->blocks_.push_back(blocks_[0]);
   for (int c = 0; c < clip_count() && clip_block_[c] == 0; ++c) {
-    index->clips_.push_back(clips_[c]);
-    index->clip_block_.push_back(0);
+    index->AddEntry(clips_[c], 0);
   }
   index->total_frames_ = base_frames;
   index->AddBlock(std::move(block), base_frames);
@@ -174,9 +173,9 @@ void LibraryIndex::AddBlock(std::vector<LibraryClip> clips, int64_t first_frame)
   int64_t next = 0;
   for (LibraryClip& clip : clips) {
     block->coordinates.middleRows(next, clip.coordinates.rows()) = clip.coordinates;
-    clips_.push_back({clip.clip_id, std::move(clip.name), std::move(clip.tags), first_frame + next,
-                      clip.coordinates.rows()});
-    clip_block_.push_back(static_cast<int>(blocks_.size()));
+    AddEntry({clip.clip_id, std::move(clip.name), std::move(clip.tags), first_frame + next,
+              clip.coordinates.rows()},
+             static_cast<int>(blocks_.size()));
     next += clip.coordinates.rows();
     clip.coordinates = RowMatrixXf();  // release each copy as soon as it is in the block
   }
@@ -222,11 +221,15 @@ std::vector<Neighbour> LibraryIndex::TreeNearest(const float* point, int dims, i
   return all;
 }
 
+void LibraryIndex::AddEntry(ClipEntry entry, int block) {
+  index_of_id_.try_emplace(entry.clip_id, clip_count());  // the first clip of an id wins
+  clips_.push_back(std::move(entry));
+  clip_block_.push_back(block);
+}
+
 int LibraryIndex::FindClip(int64_t clip_id) const {
-  for (size_t i = 0; i < clips_.size(); ++i) {
-    if (clips_[i].clip_id == clip_id) return static_cast<int>(i);
-  }
-  return -1;
+  const auto it = index_of_id_.find(clip_id);
+  return it == index_of_id_.end() ? -1 : it->second;
 }
 
 std::pair<int, int64_t> LibraryIndex::Locate(int64_t global_frame) const {

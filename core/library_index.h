@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
 #include "core/coordinate_view.h"
 #include "core/matrix.h"
@@ -100,6 +101,7 @@ class LibraryIndex {
   // A block of `clips` (validated) after `first_frame` global frames, with its kd-tree; appends
   // their entries.
   void AddBlock(std::vector<LibraryClip> clips, int64_t first_frame);
+  void AddEntry(ClipEntry entry, int block);
   // The k nearest over the kd-trees of every block, merged.
   std::vector<Neighbour> TreeNearest(const float* point, int dims, int k, float epsilon) const;
 
@@ -112,6 +114,8 @@ class LibraryIndex {
   std::vector<std::shared_ptr<const Block>> blocks_;
   std::vector<ClipEntry> clips_;
   std::vector<int> clip_block_;  // per clip: its block
+  // Clip id -> index: searches filtered by clip ids look up every id.
+  absl::flat_hash_map<int64_t, int> index_of_id_;
 };
 
 }  // namespace motiondb

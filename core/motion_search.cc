@@ -42,11 +42,13 @@ std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t sep
     const bool run_ends = i == seeds.size() || seeds[i].clip != seeds[i - 1].clip ||
                           seeds[i].frame - seeds[i - 1].frame > gap;
     if (!run_ends) continue;
-    std::vector<Seed> run(seeds.begin() + run_start, seeds.begin() + i);
-    std::sort(run.begin(), run.end(),
+    // Sorted in place: the runs still to come lie after i.
+    const auto run_begin = seeds.begin() + run_start, run_end = seeds.begin() + i;
+    std::sort(run_begin, run_end,
               [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
     const size_t first_kept = representatives.size();
-    for (const Seed& seed : run) {
+    for (auto seed_it = run_begin; seed_it != run_end; ++seed_it) {
+      const Seed& seed = *seed_it;
       const bool near_kept = std::any_of(
           representatives.begin() + first_kept, representatives.end(),
           [&](const Seed& kept) { return std::abs(kept.frame - seed.frame) < separation; });
@@ -116,13 +118,12 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   }
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
-  const std::vector<Seed> clusters = ClusterSeeds(std::move(seeds), gap, separation);
-  stats.clusters = static_cast<int64_t>(clusters.size());
+  std::vector<Seed> order = ClusterSeeds(std::move(seeds), gap, separation);
+  stats.clusters = static_cast<int64_t>(order.size());
   stats.clusters_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
-  std::vector<Seed> order = clusters;
   std::sort(order.begin(), order.end(),
             [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
@@ -137,7 +138,7 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
                      params.return_path || params.refine, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
-    top.Offer(MakeResult(library, seed.clip, *std::move(warp), seed.frame));
+    top.Offer(MakeResult(seed.clip, *std::move(warp), seed.frame));
   }
   stats.warps_ms = MillisecondsSince(stage);
 
@@ -156,7 +157,7 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stats.refine_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
-  response.results = RankResults(std::move(candidates), params.max_overlap, params.max_results);
+  response.results = FinishResults(library, std::move(candidates), params);
   stats.ranking_ms = MillisecondsSince(stage);
   stats.total_ms = MillisecondsSince(start);
   return response;

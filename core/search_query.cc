@@ -46,21 +46,30 @@ absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, Coor
   return allowed;
 }
 
-SearchResult MakeResult(const LibraryIndex& library, int clip_index, Warp warp,
-                        int64_t seed_frame) {
-  const LibraryIndex::ClipEntry& clip = library.clip(clip_index);
+SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame) {
   SearchResult result;
   result.clip_index = clip_index;
-  result.clip_id = clip.clip_id;
-  result.clip_name = clip.name;
   result.first_frame = warp.first;
   result.last_frame = warp.last;
-  result.start_s = warp.first / library.rate();
-  result.end_s = warp.last / library.rate();
   result.score = warp.score;
   result.seed_frame = seed_frame;
   result.path = std::move(warp.path);
   return result;
+}
+
+std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+                                        std::vector<SearchResult> candidates,
+                                        const SearchParams& params) {
+  std::vector<SearchResult> results =
+      RankResults(std::move(candidates), params.max_overlap, params.max_results);
+  for (SearchResult& result : results) {
+    const LibraryIndex::ClipEntry& clip = library.clip(result.clip_index);
+    result.clip_id = clip.clip_id;
+    result.clip_name = clip.name;
+    result.start_s = result.first_frame / library.rate();
+    result.end_s = result.last_frame / library.rate();
+  }
+  return results;
 }
 
 absl::Status CheckStop(const SearchParams& params) {

@@ -19,7 +19,14 @@ namespace motiondb {
 absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
                                                const SearchParams& params);
 
-SearchResult MakeResult(const LibraryIndex& library, int clip_index, Warp warp, int64_t seed_frame);
+// A candidate: the clip by index, the warp's frames and score. Its clip id, name and times are
+// filled by FinishResults, only for the results kept.
+SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame);
+
+// RankResults, then each kept result's clip id, name and start and end in seconds.
+std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+                                        std::vector<SearchResult> candidates,
+                                        const SearchParams& params);
 
 // CANCELLED when the caller's should_stop says so.
 absl::Status CheckStop(const SearchParams& params);

@@ -102,7 +102,7 @@ MOTIONDB_VECTOR_CLONES std::optional<HalfWarp> WarpHalf(
     best.resize(prev_width + 2 * s);
     {
       // Infinities around the survivors, as far as any advance reads.
-      const int64_t from = std::max<int64_t>(0, alive_first - prev_low + s - s);
+      const int64_t from = std::max<int64_t>(0, alive_first - prev_low);
       const int64_t to = std::min<int64_t>(prev_width + 2 * s, alive_last - prev_low + 2 * s + 1);
       std::fill(best.begin() + from, best.begin() + to, kInfinity);
     }

@@ -86,8 +86,6 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
   if (!warp) return;
   candidate.first_frame = warp->first;
   candidate.last_frame = warp->last;
-  candidate.start_s = warp->first / rate;
-  candidate.end_s = warp->last / rate;
   candidate.score = warp->score;
   candidate.seed_frame = warp->path[anchor];
   candidate.path = std::move(warp->path);
