@@ -2,30 +2,18 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
+#include "core/file_io.h"
 #include "core/status_macros.h"
 
 namespace motiondb::cli {
 namespace {
 
-constexpr const char* kCodeNames[] = {
-    "OK",        "CANCELLED",      "UNKNOWN",           "INVALID_ARGUMENT",   "DEADLINE_EXCEEDED",
-    "NOT_FOUND", "ALREADY_EXISTS", "PERMISSION_DENIED", "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION",
-    "ABORTED",   "OUT_OF_RANGE",   "UNIMPLEMENTED",     "INTERNAL",           "UNAVAILABLE",
-    "DATA_LOSS", "UNAUTHENTICATED"};
-
-absl::StatusOr<std::string> ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open file"));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+// A CA bundle is small; anything larger is a wrong path.
+constexpr int64_t kMaxCaBytes = int64_t{1} << 20;
 
 }  // namespace
 
@@ -48,7 +36,7 @@ absl::StatusOr<ServerConnection> ServerConnection::Connect(const CommandLine& li
   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
   if (const std::optional<std::string> ca = line.value("tls-ca")) {
     grpc::SslCredentialsOptions ssl;
-    MOTIONDB_ASSIGN_OR_RETURN(ssl.pem_root_certs, ReadText(*ca));
+    MOTIONDB_ASSIGN_OR_RETURN(ssl.pem_root_certs, ReadFileBytes(*ca, kMaxCaBytes));
     credentials = grpc::SslCredentials(ssl);
   }
   grpc::ChannelArguments arguments;
@@ -68,7 +56,9 @@ std::unique_ptr<grpc::ClientContext> ServerConnection::NewContext() const {
 
 std::string DescribeError(const grpc::Status& status, const std::string& address) {
   const int code = static_cast<int>(status.error_code());
-  const std::string name = code >= 0 && code <= 16 ? kCodeNames[code] : std::to_string(code);
+  // gRPC's and Abseil's codes are the same numbers with the same names.
+  const std::string spelled = absl::StatusCodeToString(static_cast<absl::StatusCode>(code));
+  const std::string name = spelled.empty() ? std::to_string(code) : spelled;
   if (status.error_code() == grpc::StatusCode::UNAVAILABLE) {
     return absl::StrCat("cannot reach the server at ", address, " (", status.error_message(),
                         "); is motiondb-server running? (--server ADDR)");

@@ -65,12 +65,7 @@ absl::StatusOr<IngestedClip> Library::IngestClip(const storage::ClipRecord& reco
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id, database_.InsertClip(record, clip, projections));
   facts_.Put(clip_id, ClipFacts::Of(clip));
 
-  IngestedClip ingested{clip_id, skeleton_id, {}};
-  if (skeleton_id < 0) {
-    // A new skeleton: ask the database which id it got.
-    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord stored, database_.GetClipRecord(clip_id));
-    ingested.skeleton_id = stored.skeleton_id;
-  }
+  IngestedClip ingested{clip_id, {}};
   const IndexedClipInfo info{record.name, record.tags, clip.fps(), clip.frame_count()};
   for (size_t i = 0; i < spaces.size(); ++i) {
     absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =

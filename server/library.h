@@ -26,7 +26,6 @@ namespace motiondb::server {
 
 struct IngestedClip {
   int64_t clip_id = 0;
-  int64_t skeleton_id = 0;
   std::vector<std::string> spaces;  // projected into
 };
 

@@ -30,7 +30,6 @@ class ReadPool {
       if (connection_ != nullptr) pool_->Return(std::move(connection_));
     }
     SqliteConnection& operator*() const { return *connection_; }
-    SqliteConnection* operator->() const { return connection_.get(); }
 
    private:
     ReadPool* pool_;

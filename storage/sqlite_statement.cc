@@ -58,10 +58,6 @@ SqliteStatement& SqliteStatement::BindBlob(int index, absl::string_view bytes) {
   return Check(sqlite3_bind_blob64(stmt_, index, bytes.data(), bytes.size(), SQLITE_STATIC), index);
 }
 
-SqliteStatement& SqliteStatement::BindNull(int index) {
-  return Check(sqlite3_bind_null(stmt_, index), index);
-}
-
 absl::StatusOr<bool> SqliteStatement::Step() {
   if (!bind_status_.ok()) return bind_status_;
   const int rc = sqlite3_step(stmt_);
@@ -88,10 +84,6 @@ int64_t SqliteStatement::ColumnInt64(int index) const { return sqlite3_column_in
 
 double SqliteStatement::ColumnDouble(int index) const {
   return sqlite3_column_double(stmt_, index);
-}
-
-bool SqliteStatement::ColumnIsNull(int index) const {
-  return sqlite3_column_type(stmt_, index) == SQLITE_NULL;
 }
 
 std::string SqliteStatement::ColumnText(int index) const {

@@ -35,7 +35,6 @@ class SqliteStatement {
   SqliteStatement& BindDouble(int index, double value);
   SqliteStatement& BindText(int index, absl::string_view text);
   SqliteStatement& BindBlob(int index, absl::string_view bytes);
-  SqliteStatement& BindNull(int index);
 
   // Advances to the next row: true on a row, false when the statement is done.
   absl::StatusOr<bool> Step();
@@ -47,7 +46,6 @@ class SqliteStatement {
   // Columns of the current row, counted from 0.
   int64_t ColumnInt64(int index) const;
   double ColumnDouble(int index) const;
-  bool ColumnIsNull(int index) const;
   std::string ColumnText(int index) const;
   // Valid until the next Step(), Reset() or destruction.
   absl::string_view ColumnBlob(int index) const;
