@@ -17,6 +17,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "bench/measure.h"
 #include "benchmark/benchmark.h"
 #include "core/bvh_reader.h"
 
@@ -32,13 +33,6 @@ struct Corpus {
 Corpus& TheCorpus() {
   static Corpus corpus;
   return corpus;
-}
-
-std::filesystem::path MocapRoot() {
-  if (const char* env = std::getenv("MOTIONDB_MOCAP_DIR"); env != nullptr && *env != '\0') {
-    return env;
-  }
-  return MOTIONDB_MOCAP_DIR;
 }
 
 // The baseline a hand-written parser would start from: formatted extraction from a stream.
@@ -155,7 +149,7 @@ bool LoadCorpus(const std::filesystem::path& dir, Corpus& corpus) {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  const std::filesystem::path dir = MocapRoot() / "bandai2-normal";
+  const std::filesystem::path dir = motiondb::bench::MocapRoot() / "bandai2-normal";
   if (!LoadCorpus(dir, TheCorpus())) return 0;
   const Corpus& corpus = TheCorpus();
   std::cout << "bvh_parse_bench: " << corpus.texts.size() << " files, " << corpus.bytes

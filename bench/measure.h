@@ -1,9 +1,15 @@
-// What the measurement programs share: elapsed time and percentiles.
+// What the measurement programs share: elapsed time, percentiles, memory, the corpus folder.
 #ifndef MOTIONDB_BENCH_MEASURE_H_
 #define MOTIONDB_BENCH_MEASURE_H_
 
+#include <sys/types.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <vector>
 
 namespace motiondb::bench {
@@ -19,6 +25,25 @@ inline double Percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())))];
+}
+
+// A field of /proc/PID/status in MiB (VmRSS: resident now; VmHWM: its peak).
+inline double StatusMiB(pid_t pid, const std::string& field) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind(field + ":", 0) == 0) return std::atof(line.c_str() + field.size() + 1) / 1024;
+  }
+  return 0;
+}
+
+// The shared mocap folder: $MOTIONDB_MOCAP_DIR when set and not empty, else the build's
+// MOTIONDB_MOCAP_DIR (../shared/mocap beside the checkout), as the tests find it.
+inline std::filesystem::path MocapRoot() {
+  if (const char* env = std::getenv("MOTIONDB_MOCAP_DIR"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return MOTIONDB_MOCAP_DIR;
 }
 
 }  // namespace motiondb::bench

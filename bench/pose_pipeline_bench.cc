@@ -9,12 +9,12 @@
 // MOTIONDB_MOCAP_DIR, ../shared/mocap beside the checkout), already at the space's 30 Hz. Without
 // that folder the program prints why and exits 0, as the corpus is not part of the repository.
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <vector>
 
+#include "bench/measure.h"
 #include "benchmark/benchmark.h"
 #include "core/bvh_reader.h"
 #include "core/heading.h"
@@ -37,11 +37,7 @@ Corpus& TheCorpus() {
   return corpus;
 }
 
-std::filesystem::path BandaiDir() {
-  const char* env = std::getenv("MOTIONDB_MOCAP_DIR");
-  const std::filesystem::path root = env != nullptr && *env != '\0' ? env : MOTIONDB_MOCAP_DIR;
-  return root / "bandai2-normal";
-}
+std::filesystem::path BandaiDir() { return bench::MocapRoot() / "bandai2-normal"; }
 
 bool LoadCorpus() {
   const std::filesystem::path dir = BandaiDir();

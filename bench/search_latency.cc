@@ -7,11 +7,11 @@
 // usage: search_latency [--scenario 70s120|1h30|10h30|10h120|sweeps|all] [--queries N]
 //          [--exact-queries N]
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <string>
 
 #include "bench/measure.h"
@@ -29,14 +29,7 @@ namespace {
 using bench::Clock;
 using bench::Percentile;
 using bench::SecondsSince;
-
-// Resident memory now, in MiB.
-double ResidentMiB() {
-  std::ifstream statm("/proc/self/statm");
-  long pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return resident * (sysconf(_SC_PAGESIZE) / 1048576.0);
-}
+using bench::StatusMiB;
 
 struct Query {
   RowMatrixXf coordinates;
@@ -89,11 +82,11 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
   generated = SyntheticLibrary();  // the joint rotations are not needed any more
   bench.project_s = SecondsSince(start);
 
-  const double rss_before = ResidentMiB();
+  const double rss_before = StatusMiB(getpid(), "VmRSS");
   start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(bench.library, LibraryIndex::Build(std::move(clips), rate, {}));
   bench.build_s = SecondsSince(start);
-  bench.build_rss_mib = ResidentMiB() - rss_before;
+  bench.build_rss_mib = StatusMiB(getpid(), "VmRSS") - rss_before;
   return bench;
 }
 

@@ -10,8 +10,8 @@
 //          [--no-refine]
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 
+#include "bench/measure.h"
 #include "client/command_line.h"
 #include "core/retrieval_evaluation.h"
 #include "core/status_macros.h"
@@ -21,8 +21,7 @@ namespace motiondb {
 namespace {
 
 absl::Status Run(const cli::CommandLine& line) {
-  const char* env = std::getenv("MOTIONDB_MOCAP_DIR");
-  const std::filesystem::path mocap = env != nullptr ? env : MOTIONDB_MOCAP_DIR;
+  const std::filesystem::path mocap = bench::MocapRoot();
   const std::filesystem::path folder =
       line.value("folder").value_or((mocap / "bandai2-normal").string());
   if (!std::filesystem::is_directory(folder)) {
@@ -56,11 +55,10 @@ absl::Status Run(const cli::CommandLine& line) {
                                            : NeutralPose::kQueryMean;
   params.refine = !line.flag("no-refine");
 
-  const auto start = std::chrono::steady_clock::now();
+  const bench::Clock::time_point start = bench::Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledLibrary library,
                             testing::LoadLabelledLibrary(folder, space_options, {params.ann_dims}));
-  const double setup_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double setup_s = bench::SecondsSince(start);
   MOTIONDB_ASSIGN_OR_RETURN(const RetrievalReport report,
                             EvaluateLeaveOneOut(*library.index, library.labels, options));
 

@@ -22,9 +22,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <regex>
 #include <string>
 #include <thread>
@@ -54,18 +52,10 @@ namespace motiondb {
 namespace {
 
 using bench::Clock;
+using bench::MocapRoot;
 using bench::Percentile;
 using bench::SecondsSince;
-
-// A field of /proc/PID/status in MiB (VmRSS, VmHWM).
-double StatusMiB(pid_t pid, const std::string& field) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind(field + ":", 0) == 0) return std::atof(line.c_str() + field.size() + 1) / 1024;
-  }
-  return 0;
-}
+using bench::StatusMiB;
 
 absl::Status FromGrpc(const grpc::Status& status, const std::string& what) {
   if (status.ok()) return absl::OkStatus();
@@ -453,8 +443,7 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
 }
 
 absl::Status Run(const cli::CommandLine& line) {
-  const char* env = std::getenv("MOTIONDB_MOCAP_DIR");
-  const std::filesystem::path mocap = env != nullptr ? env : MOTIONDB_MOCAP_DIR;
+  const std::filesystem::path mocap = MocapRoot();
   const std::filesystem::path folder =
       line.value("folder").value_or((mocap / "bandai2-normal").string());
   MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> seconds, line.number("seconds"));

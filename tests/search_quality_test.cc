@@ -61,6 +61,18 @@ class SyntheticValidation : public ::testing::Test {
     return -1;
   }
 
+  // The segment's frames as a query at the space rate, with `params.characteristic_frame` set to
+  // its peak (the first frame of the peak hold), as the thesis chose it by hand.
+  static RowMatrixXf QueryAtPeak(const SyntheticSegment& segment, SearchParams& params) {
+    const Clip& clip = synthetic_->clips[segment.clip];
+    RowMatrixXf query =
+        *SearchCoordinates(*space_, *clip.Slice({segment.first_frame, segment.last_frame}));
+    params.characteristic_frame = static_cast<int>(std::min<int64_t>(
+        query.rows() - 1, std::llround((segment.peak_first_frame - segment.first_frame) *
+                                       space_->sample_rate() * clip.frame_time())));
+    return query;
+  }
+
   static SyntheticLibrary* synthetic_;
   static MotionSpace* space_;
   static LibraryIndex* library_;
@@ -81,15 +93,10 @@ TEST_F(SyntheticValidation, FirstInstanceRanksItsWholeClassFirst) {
     const auto first = std::find_if(synthetic_->segments.begin(), synthetic_->segments.end(),
                                     [&](const SyntheticSegment& s) { return s.action == action; });
     ASSERT_NE(first, synthetic_->segments.end());
-    const Clip& clip = synthetic_->clips[first->clip];
-    const Clip query_clip = *clip.Slice({first->first_frame, first->last_frame});
-    const RowMatrixXf query = *SearchCoordinates(*space_, query_clip);
     SearchParams params;
     params.max_results = 200;
     params.neighbours = 2000;
-    params.characteristic_frame = static_cast<int>(std::min<int64_t>(
-        query.rows() - 1, std::llround((first->peak_first_frame - first->first_frame) *
-                                       space_->sample_rate() * clip.frame_time())));
+    const RowMatrixXf query = QueryAtPeak(*first, params);
     absl::StatusOr<SearchResponse> response = Search(*library_, CoordinateView::Of(query), params);
     ASSERT_TRUE(response.ok()) << response.status();
 
@@ -127,14 +134,9 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
         SyntheticAction::kBothArmsRaise, SyntheticAction::kShrug, SyntheticAction::kSlouch}) {
     const auto first = std::find_if(synthetic_->segments.begin(), synthetic_->segments.end(),
                                     [&](const SyntheticSegment& s) { return s.action == action; });
-    const Clip& clip = synthetic_->clips[first->clip];
-    const RowMatrixXf query =
-        *SearchCoordinates(*space_, *clip.Slice({first->first_frame, first->last_frame}));
     SearchParams params;
     params.max_results = 10;
-    params.characteristic_frame = static_cast<int>(std::min<int64_t>(
-        query.rows() - 1, std::llround((first->peak_first_frame - first->first_frame) *
-                                       space_->sample_rate() * clip.frame_time())));
+    const RowMatrixXf query = QueryAtPeak(*first, params);
     const SearchResponse exact = *ExactSearch(*library_, CoordinateView::Of(query), params);
     const SearchResponse fast = *Search(*library_, CoordinateView::Of(query), params);
     for (const SearchResult& e : exact.results) {
@@ -148,20 +150,12 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
   EXPECT_GE(found, 45) << found << " of " << total;
 }
 
-class BandaiQuality : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto mocap = testing::MocapDir();
-    if (!mocap) GTEST_SKIP() << "../shared/mocap is absent; skipped";
-    folder_ = *mocap / "bandai2-normal";
-  }
-  std::filesystem::path folder_;
-};
-
 // Each clip as a query against all the others: precision@5 of the content class >= 0.8 and the
 // fast search's recall@10 against exact search >= 0.9, with the default (unit) metric.
-TEST_F(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
-  absl::StatusOr<testing::LabelledLibrary> library = testing::LoadLabelledLibrary(folder_, {}, {});
+TEST(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
+  MOTIONDB_REQUIRE_MOCAP(mocap);
+  absl::StatusOr<testing::LabelledLibrary> library =
+      testing::LoadLabelledLibrary(mocap / "bandai2-normal", {}, {});
   ASSERT_TRUE(library.ok()) << library.status();
   ASSERT_EQ(library->index->clip_count(), 465);
   RetrievalOptions options;

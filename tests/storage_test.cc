@@ -27,6 +27,7 @@
 #include "storage/sqlite_connection.h"
 #include "tests/clip_builder.h"
 #include "tests/synthetic_motion.h"
+#include "tests/test_data.h"
 
 namespace motiondb::storage {
 namespace {
@@ -152,10 +153,6 @@ class StorageTest : public ::testing::Test {
     auto raw = SqliteConnection::Open(path_, SqliteConnection::Mode::kReadWrite, 1000);
     EXPECT_TRUE(raw.ok()) << raw.status();
     return *std::move(raw);
-  }
-  std::string FileBytes() {
-    std::ifstream file(path_, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(file), {});
   }
 
   std::filesystem::path dir_;
@@ -470,7 +467,7 @@ TEST_F(StorageSpaceTest, RejectedWritesChangeNothing) {
   Insert(Named("chain_01"), clip);
   const Counts before = CountsNow();
   Close();
-  const std::string file_before = FileBytes();
+  const std::string file_before = testing::ReadFileOrDie(path_);
 
   const absl::StatusOr<int64_t> duplicate = Db().InsertClip(Named("chain_01"), clip, {});
   EXPECT_EQ(duplicate.status().code(), absl::StatusCode::kAlreadyExists);
@@ -524,7 +521,7 @@ TEST_F(StorageSpaceTest, RejectedWritesChangeNothing) {
 
   EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
   Close();
-  EXPECT_EQ(FileBytes(), file_before);
+  EXPECT_EQ(testing::ReadFileOrDie(path_), file_before);
 }
 
 TEST_F(StorageTest, FailureMidTransactionLeavesNoRow) {
@@ -574,11 +571,11 @@ TEST_F(StorageTest, NewerSchemaVersionIsRefused) {
 
 TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {
   { std::ofstream(path_) << "name,frames\nwalk,120\n"; }
-  const std::string bytes = FileBytes();
+  const std::string bytes = testing::ReadFileOrDie(path_);
   const absl::StatusOr<std::unique_ptr<Database>> text = Database::Open(path_);
   EXPECT_EQ(text.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(text.status().message(), HasSubstr("not a SQLite database"));
-  EXPECT_EQ(FileBytes(), bytes);
+  EXPECT_EQ(testing::ReadFileOrDie(path_), bytes);
   EXPECT_FALSE(std::filesystem::exists(path_ + "-wal"));
   std::filesystem::remove(path_);
 
@@ -587,9 +584,9 @@ TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {
                   .value()
                   ->Execute("CREATE TABLE songs (title TEXT)")
                   .ok());
-  const std::string sqlite_bytes = FileBytes();
+  const std::string sqlite_bytes = testing::ReadFileOrDie(path_);
   EXPECT_EQ(Database::Open(path_).status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_EQ(FileBytes(), sqlite_bytes);
+  EXPECT_EQ(testing::ReadFileOrDie(path_), sqlite_bytes);
 
   EXPECT_EQ(
       Database::Open((dir_ / "absent.db").string(), {.create_if_missing = false}).status().code(),
@@ -601,7 +598,7 @@ TEST_F(StorageTest, DamagedFileFailsToOpen) {
   for (int i = 0; i < 40; ++i)
     Insert(Named(absl::StrCat("clip_", i), {"tag"}), Motion(testing::ChainSkeleton(), 200, i));
   Close();
-  const std::string bytes = FileBytes();
+  const std::string bytes = testing::ReadFileOrDie(path_);
   constexpr size_t kPage = 4096;
   ASSERT_GT(bytes.size(), 20 * kPage);
   {

@@ -18,8 +18,8 @@ struct Best {
   int64_t first = -1, last = -1;
 };
 
-void Enumerate(const RowMatrixXf& q, const RowMatrixXf& x, int s, int dims, int row, int direction,
-               int64_t frame, int pauses, double sum, std::vector<int64_t>& path,
+void Enumerate(const RowMatrixXf& q, const RowMatrixXf& x, int s, int row, int direction,
+               int64_t frame, int pauses, std::vector<int64_t>& path,
                std::vector<std::vector<int64_t>>& out) {
   path[row] = frame;
   const int next = row + direction;
@@ -31,7 +31,7 @@ void Enumerate(const RowMatrixXf& q, const RowMatrixXf& x, int s, int dims, int 
     if (advance == 0 && pauses + 1 > s - 1) continue;
     const int64_t to = frame + direction * advance;
     if (to < 0 || to >= x.rows()) continue;
-    Enumerate(q, x, s, dims, next, direction, to, advance == 0 ? pauses + 1 : 0, sum, path, out);
+    Enumerate(q, x, s, next, direction, to, advance == 0 ? pauses + 1 : 0, path, out);
   }
 }
 
@@ -39,8 +39,8 @@ Best BruteForce(const RowMatrixXf& q, const RowMatrixXf& x, int anchor, int64_t 
                 int dims) {
   std::vector<int64_t> path(q.rows());
   std::vector<std::vector<int64_t>> forward, backward;
-  Enumerate(q, x, s, dims, anchor, +1, at, 0, 0, path, forward);
-  Enumerate(q, x, s, dims, anchor, -1, at, 0, 0, path, backward);
+  Enumerate(q, x, s, anchor, +1, at, 0, path, forward);
+  Enumerate(q, x, s, anchor, -1, at, 0, path, backward);
   Best best;
   for (const auto& f : forward) {
     for (const auto& b : backward) {

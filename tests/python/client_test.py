@@ -7,8 +7,8 @@ usage: client_test.py SERVER_BINARY EXAMPLE_SCRIPT   (PYTHONPATH must hold the s
 import math
 import os
 import pathlib
+import re
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -26,10 +26,17 @@ from motiondb.v1 import space_service_pb2, space_service_pb2_grpc
 SERVER = EXAMPLE = None
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+def logged_port(log_path, server, timeout=60):
+    """The port the server picked for --listen 127.0.0.1:0, read from its log."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        match = re.search(r"\(port ([0-9]+)\)", pathlib.Path(log_path).read_text())
+        if match:
+            return int(match.group(1))
+        if server.poll() is not None:
+            raise RuntimeError(f"motiondb-server exited with {server.returncode}")
+        time.sleep(0.02)
+    raise RuntimeError("motiondb-server did not report its port")
 
 
 def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):
@@ -51,11 +58,14 @@ class ServerTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.dir = tempfile.TemporaryDirectory()
-        cls.port = free_port()
-        cls.address = f"127.0.0.1:{cls.port}"
+        log = os.path.join(cls.dir.name, "server.log")
+        # Port 0: the server picks a free port itself and logs it, so no other process can take
+        # it between choosing and binding.
         cls.server = subprocess.Popen(
-            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", cls.address],
-            stdout=subprocess.DEVNULL, stderr=open(os.path.join(cls.dir.name, "server.log"), "w"))
+            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0"],
+            stdout=subprocess.DEVNULL, stderr=open(log, "w"))
+        cls.port = logged_port(log, cls.server)
+        cls.address = f"127.0.0.1:{cls.port}"
         cls.channel = grpc.insecure_channel(cls.address)
         grpc.channel_ready_future(cls.channel).result(timeout=30)
         cls.clips = clip_service_pb2_grpc.ClipServiceStub(cls.channel)
