@@ -19,7 +19,7 @@
 #include "absl/strings/string_view.h"
 #include "bench/measure.h"
 #include "benchmark/benchmark.h"
-#include "core/bvh_reader.h"
+#include "core/bvh/bvh_reader.h"
 
 namespace {
 

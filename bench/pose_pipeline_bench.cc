@@ -16,11 +16,11 @@
 
 #include "bench/measure.h"
 #include "benchmark/benchmark.h"
-#include "core/bvh_reader.h"
-#include "core/heading.h"
-#include "core/motion_space.h"
-#include "core/pose_encoder.h"
-#include "core/resample.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/motion/resample.h"
+#include "core/space/heading.h"
+#include "core/space/motion_space.h"
+#include "core/space/pose_encoder.h"
 
 namespace motiondb {
 namespace {

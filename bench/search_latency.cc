@@ -15,13 +15,13 @@
 #include <string>
 
 #include "bench/measure.h"
-#include "client/command_line.h"
-#include "core/exact_search.h"
-#include "core/library_index.h"
-#include "core/motion_search.h"
-#include "core/search_coordinates.h"
-#include "core/status_macros.h"
-#include "core/synthetic_library.h"
+#include "core/index/library_index.h"
+#include "core/search/exact_search.h"
+#include "core/search/motion_search.h"
+#include "core/space/search_coordinates.h"
+#include "testing/synthetic_library.h"
+#include "util/command_line.h"
+#include "util/status_macros.h"
 
 namespace motiondb {
 namespace {

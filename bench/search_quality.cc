@@ -12,10 +12,10 @@
 #include <cstdio>
 
 #include "bench/measure.h"
-#include "client/command_line.h"
-#include "core/retrieval_evaluation.h"
-#include "core/status_macros.h"
-#include "tests/labelled_library.h"
+#include "testing/labelled_library.h"
+#include "testing/retrieval_evaluation.h"
+#include "util/command_line.h"
+#include "util/status_macros.h"
 
 namespace motiondb {
 namespace {

@@ -3,12 +3,12 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "client/command_line.h"
 #include "client/commands.h"
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
-#include "core/resample.h"
-#include "core/status_macros.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
+#include "core/motion/resample.h"
+#include "util/command_line.h"
+#include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {

@@ -7,8 +7,8 @@
 #include "absl/strings/str_format.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
-#include "core/status_macros.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
+#include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {

@@ -12,8 +12,8 @@
 #include "absl/strings/str_format.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
-#include "core/file_io.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "util/file_io.h"
 
 namespace motiondb::cli {
 namespace {

@@ -6,9 +6,9 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "client/command_line.h"
 #include "client/commands.h"
-#include "core/bvh_reader.h"
+#include "core/bvh/bvh_reader.h"
+#include "util/command_line.h"
 
 namespace motiondb::cli {
 namespace {

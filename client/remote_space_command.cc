@@ -10,9 +10,9 @@
 #include "absl/strings/str_split.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
-#include "core/file_io.h"
-#include "core/status_macros.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {

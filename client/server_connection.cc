@@ -6,8 +6,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/strip.h"
-#include "core/file_io.h"
-#include "core/status_macros.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {

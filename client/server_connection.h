@@ -12,7 +12,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/status/statusor.h"
-#include "client/command_line.h"
+#include "util/command_line.h"
 
 namespace motiondb::cli {
 

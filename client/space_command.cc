@@ -9,14 +9,14 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "client/command_line.h"
 #include "client/commands.h"
-#include "core/bvh_reader.h"
-#include "core/file_io.h"
-#include "core/heading.h"
-#include "core/motion_space.h"
-#include "core/space_serialization.h"
-#include "core/status_macros.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/space/heading.h"
+#include "core/space/motion_space.h"
+#include "core/space/space_serialization.h"
+#include "util/command_line.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {

@@ -1,6 +1,6 @@
 #include "server/clip_facts.h"
 
-#include "core/status_macros.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 

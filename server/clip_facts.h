@@ -10,7 +10,7 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
-#include "core/clip.h"
+#include "core/motion/clip.h"
 #include "storage/database.h"
 
 namespace motiondb::server {

@@ -11,7 +11,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "core/clip.h"
+#include "core/motion/clip.h"
 
 namespace motiondb::server {
 

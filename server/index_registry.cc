@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "core/status_macros.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 namespace {

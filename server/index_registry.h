@@ -15,8 +15,8 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
-#include "core/library_index.h"
-#include "core/motion_space.h"
+#include "core/index/library_index.h"
+#include "core/space/motion_space.h"
 #include "server/frame_conversion.h"
 #include "storage/database.h"
 

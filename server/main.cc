@@ -15,12 +15,12 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
-#include "client/command_line.h"
-#include "core/file_io.h"
-#include "core/status_macros.h"
-#include "server/motiondb_server.h"
-#include "server/request_logger.h"
+#include "server/grpc/motiondb_server.h"
+#include "server/grpc/request_logger.h"
 #include "server/server_options.h"
+#include "util/command_line.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
 
 namespace {
 

@@ -5,10 +5,10 @@
 #include <map>
 
 #include "absl/strings/str_cat.h"
-#include "core/search_coordinates.h"
-#include "core/status_macros.h"
+#include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
 #include "server/space_report.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/motion_space.h"
+#include "core/space/motion_space.h"
 #include "server/clip_facts.h"
 #include "server/index_registry.h"
 #include "storage/database.h"

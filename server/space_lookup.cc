@@ -1,7 +1,7 @@
 #include "server/space_lookup.h"
 
 #include "absl/strings/str_cat.h"
-#include "core/status_macros.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 

@@ -2,7 +2,7 @@
 
 #include <google/protobuf/util/json_util.h>
 
-#include "core/heading.h"
+#include "core/space/heading.h"
 
 namespace motiondb::server {
 

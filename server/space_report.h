@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/motion_space.h"
+#include "core/space/motion_space.h"
 #include "motiondb/v1/space_service.pb.h"
 #include "server/index_registry.h"
 

@@ -12,8 +12,8 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "core/matrix.h"
-#include "core/skeleton.h"
+#include "core/motion/matrix.h"
+#include "core/motion/skeleton.h"
 
 namespace motiondb::storage {
 

@@ -16,13 +16,13 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
-#include "core/space_serialization.h"
-#include "core/status_macros.h"
+#include "core/space/space_serialization.h"
 #include "storage/blob_codec.h"
 #include "storage/read_pool.h"
 #include "storage/schema.h"
 #include "storage/sqlite_connection.h"
 #include "storage/sqlite_transaction.h"
+#include "util/status_macros.h"
 
 namespace motiondb::storage {
 namespace {

@@ -26,9 +26,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "core/clip.h"
-#include "core/matrix.h"
-#include "core/motion_space.h"
+#include "core/motion/clip.h"
+#include "core/motion/matrix.h"
+#include "core/space/motion_space.h"
 
 namespace motiondb::storage {
 

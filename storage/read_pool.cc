@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "core/status_macros.h"
+#include "util/status_macros.h"
 
 namespace motiondb::storage {
 

@@ -3,8 +3,8 @@
 #include <array>
 
 #include "absl/strings/str_cat.h"
-#include "core/status_macros.h"
 #include "storage/sqlite_transaction.h"
+#include "util/status_macros.h"
 
 namespace motiondb::storage {
 namespace {

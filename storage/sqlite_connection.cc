@@ -1,8 +1,8 @@
 #include "storage/sqlite_connection.h"
 
 #include "absl/strings/str_cat.h"
-#include "core/status_macros.h"
 #include "storage/sqlite_status.h"
+#include "util/status_macros.h"
 
 namespace motiondb::storage {
 

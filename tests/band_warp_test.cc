@@ -1,4 +1,4 @@
-#include "core/band_warp.h"
+#include "core/search/warp/band_warp.h"
 
 #include <cmath>
 #include <limits>

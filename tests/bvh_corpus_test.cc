@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/bvh_reader.h"
+#include "core/bvh/bvh_reader.h"
 #include "tests/test_data.h"
 
 namespace motiondb {

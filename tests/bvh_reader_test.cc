@@ -1,4 +1,4 @@
-#include "core/bvh_reader.h"
+#include "core/bvh/bvh_reader.h"
 
 #include <cmath>
 #include <numbers>

@@ -6,8 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
 #include "tests/clip_builder.h"
 #include "tests/test_data.h"
 

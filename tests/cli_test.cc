@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
 #include "tests/clip_builder.h"
 #include "tests/test_data.h"
 

@@ -5,7 +5,7 @@
 #include <functional>
 #include <memory>
 
-#include "core/clip.h"
+#include "core/motion/clip.h"
 
 namespace motiondb::testing {
 

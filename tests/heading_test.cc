@@ -1,5 +1,5 @@
 // Facing removal (SPEC §2.4): the pelvis, the heading of its global orientation, the yaw rate.
-#include "core/heading.h"
+#include "core/space/heading.h"
 
 #include <cmath>
 #include <numbers>

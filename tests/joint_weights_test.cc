@@ -1,5 +1,5 @@
 // Joint weights (SPEC §3): the mass preset, uniform, overrides by name, and bad weights.
-#include "core/joint_weights.h"
+#include "core/space/joint_weights.h"
 
 #include <cmath>
 #include <limits>

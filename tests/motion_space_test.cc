@@ -1,6 +1,6 @@
 // Motion Curve spaces (SPEC §2-3, thesis 3.2-3.3): construction, projection, reconstruction,
 // metrics, facing invariance, weighting, the error report and bad input.
-#include "core/motion_space.h"
+#include "core/space/motion_space.h"
 
 #include <cmath>
 #include <functional>
@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
-#include "core/bvh_reader.h"
-#include "core/heading.h"
-#include "core/resample.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/motion/resample.h"
+#include "core/space/heading.h"
 #include "tests/clip_builder.h"
 #include "tests/synthetic_motion.h"
 #include "tests/test_data.h"

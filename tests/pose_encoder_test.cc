@@ -1,5 +1,5 @@
 // Pose vectors (SPEC §2.5-2.6): the batched encoder against the scalar log map, and its inverse.
-#include "core/pose_encoder.h"
+#include "core/space/pose_encoder.h"
 
 #include <cmath>
 #include <numbers>

@@ -1,4 +1,4 @@
-#include "core/resample.h"
+#include "core/motion/resample.h"
 
 #include <cmath>
 

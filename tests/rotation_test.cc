@@ -1,4 +1,4 @@
-#include "core/rotation.h"
+#include "core/motion/rotation.h"
 
 #include <cmath>
 #include <numbers>

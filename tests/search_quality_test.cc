@@ -5,12 +5,12 @@
 
 #include <gtest/gtest.h>
 
-#include "core/exact_search.h"
-#include "core/motion_search.h"
-#include "core/retrieval_evaluation.h"
-#include "core/search_coordinates.h"
-#include "core/synthetic_library.h"
-#include "tests/labelled_library.h"
+#include "core/search/exact_search.h"
+#include "core/search/motion_search.h"
+#include "core/space/search_coordinates.h"
+#include "testing/labelled_library.h"
+#include "testing/retrieval_evaluation.h"
+#include "testing/synthetic_library.h"
 #include "tests/test_data.h"
 
 namespace motiondb {

@@ -8,10 +8,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/exact_search.h"
-#include "core/library_index.h"
-#include "core/motion_search.h"
-#include "core/time_warp.h"
+#include "core/index/library_index.h"
+#include "core/search/exact_search.h"
+#include "core/search/motion_search.h"
+#include "core/search/warp/time_warp.h"
 #include "tests/search_test_data.h"
 
 namespace motiondb {

@@ -4,7 +4,7 @@
 #include <numbers>
 #include <random>
 
-#include "core/coordinate_view.h"
+#include "core/index/coordinate_view.h"
 
 namespace motiondb::testing {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/matrix.h"
+#include "core/motion/matrix.h"
 
 namespace motiondb::testing {
 

@@ -17,16 +17,16 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
-#include "core/synthetic_library.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "testing/server_process.h"
+#include "testing/synthetic_library.h"
 #include "tests/clip_builder.h"
-#include "tests/server_process.h"
 #include "tests/test_data.h"
 
 namespace motiondb {

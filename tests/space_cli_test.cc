@@ -8,9 +8,9 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
-#include "core/space_serialization.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
+#include "core/space/space_serialization.h"
 #include "tests/synthetic_motion.h"
 #include "tests/test_data.h"
 

@@ -1,5 +1,5 @@
 // The binary space format: exact round trips, and every kind of damage rejected.
-#include "core/space_serialization.h"
+#include "core/space/space_serialization.h"
 
 #include <filesystem>
 
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/synthetic_motion.h"
+#include "util/crc32.h"
 
 namespace motiondb {
 namespace {

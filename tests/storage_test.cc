@@ -22,7 +22,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/space_serialization.h"
+#include "core/space/space_serialization.h"
 #include "storage/schema.h"
 #include "storage/sqlite_connection.h"
 #include "tests/clip_builder.h"

@@ -1,4 +1,4 @@
-#include "core/synthetic_library.h"
+#include "testing/synthetic_library.h"
 
 #include <algorithm>
 #include <functional>
@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
 #include "tests/test_data.h"
 
 namespace motiondb {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/clip.h"
+#include "core/motion/clip.h"
 
 namespace motiondb::testing {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/clip.h"
+#include "core/motion/clip.h"
 
 namespace motiondb::testing {
 

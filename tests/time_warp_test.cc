@@ -1,4 +1,4 @@
-#include "core/time_warp.h"
+#include "core/search/warp/time_warp.h"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "core/warp_refinement.h"
+#include "core/search/warp_refinement.h"
 
 #include <gtest/gtest.h>
 

@@ -10,10 +10,10 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
-#include "core/bvh_reader.h"
-#include "core/bvh_writer.h"
-#include "core/clip.h"
-#include "core/rotation.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
+#include "core/motion/clip.h"
+#include "core/motion/rotation.h"
 
 namespace {
 

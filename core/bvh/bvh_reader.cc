@@ -1,0 +1,439 @@
+#include "core/bvh/bvh_reader.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <system_error>
+#include <utility>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+constexpr double kDegreesToRadians = std::numbers::pi / 180.0;
+
+bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+bool IsSpace(char c) { return IsBlank(c) || c == '\n'; }
+
+// How a token is shown in an error: quoted and shortened, or named when it is not text.
+std::string Describe(absl::string_view token) {
+  if (token.empty()) return "end of file";
+  for (char c : token) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) return "binary data";
+  }
+  if (token.size() > 40) return absl::StrCat("'", token.substr(0, 40), "...'");
+  return absl::StrCat("'", token, "'");
+}
+
+absl::Status ErrorAt(int line, absl::string_view expected, absl::string_view found) {
+  return absl::InvalidArgumentError(
+      absl::StrCat("line ", line, ": expected ", expected, ", found ", Describe(found)));
+}
+
+// Parses a whole token as a finite double (E-notation and a leading '+' allowed).
+std::optional<double> ParseDouble(absl::string_view token) {
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  if (begin != end && *begin == '+') ++begin;
+  double value = 0.0;
+  const auto [ptr, ec] = std::from_chars(begin, end, value);
+  if (ec != std::errc() || ptr != end || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+// A forward cursor over the text that counts lines.
+class Scanner {
+ public:
+  explicit Scanner(absl::string_view text) : text_(text) {}
+
+  // The next whitespace-delimited token, or "" at the end; token_line() is its line.
+  absl::string_view NextToken() {
+    SkipSpace();
+    token_line_ = line_;
+    const size_t start = pos_;
+    while (pos_ < text_.size() && !IsSpace(text_[pos_])) ++pos_;
+    return text_.substr(start, pos_ - start);
+  }
+
+  // The rest of the current line, without surrounding blanks; advances past the newline.
+  absl::string_view RestOfLine() {
+    while (pos_ < text_.size() && IsBlank(text_[pos_])) ++pos_;
+    token_line_ = line_;
+    const size_t start = pos_;
+    while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    size_t stop = pos_;
+    while (stop > start && IsBlank(text_[stop - 1])) --stop;
+    if (pos_ < text_.size()) {
+      ++pos_;
+      ++line_;
+    }
+    return text_.substr(start, stop - start);
+  }
+
+  int token_line() const { return token_line_; }
+  int line() const { return line_; }
+  size_t pos() const { return pos_; }
+
+ private:
+  void SkipSpace() {
+    while (pos_ < text_.size() && IsSpace(text_[pos_])) {
+      if (text_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+  }
+
+  absl::string_view text_;
+  size_t pos_ = 0;
+  int line_ = 1;
+  int token_line_ = 1;
+};
+
+absl::Status Expect(Scanner& scanner, absl::string_view keyword) {
+  const absl::string_view token = scanner.NextToken();
+  if (token != keyword) {
+    return ErrorAt(scanner.token_line(), absl::StrCat("'", keyword, "'"), token);
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Eigen::Vector3d> ParseOffset(Scanner& scanner) {
+  Eigen::Vector3d offset;
+  for (int axis = 0; axis < 3; ++axis) {
+    const absl::string_view token = scanner.NextToken();
+    const std::optional<double> value = ParseDouble(token);
+    if (!value) return ErrorAt(scanner.token_line(), "a finite number in OFFSET", token);
+    offset[axis] = *value;
+  }
+  return offset;
+}
+
+absl::StatusOr<std::vector<Channel>> ParseChannels(Scanner& scanner) {
+  const absl::string_view count_token = scanner.NextToken();
+  int count = -1;
+  const auto [ptr, ec] =
+      std::from_chars(count_token.data(), count_token.data() + count_token.size(), count);
+  if (ec != std::errc() || ptr != count_token.data() + count_token.size() || count < 0 ||
+      count > 6) {
+    return ErrorAt(scanner.token_line(), "a channel count from 0 to 6", count_token);
+  }
+  std::vector<Channel> channels;
+  for (int i = 0; i < count; ++i) {
+    const absl::string_view name = scanner.NextToken();
+    const std::optional<Channel> channel = ParseChannel(name);
+    if (!channel) {
+      return ErrorAt(scanner.token_line(),
+                     "a channel name (Xposition, Yposition, Zposition, Xrotation, Yrotation or "
+                     "Zrotation)",
+                     name);
+    }
+    channels.push_back(*channel);
+  }
+  return channels;
+}
+
+// A joint name: the rest of the line after ROOT/JOINT (names may hold colons and spaces).
+// Some exporters put the opening brace on the same line; `brace_consumed` reports it.
+absl::StatusOr<std::string> ParseJointName(Scanner& scanner, bool& brace_consumed) {
+  absl::string_view name = scanner.RestOfLine();
+  brace_consumed = false;
+  if (name.size() > 1 && name.back() == '{') {
+    name.remove_suffix(1);
+    while (!name.empty() && IsBlank(name.back())) name.remove_suffix(1);
+    brace_consumed = true;
+  }
+  // Braces inside a name could not be written back unambiguously.
+  const bool bad = name.empty() || std::any_of(name.begin(), name.end(), [](char c) {
+                     const auto u = static_cast<unsigned char>(c);
+                     return u < 0x20 || u == 0x7f || c == '{' || c == '}';
+                   });
+  if (bad) return ErrorAt(scanner.token_line(), "a joint name without braces", name);
+  return std::string(name);
+}
+
+absl::StatusOr<std::vector<Joint>> ParseHierarchy(Scanner& scanner, const BvhReadOptions& options) {
+  const absl::string_view first = scanner.NextToken();
+  if (first.empty()) return absl::InvalidArgumentError("empty file");
+  if (first != "HIERARCHY") return ErrorAt(scanner.token_line(), "'HIERARCHY'", first);
+  MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "ROOT"));
+
+  std::vector<Joint> joints;
+  std::vector<int> open;  // the joints whose '{' is not closed yet, innermost last
+  std::vector<int> joint_lines;
+  auto open_joint = [&](int parent) -> absl::Status {
+    if (static_cast<int>(joints.size()) >= options.max_joints) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "line ", scanner.token_line(), ": more than ", options.max_joints, " joints"));
+    }
+    bool brace_consumed = false;
+    MOTIONDB_ASSIGN_OR_RETURN(std::string name, ParseJointName(scanner, brace_consumed));
+    joint_lines.push_back(scanner.token_line());
+    if (!brace_consumed) MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "{"));
+    Joint joint;
+    joint.name = std::move(name);
+    joint.parent = parent;
+    joints.push_back(std::move(joint));
+    open.push_back(static_cast<int>(joints.size()) - 1);
+    return absl::OkStatus();
+  };
+  MOTIONDB_RETURN_IF_ERROR(open_joint(-1));
+
+  while (!open.empty()) {
+    const absl::string_view token = scanner.NextToken();
+    Joint& joint = joints[open.back()];
+    if (token == "OFFSET") {
+      MOTIONDB_ASSIGN_OR_RETURN(joint.offset, ParseOffset(scanner));
+    } else if (token == "CHANNELS") {
+      const int line = scanner.token_line();
+      MOTIONDB_ASSIGN_OR_RETURN(joint.channels, ParseChannels(scanner));
+      // Validate the channel mix here, while the line is known.
+      if (absl::Status status = ValidateJointChannels(joint); !status.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("line ", line, ": ", status.message()));
+      }
+    } else if (token == "JOINT") {
+      MOTIONDB_RETURN_IF_ERROR(open_joint(open.back()));
+    } else if (token == "End") {
+      MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "Site"));
+      if (joint.end_site)
+        return ErrorAt(scanner.token_line(), "one End Site per joint", "End Site");
+      MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "{"));
+      MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "OFFSET"));
+      MOTIONDB_ASSIGN_OR_RETURN(joint.end_site, ParseOffset(scanner));
+      MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "}"));
+    } else if (token == "}") {
+      open.pop_back();
+    } else {
+      return ErrorAt(scanner.token_line(), "'OFFSET', 'CHANNELS', 'JOINT', 'End Site' or '}'",
+                     token);
+    }
+  }
+  // Reported here rather than by Skeleton::Create so that the error names both lines.
+  absl::flat_hash_map<absl::string_view, int> first_use;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const auto [it, inserted] = first_use.emplace(joints[i].name, static_cast<int>(i));
+    if (!inserted) {
+      return absl::InvalidArgumentError(absl::StrCat("line ", joint_lines[i], ": joint name '",
+                                                     joints[i].name, "' is already used on line ",
+                                                     joint_lines[it->second]));
+    }
+  }
+  return joints;
+}
+
+// Reads "KEY VALUE" where the value may also be glued to the key ("Frames:51").
+absl::StatusOr<absl::string_view> ValueAfter(Scanner& scanner, absl::string_view key) {
+  absl::string_view token = scanner.NextToken();
+  if (token.substr(0, key.size()) != key) {
+    return ErrorAt(scanner.token_line(), absl::StrCat("'", key, "'"), token);
+  }
+  token.remove_prefix(key.size());
+  return token.empty() ? scanner.NextToken() : token;
+}
+
+// Per-channel instructions for turning a frame row into quaternions and positions.
+struct RowLayout {
+  struct JointLayout {
+    std::optional<EulerOrder> order;
+    std::array<int, 3> rotation_channel{};  // value index of each Euler angle, in listed order
+    int position_slot = -1;
+    std::array<int, 3> position_channel{};  // value index of x, y, z
+  };
+  std::vector<JointLayout> joints;
+
+  explicit RowLayout(const Skeleton& skeleton) {
+    int value = 0;
+    for (int j = 0; j < skeleton.joint_count(); ++j) {
+      JointLayout layout;
+      layout.order =
+          skeleton.has_rotation(j) ? std::optional(skeleton.rotation_order(j)) : std::nullopt;
+      layout.position_slot = skeleton.position_slot(j);
+      int rotations = 0;
+      for (Channel c : skeleton.joint(j).channels) {
+        const int axis = static_cast<int>(c) % 3;
+        if (c >= Channel::kXrotation) {
+          layout.rotation_channel[rotations++] = value;
+        } else {
+          layout.position_channel[axis] = value;
+        }
+        ++value;
+      }
+      joints.push_back(layout);
+    }
+  }
+
+  void Apply(const double* values, double* rotation_row, double* position_row) const {
+    for (size_t j = 0; j < joints.size(); ++j) {
+      const JointLayout& layout = joints[j];
+      Quat q = Quat::Identity();
+      if (layout.order) {
+        const Eigen::Vector3d angles(values[layout.rotation_channel[0]] * kDegreesToRadians,
+                                     values[layout.rotation_channel[1]] * kDegreesToRadians,
+                                     values[layout.rotation_channel[2]] * kDegreesToRadians);
+        q = EulerToQuaternion(angles, *layout.order);
+      }
+      double* out = rotation_row + 4 * j;
+      out[0] = q.w();
+      out[1] = q.x();
+      out[2] = q.y();
+      out[3] = q.z();
+      if (layout.position_slot >= 0) {
+        for (int axis = 0; axis < 3; ++axis) {
+          position_row[3 * layout.position_slot + axis] = values[layout.position_channel[axis]];
+        }
+      }
+    }
+  }
+};
+
+absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scanner,
+                                          std::shared_ptr<const Skeleton> skeleton,
+                                          const BvhReadOptions& options) {
+  {
+    const absl::string_view token = scanner.NextToken();
+    if (token == "ROOT") {
+      return absl::InvalidArgumentError(absl::StrCat("line ", scanner.token_line(),
+                                                     ": a second ROOT hierarchy is not supported"));
+    }
+    if (token != "MOTION") return ErrorAt(scanner.token_line(), "'MOTION'", token);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const absl::string_view frames_token, ValueAfter(scanner, "Frames:"));
+  const int frames_line = scanner.token_line();
+  int64_t header_frames = -1;
+  {
+    const char* end = frames_token.data() + frames_token.size();
+    const auto [ptr, ec] = std::from_chars(frames_token.data(), end, header_frames);
+    if (ec == std::errc::result_out_of_range ||
+        (ec == std::errc() && ptr == end && header_frames > options.max_frames)) {
+      return absl::ResourceExhaustedError(absl::StrCat("line ", frames_line, ": frame count ",
+                                                       frames_token, " is over the limit of ",
+                                                       options.max_frames));
+    }
+    if (ec != std::errc() || ptr != end || header_frames < 0) {
+      return ErrorAt(frames_line, "a non-negative frame count after 'Frames:'", frames_token);
+    }
+  }
+  MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "Frame"));
+  MOTIONDB_ASSIGN_OR_RETURN(const absl::string_view time_token, ValueAfter(scanner, "Time:"));
+  const std::optional<double> frame_time = ParseDouble(time_token);
+  if (!frame_time || *frame_time <= 0.0) {
+    return ErrorAt(scanner.token_line(), "a positive frame time after 'Frame Time:'", time_token);
+  }
+  const int time_line = scanner.token_line();
+  if (absl::string_view rest = scanner.RestOfLine(); !rest.empty()) {
+    return ErrorAt(time_line, "end of line after the frame time", rest);
+  }
+
+  const int channels = skeleton->channel_count();
+  if (channels == 0) return absl::InvalidArgumentError("the hierarchy has no channels");
+  const RowLayout layout(*skeleton);
+  const int joints = skeleton->joint_count();
+  const int positions = 3 * skeleton->position_joint_count();
+
+  // Each value takes at least two bytes, which bounds the rows the rest of the text can hold.
+  const size_t remaining = text.size() - scanner.pos();
+  Eigen::Index capacity = static_cast<Eigen::Index>(
+      std::min<size_t>(static_cast<size_t>(header_frames), remaining / (2 * channels) + 1));
+  capacity = std::max<Eigen::Index>(capacity, 1);
+  RowMatrixXd rotations(capacity, 4 * joints);
+  RowMatrixXd translations(capacity, positions);
+  std::vector<double> values(channels);
+
+  const char* p = text.data() + scanner.pos();
+  const char* const end = text.data() + text.size();
+  int line = scanner.line();
+  Eigen::Index rows = 0;
+  for (; p < end; ++line) {
+    int count = 0;
+    while (true) {
+      while (p < end && IsBlank(*p)) ++p;
+      if (p == end || *p == '\n') break;
+      const char* start = p;
+      if (*p == '+') ++p;
+      double value;
+      const auto [next, ec] = std::from_chars(p, end, value);
+      if (ec != std::errc() || (next < end && !IsSpace(*next))) {
+        const char* stop = start;
+        while (stop < end && !IsSpace(*stop)) ++stop;
+        return ErrorAt(line, absl::StrCat("a number (value ", count + 1, " of ", channels, ")"),
+                       absl::string_view(start, stop - start));
+      }
+      if (!std::isfinite(value)) {
+        return absl::InvalidArgumentError(absl::StrCat("line ", line, ": value ", count + 1, " is ",
+                                                       absl::string_view(start, next - start),
+                                                       "; expected a finite number"));
+      }
+      if (count == channels) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("line ", line, ": expected ", channels, " values, found more"));
+      }
+      values[count++] = value;
+      p = next;
+    }
+    if (p < end) ++p;  // the newline
+    if (count == 0) continue;
+    if (count != channels) {
+      return absl::InvalidArgumentError(absl::StrCat("line ", line, ": expected ", channels,
+                                                     " values, found ", count,
+                                                     p == end ? " (the file is truncated)" : ""));
+    }
+    if (rows == options.max_frames) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("line ", line, ": more than ", options.max_frames, " frames"));
+    }
+    if (rows == capacity) {
+      capacity *= 2;
+      rotations.conservativeResize(capacity, Eigen::NoChange);
+      translations.conservativeResize(capacity, Eigen::NoChange);
+    }
+    layout.Apply(values.data(), rotations.row(rows).data(), translations.row(rows).data());
+    ++rows;
+  }
+  if (rows == 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "line ", line, ": expected frame rows after 'Frame Time:', found end of file"));
+  }
+  rotations.conservativeResize(rows, Eigen::NoChange);
+  translations.conservativeResize(rows, Eigen::NoChange);
+
+  std::vector<std::string> warnings;
+  if (rows != header_frames) {
+    warnings.push_back(absl::StrCat("line ", frames_line, ": header says Frames: ", header_frames,
+                                    " but the file holds ", rows, " frame rows; using ", rows));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(Clip clip, Clip::Create(std::move(skeleton), *frame_time,
+                                                    std::move(rotations), std::move(translations)));
+  return BvhReadResult{std::move(clip), std::move(warnings)};
+}
+
+}  // namespace
+
+absl::StatusOr<BvhReadResult> ReadBvh(absl::string_view text, const BvhReadOptions& options) {
+  if (static_cast<int64_t>(text.size()) > options.max_bytes) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("input is ", text.size(), " bytes, over the limit of ", options.max_bytes));
+  }
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+  Scanner scanner(text);
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<Joint> joints, ParseHierarchy(scanner, options));
+  MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(std::move(joints)));
+  return ParseMotion(text, scanner, std::make_shared<const Skeleton>(std::move(skeleton)), options);
+}
+
+absl::StatusOr<BvhReadResult> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string text, ReadFileBytes(path, options.max_bytes));
+  absl::StatusOr<BvhReadResult> result = ReadBvh(text, options);
+  if (!result.ok()) {
+    return absl::Status(result.status().code(),
+                        absl::StrCat(path, ": ", result.status().message()));
+  }
+  return result;
+}
+
+}  // namespace motiondb

@@ -1,0 +1,25 @@
+// Writes a clip, or a frame range of it, as BVH with the clip's original hierarchy, offsets and
+// channel orders. Rotations are decomposed into each joint's own Euler order, continuous from
+// frame to frame.
+#ifndef MOTIONDB_CORE_BVH_BVH_WRITER_H_
+#define MOTIONDB_CORE_BVH_BVH_WRITER_H_
+
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/motion/clip.h"
+
+namespace motiondb {
+
+// The BVH text of `range` (default: the whole clip). Fails if the range is outside the clip.
+absl::StatusOr<std::string> WriteBvh(const Clip& clip,
+                                     std::optional<FrameRange> range = std::nullopt);
+
+// Writes to `path` atomically (a temporary file renamed into place).
+absl::Status WriteBvhFile(const std::string& path, const Clip& clip,
+                          std::optional<FrameRange> range = std::nullopt);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_BVH_BVH_WRITER_H_

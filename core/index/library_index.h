@@ -1,0 +1,123 @@
+// The searchable library of one space: every clip's projection (pre-scaled so that Euclidean
+// distance is the space's pose metric) in a frames x dims block, the map between global frame
+// numbers and (clip, frame), and a kd-tree over the first `ann_dims` coordinates that reads the
+// coordinates in place.
+//
+// Clips added with WithClips() go into a second, smaller block with a kd-tree of its own, shared
+// with the index they were added to, so that adding a clip costs in proportion to the recent
+// additions rather than to the library (an ingest into hours of capture stays fast); once the
+// recent additions exceed a sixteenth of the frames, everything is built again as one block.
+//
+// Immutable once made; thread-safe for any number of concurrent readers.
+#ifndef MOTIONDB_CORE_INDEX_LIBRARY_INDEX_H_
+#define MOTIONDB_CORE_INDEX_LIBRARY_INDEX_H_
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/status/statusor.h"
+#include "core/index/coordinate_view.h"
+#include "core/motion/matrix.h"
+
+namespace motiondb {
+
+struct LibraryClip {
+  int64_t clip_id = 0;
+  std::string name;
+  std::vector<std::string> tags;
+  // frames x dims at the space rate, pre-scaled by the metric; moved into the index.
+  RowMatrixXf coordinates;
+};
+
+struct LibraryIndexOptions {
+  // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
+  int ann_dims = 10;
+  // Points per kd-tree leaf.
+  int leaf_size = 32;
+};
+
+struct Neighbour {
+  int64_t frame;   // global frame number
+  float distance;  // pose distance over the searched dimensions
+};
+
+class LibraryIndex {
+ public:
+  struct ClipEntry {
+    int64_t clip_id;
+    std::string name;
+    std::vector<std::string> tags;
+    int64_t first_frame;  // global number of the clip's frame 0
+    int64_t frame_count;
+  };
+
+  // Clips must all have the same number of columns (at least ann_dims), at least one frame, and
+  // finite coordinates; `rate` is the space's sample rate in frames per second.
+  static absl::StatusOr<std::unique_ptr<LibraryIndex>> Build(std::vector<LibraryClip> clips,
+                                                             double rate,
+                                                             const LibraryIndexOptions& options);
+  ~LibraryIndex();
+  LibraryIndex(const LibraryIndex&) = delete;
+  LibraryIndex& operator=(const LibraryIndex&) = delete;
+
+  // This library with `clips` added after its own clips (same rules as Build(); their ids must
+  // be new). Shares this index's first block and kd-tree; the second is built anew from the
+  // clips added since the last full build and these.
+  absl::StatusOr<std::unique_ptr<LibraryIndex>> WithClips(std::vector<LibraryClip> clips) const;
+
+  double rate() const { return rate_; }
+  int dims() const { return dims_; }
+  int ann_dims() const { return options_.ann_dims; }
+  int64_t total_frames() const { return total_frames_; }
+  int clip_count() const { return static_cast<int>(clips_.size()); }
+  // 1 after a full build; 2 while recent additions are kept apart.
+  int block_count() const { return static_cast<int>(blocks_.size()); }
+  const ClipEntry& clip(int index) const { return clips_[index]; }
+  // Index of the clip with this id, or -1.
+  int FindClip(int64_t clip_id) const;
+  // The clip holding a global frame, and the frame's number within it.
+  std::pair<int, int64_t> Locate(int64_t global_frame) const;
+  CoordinateView clip_coordinates(int index) const;
+  // A copy of clip_coordinates(index), all dims.
+  RowMatrixXf CopyClipCoordinates(int index) const;
+
+  // The k frames nearest to `point` over its first `dims` coordinates, nearest first. Uses the
+  // kd-tree when dims == ann_dims() and every clip is allowed; otherwise an exact linear scan
+  // over the allowed clips (`allowed_clips` empty: all).
+  std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
+                                 const std::vector<bool>& allowed_clips) const;
+
+  // Bytes held: the coordinate blocks and the kd-trees.
+  int64_t coordinate_bytes() const;
+  int64_t tree_bytes() const;
+
+ private:
+  class Tree;
+  struct Block;
+  LibraryIndex(double rate, const LibraryIndexOptions& options, int dims);
+  // A block of `clips` (validated) after `first_frame` global frames, with its kd-tree; appends
+  // their entries.
+  void AddBlock(std::vector<LibraryClip> clips, int64_t first_frame);
+  void AddEntry(ClipEntry entry, int block);
+  // The k nearest over the kd-trees of every block, merged.
+  std::vector<Neighbour> TreeNearest(const float* point, int dims, int k, float epsilon) const;
+
+  double rate_;
+  LibraryIndexOptions options_;
+  int dims_;
+  int64_t total_frames_ = 0;
+  // The first block holds the clips of the last full build; a second one, if any, those added
+  // since. Clips are numbered across blocks in order.
+  std::vector<std::shared_ptr<const Block>> blocks_;
+  std::vector<ClipEntry> clips_;
+  std::vector<int> clip_block_;  // per clip: its block
+  // Clip id -> index: searches filtered by clip ids look up every id.
+  absl::flat_hash_map<int64_t, int> index_of_id_;
+};
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_INDEX_LIBRARY_INDEX_H_

@@ -1,0 +1,53 @@
+#include "core/motion/resample.h"
+
+#include <cmath>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+
+namespace motiondb {
+namespace {
+
+// Output larger than this many frames is refused (a day at 1 kHz).
+constexpr double kMaxOutputFrames = 86'400'000;
+
+}  // namespace
+
+absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
+  if (!std::isfinite(target_fps) || target_fps <= 0.0 || target_fps > 10000.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("target rate must be in (0, 10000] frames per second, got ", target_fps));
+  }
+  const int n = clip.frame_count();
+  const double span = (n - 1) * clip.frame_time();
+  // A sample within 1% of a frame past the end takes the last frame: files write the frame time
+  // rounded (0.0333333 for 1/30 s), and the last frame should not be lost to that rounding.
+  const double samples = std::floor(span * target_fps + 0.01) + 1;
+  if (samples > kMaxOutputFrames) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("resampling would produce ", samples, " frames"));
+  }
+  const int count = static_cast<int>(samples);
+  const int joints = clip.skeleton().joint_count();
+  const RowMatrixXd& rotations = clip.rotations();
+  const RowMatrixXd& positions = clip.positions();
+  RowMatrixXd out_rotations(count, rotations.cols());
+  RowMatrixXd out_positions(count, positions.cols());
+  for (int k = 0; k < count; ++k) {
+    double u = std::min(k / target_fps / clip.frame_time(), n - 1.0);
+    if (std::abs(u - std::round(u)) < 1e-9) u = std::round(u);  // land exactly on source frames
+    const int i = std::min(static_cast<int>(u), n - 1);
+    const int next = std::min(i + 1, n - 1);
+    const double t = u - i;
+    for (int j = 0; j < joints; ++j) {
+      const Quat q =
+          t == 0.0 ? clip.rotation(i, j) : Slerp(clip.rotation(i, j), clip.rotation(next, j), t);
+      out_rotations.block<1, 4>(k, 4 * j) << q.w(), q.x(), q.y(), q.z();
+    }
+    out_positions.row(k) = (1.0 - t) * positions.row(i) + t * positions.row(next);
+  }
+  return Clip::Create(clip.shared_skeleton(), 1.0 / target_fps, std::move(out_rotations),
+                      std::move(out_positions));
+}
+
+}  // namespace motiondb

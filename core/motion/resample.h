@@ -1,0 +1,18 @@
+// Resampling a clip to another frame rate: slerp for rotations (shorter arc), lerp for positions.
+#ifndef MOTIONDB_CORE_MOTION_RESAMPLE_H_
+#define MOTIONDB_CORE_MOTION_RESAMPLE_H_
+
+#include "absl/status/statusor.h"
+#include "core/motion/clip.h"
+
+namespace motiondb {
+
+// Samples `clip` at t = k / target_fps for every k with t within the clip's span
+// [0, (frame_count - 1) * frame_time], allowing 1% of an output frame past the end (taken as
+// the last frame) so that rounded frame times such as 0.0333333 keep every frame. `target_fps` must
+// be finite and in (0, 10000].
+absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_MOTION_RESAMPLE_H_

@@ -1,0 +1,207 @@
+#include "core/search/exact_search.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/search/internal/search_query.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// Clip frames per lower-bound block.
+constexpr int64_t kBlock = 32;
+
+// The subsequence warp of one clip: columns are clip frames (in order), rows query frames,
+// states the pauses in a row. Only the last slope_limit columns are kept.
+class ClipScan {
+ public:
+  ClipScan(CoordinateView query, CoordinateView clip, int slope_limit, int dims)
+      : query_(query),
+        clip_(clip),
+        s_(slope_limit),
+        dims_(dims),
+        m_(query.rows),
+        ring_(slope_limit + 1) {
+    for (Column& column : ring_) {
+      column.cost.assign(m_ * s_, kInfinity);
+      column.start.assign(m_ * s_, 0);
+    }
+    lower_bound_.resize(m_ + 1);
+    ComputeBlockBoxes();
+  }
+
+  // Runs over every column, offering each end frame's best path to `top`.
+  absl::Status Run(int clip_index, const SearchParams& params, StreamingTopResults& top,
+                   SearchStats& stats) {
+    for (int64_t j = 0; j < clip_.rows; ++j) {
+      if (j % kBlock == 0) {
+        if ((j / kBlock) % 256 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
+        BlockLowerBound(j);
+        if (!AnyAlive() && lower_bound_[0] >= top.threshold()) {
+          // No path can start in this block and beat the k-th best: skip it.
+          const int64_t skip = std::min(kBlock, clip_.rows - j);
+          for (int64_t k = 0; k < std::min<int64_t>(skip, s_ + 1); ++k) {
+            ring_[(j + k) % ring_.size()].top = -1;
+          }
+          j += skip - 1;
+          ++stats.pruned_blocks;
+          continue;
+        }
+      }
+      const float end_cost = FillColumn(j, top.threshold(), stats);
+      if (end_cost < kInfinity) {
+        const Warp warp{
+            ring_[j % ring_.size()].best_start, j, end_cost / static_cast<double>(m_), {}};
+        top.Offer(MakeResult(clip_index, warp, -1));
+      }
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  struct Column {
+    std::vector<float> cost;     // m x s
+    std::vector<int64_t> start;  // clip frame of the path's first query frame
+    int64_t top = -1;            // highest row with a finite cost
+    int64_t best_start = 0;
+  };
+
+  bool AnyAlive() const {
+    return std::any_of(ring_.begin(), ring_.end(), [](const Column& c) { return c.top >= 0; });
+  }
+
+  // Fills column j; returns the best total over the last row (infinity when none).
+  float FillColumn(int64_t j, float threshold, SearchStats& stats) {
+    Column& column = ring_[j % ring_.size()];
+    std::fill(column.cost.begin(), column.cost.end(), kInfinity);
+    // Rows reachable: one above the previous columns' top, plus pauses within this column.
+    int64_t reach = 0;
+    for (int advance = 1; advance <= s_ && advance <= j; ++advance) {
+      reach = std::max(reach, ring_[(j - advance) % ring_.size()].top + 1);
+    }
+    reach = std::min<int64_t>(m_ - 1, reach + s_ - 1);
+    column.top = -1;
+    const float* x = clip_.row(j);
+    for (int64_t i = 0; i <= reach; ++i) {
+      float best = kInfinity;
+      int64_t best_start = 0;
+      if (i == 0) {
+        best = 0.0f;
+        best_start = j;
+      } else {
+        for (int advance = 1; advance <= s_ && advance <= j; ++advance) {
+          const Column& from = ring_[(j - advance) % ring_.size()];
+          if (from.top < i - 1) continue;
+          for (int z = 0; z < s_; ++z) {
+            const float c = from.cost[(i - 1) * s_ + z];
+            if (c < best) {
+              best = c;
+              best_start = from.start[(i - 1) * s_ + z];
+            }
+          }
+        }
+      }
+      const float* pause = i > 0 ? &column.cost[(i - 1) * s_] : nullptr;
+      const bool can_pause = pause != nullptr && std::any_of(pause, pause + s_ - 1,
+                                                             [](float c) { return c < kInfinity; });
+      if (best == kInfinity && !can_pause) continue;
+      const float d = Distance(query_.row(i), x, dims_);
+      ++stats.cells;
+      const float bound = threshold - lower_bound_[i + 1];
+      if (best + d < bound) {
+        column.cost[i * s_] = best + d;
+        column.start[i * s_] = best_start;
+        column.top = i;
+      }
+      for (int z = 1; z < s_ && can_pause; ++z) {
+        const float c = pause[z - 1] + d;
+        if (c < bound) {
+          column.cost[i * s_ + z] = c;
+          column.start[i * s_ + z] = column.start[(i - 1) * s_ + z - 1];
+          column.top = i;
+        }
+      }
+    }
+    if (column.top < m_ - 1) return kInfinity;
+    float best = kInfinity;
+    for (int z = 0; z < s_; ++z) {
+      if (column.cost[(m_ - 1) * s_ + z] < best) {
+        best = column.cost[(m_ - 1) * s_ + z];
+        column.best_start = column.start[(m_ - 1) * s_ + z];
+      }
+    }
+    return best;
+  }
+
+  void ComputeBlockBoxes() {
+    const int64_t blocks = (clip_.rows + kBlock - 1) / kBlock;
+    box_low_.assign(blocks * dims_, kInfinity);
+    box_high_.assign(blocks * dims_, -kInfinity);
+    for (int64_t f = 0; f < clip_.rows; ++f) {
+      const int64_t b = f / kBlock;
+      for (int k = 0; k < dims_; ++k) {
+        box_low_[b * dims_ + k] = std::min(box_low_[b * dims_ + k], clip_.row(f)[k]);
+        box_high_[b * dims_ + k] = std::max(box_high_[b * dims_ + k], clip_.row(f)[k]);
+      }
+    }
+  }
+
+  // lower_bound_[i]: a lower bound on the cost of query rows i.. for any path with a cell in
+  // the block starting at column j0: each row's distance to the box of every frame such a path
+  // can reach, [j0, j0 + kBlock - 1 + s * (m - 1)].
+  void BlockLowerBound(int64_t j0) {
+    const int64_t last = std::min(clip_.rows - 1, j0 + kBlock - 1 + s_ * (m_ - 1));
+    std::vector<float> low(dims_, kInfinity), high(dims_, -kInfinity);
+    for (int64_t b = j0 / kBlock; b <= last / kBlock; ++b) {
+      for (int k = 0; k < dims_; ++k) {
+        low[k] = std::min(low[k], box_low_[b * dims_ + k]);
+        high[k] = std::max(high[k], box_high_[b * dims_ + k]);
+      }
+    }
+    lower_bound_[m_] = 0.0f;
+    for (int64_t i = m_ - 1; i >= 0; --i) {
+      float sum = 0.0f;
+      for (int k = 0; k < dims_; ++k) {
+        const float v = query_.row(i)[k];
+        const float outside = v < low[k] ? low[k] - v : (v > high[k] ? v - high[k] : 0.0f);
+        sum += outside * outside;
+      }
+      // Slightly loosened so float rounding can never prune a path that would have won.
+      lower_bound_[i] = lower_bound_[i + 1] + 0.999f * std::sqrt(sum);
+    }
+  }
+
+  CoordinateView query_;
+  CoordinateView clip_;
+  int s_;
+  int dims_;
+  int64_t m_;
+  std::vector<Column> ring_;
+  std::vector<float> lower_bound_;
+  std::vector<float> box_low_, box_high_;
+};
+
+}  // namespace
+
+absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
+                                           const SearchParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
+  SearchResponse response;
+  StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
+  for (int c = 0; c < library.clip_count(); ++c) {
+    if (!allowed.empty() && !allowed[c]) continue;
+    ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
+    MOTIONDB_RETURN_IF_ERROR(scan.Run(c, params, top, response.stats));
+  }
+  response.results = FinishResults(library, top.Take(), params);
+  response.stats.warps_ms = response.stats.total_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return response;
+}
+
+}  // namespace motiondb

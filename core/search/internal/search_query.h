@@ -1,0 +1,36 @@
+// What the fast and the exact search share: checking a query against a library, the clip filter,
+// and turning a warp into a result.
+#ifndef MOTIONDB_CORE_SEARCH_INTERNAL_SEARCH_QUERY_H_
+#define MOTIONDB_CORE_SEARCH_INTERNAL_SEARCH_QUERY_H_
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/coordinate_view.h"
+#include "core/index/library_index.h"
+#include "core/search/search_params.h"
+#include "core/search/search_result.h"
+#include "core/search/warp/time_warp.h"
+
+namespace motiondb {
+
+// Checks the parameters and that the query has frames, the library's dimensions, and finite
+// coordinates; returns the allowed-clip mask of the filters (empty: every clip).
+absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
+                                               const SearchParams& params);
+
+// A candidate: the clip by index, the warp's frames and score. Its clip id, name and times are
+// filled by FinishResults, only for the results kept.
+SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame);
+
+// RankResults, then each kept result's clip id, name and start and end in seconds.
+std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+                                        std::vector<SearchResult> candidates,
+                                        const SearchParams& params);
+
+// CANCELLED when the caller's should_stop says so.
+absl::Status CheckStop(const SearchParams& params);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SEARCH_INTERNAL_SEARCH_QUERY_H_

@@ -1,0 +1,48 @@
+#include "core/search/search_params.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "core/search/warp/time_warp.h"
+
+namespace motiondb {
+namespace {
+
+absl::Status OutOfRange(absl::string_view name, double value, absl::string_view range) {
+  return absl::InvalidArgumentError(
+      absl::StrCat(name, " = ", value, " is out of range; expected ", range));
+}
+
+}  // namespace
+
+absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
+  const std::string dims_range = absl::StrCat("1..", dims, " (the library's dimensions)");
+  if (params.ann_dims < 1 || params.ann_dims > dims) {
+    return OutOfRange("ann_dims", params.ann_dims, dims_range);
+  }
+  if (params.dtw_dims < 1 || params.dtw_dims > dims) {
+    return OutOfRange("dtw_dims", params.dtw_dims, dims_range);
+  }
+  if (params.neighbours < 1 || params.neighbours > 1'000'000) {
+    return OutOfRange("neighbours", params.neighbours, "1..1000000");
+  }
+  if (!std::isfinite(params.epsilon) || params.epsilon < 0) {
+    return OutOfRange("epsilon", params.epsilon, "a finite value >= 0");
+  }
+  if (params.slope_limit < 1 || params.slope_limit > kMaxSlopeLimit) {
+    return OutOfRange("slope_limit", params.slope_limit, absl::StrCat("1..", kMaxSlopeLimit));
+  }
+  if (params.max_results < 1 || params.max_results > 10'000) {
+    return OutOfRange("max_results", params.max_results, "1..10000");
+  }
+  if (!std::isfinite(params.cluster_gap_s) || params.cluster_gap_s < 0 ||
+      params.cluster_gap_s > 60) {
+    return OutOfRange("cluster_gap_s", params.cluster_gap_s, "0..60 seconds");
+  }
+  if (!std::isfinite(params.max_overlap) || params.max_overlap < 0 || params.max_overlap > 1) {
+    return OutOfRange("max_overlap", params.max_overlap, "0..1");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace motiondb

@@ -1,0 +1,61 @@
+// Parameters of a query-by-example search (thesis chapter 6, Table 6.2 defaults).
+#ifndef MOTIONDB_CORE_SEARCH_SEARCH_PARAMS_H_
+#define MOTIONDB_CORE_SEARCH_SEARCH_PARAMS_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+
+namespace motiondb {
+
+// The neutral pose the characteristic point is farthest from (thesis 6.2.1).
+enum class NeutralPose {
+  kQueryMean,     // the mean of the query's poses
+  kBoundaryMean,  // the mean of the query's first and last poses
+  kOrigin,        // the space origin: the training set's mean pose
+};
+
+struct SearchParams {
+  // Dimensions of the nearest-neighbour seed search.
+  int ann_dims = 10;
+  // Seeds: nearest library frames to the characteristic pose.
+  int neighbours = 1000;
+  // Approximation bound of the seed search (0 = exact).
+  float epsilon = 0.0f;
+  // Dimensions of the pose distance inside the time warp.
+  int dtw_dims = 5;
+  // The warp never runs more than this many times faster or slower than the query.
+  int slope_limit = 2;
+  // Results returned after overlap suppression.
+  int max_results = 20;
+  // The query frame (at the space rate) that every warp passes through; -1 finds it
+  // automatically as the pose farthest from `neutral`.
+  int characteristic_frame = -1;
+  NeutralPose neutral = NeutralPose::kQueryMean;
+  // Seeds of one clip closer than this in time join one cluster.
+  double cluster_gap_s = 0.1;
+  // A result is dropped when it overlaps a better one by more than this fraction of its length.
+  double max_overlap = 0.5;
+  // Move each candidate to the best warp near it, free of its seed, before ranking
+  // (core/warp_refinement.h): a warp pinned to a seed in a held pose can score far worse than
+  // the best warp beside it. false runs the thesis's algorithm as is.
+  bool refine = true;
+  // Return each result's warp path (one library frame per query frame).
+  bool return_path = false;
+  // Only clips with these ids (empty: all clips).
+  std::vector<int64_t> clip_ids;
+  // Only clips carrying at least one of these tags (empty: no tag filter).
+  std::vector<std::string> tags;
+  // Polled inside long loops; returning true stops the search with CANCELLED.
+  std::function<bool()> should_stop;
+};
+
+// INVALID_ARGUMENT naming the first out-of-range parameter; `dims` is the library's dimensions.
+absl::Status ValidateSearchParams(const SearchParams& params, int dims);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SEARCH_SEARCH_PARAMS_H_

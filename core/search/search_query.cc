@@ -1,0 +1,82 @@
+#include "core/search/internal/search_query.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+
+absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
+                                               const SearchParams& params) {
+  MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, library.dims()));
+  if (query.rows < 1) return absl::InvalidArgumentError("the query has no frames");
+  if (query.stride < library.dims()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the query has ", query.stride, " dimensions; the library has ", library.dims()));
+  }
+  for (int64_t f = 0; f < query.rows; ++f) {
+    if (!std::all_of(query.row(f), query.row(f) + library.dims(),
+                     [](float v) { return std::isfinite(v); })) {
+      return absl::InvalidArgumentError(absl::StrCat("query frame ", f, " is not finite"));
+    }
+  }
+  if (params.characteristic_frame < -1 || params.characteristic_frame >= query.rows) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("characteristic_frame ", params.characteristic_frame,
+                     " is outside the query's frames 0-", query.rows - 1));
+  }
+  if (params.clip_ids.empty() && params.tags.empty()) return std::vector<bool>();
+  std::vector<bool> allowed(library.clip_count(), false);
+  for (int64_t id : params.clip_ids) {
+    const int index = library.FindClip(id);
+    if (index < 0) return absl::NotFoundError(absl::StrCat("clip ", id, " is not in the library"));
+    allowed[index] = true;
+  }
+  if (!params.tags.empty()) {
+    for (int c = 0; c < library.clip_count(); ++c) {
+      if (!params.clip_ids.empty() && !allowed[c]) continue;  // both filters must hold
+      const std::vector<std::string>& tags = library.clip(c).tags;
+      allowed[c] = std::any_of(params.tags.begin(), params.tags.end(), [&](const std::string& t) {
+        return std::find(tags.begin(), tags.end(), t) != tags.end();
+      });
+    }
+  }
+  return allowed;
+}
+
+SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame) {
+  SearchResult result;
+  result.clip_index = clip_index;
+  result.first_frame = warp.first;
+  result.last_frame = warp.last;
+  result.score = warp.score;
+  result.seed_frame = seed_frame;
+  result.path = std::move(warp.path);
+  return result;
+}
+
+std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+                                        std::vector<SearchResult> candidates,
+                                        const SearchParams& params) {
+  std::vector<SearchResult> results =
+      RankResults(std::move(candidates), params.max_overlap, params.max_results);
+  for (SearchResult& result : results) {
+    const LibraryIndex::ClipEntry& clip = library.clip(result.clip_index);
+    result.clip_id = clip.clip_id;
+    result.clip_name = clip.name;
+    result.start_s = result.first_frame / library.rate();
+    result.end_s = result.last_frame / library.rate();
+  }
+  return results;
+}
+
+absl::Status CheckStop(const SearchParams& params) {
+  if (params.should_stop && params.should_stop()) {
+    return absl::CancelledError("the search was stopped by its caller");
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace motiondb

@@ -1,0 +1,339 @@
+#include "core/space/motion_space.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <Eigen/Eigenvalues>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "core/motion/resample.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+// Tolerance for the unit length of stored references and the orthonormality of a stored basis.
+constexpr double kStoredTolerance = 1e-6;
+
+absl::Status Prefixed(absl::string_view source, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat(source, ": ", status.message()));
+}
+
+// The range's frames sampled at `rate`, with errors naming the source.
+absl::StatusOr<Clip> SampleRange(const ClipRange& range, double rate) {
+  absl::StatusOr<Clip> cut = range.frames ? range.clip.Slice(*range.frames) : range.clip;
+  if (!cut.ok()) return Prefixed(range.source, cut.status());
+  absl::StatusOr<Clip> sampled = Resample(*cut, rate);
+  if (!sampled.ok()) return Prefixed(range.source, sampled.status());
+  if (sampled->frame_count() == 0) {
+    return absl::InvalidArgumentError(absl::StrCat(range.source, ": the clip has no frames"));
+  }
+  return sampled;
+}
+
+absl::Status CheckSampleRate(double rate) {
+  if (!std::isfinite(rate) || rate <= 0.0 || rate > 10000.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("space sample rate must be in (0, 10000] frames per second, got ", rate));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckYawRateWeight(double weight) {
+  if (!std::isfinite(weight) || weight <= 0.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("yaw-rate weight must be finite and positive, got ", weight));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckShape(absl::string_view what, Eigen::Index rows, Eigen::Index cols,
+                        Eigen::Index want_rows, Eigen::Index want_cols) {
+  if (rows != want_rows || cols != want_cols) {
+    return absl::InvalidArgumentError(absl::StrCat("space ", what, " is ", rows, " x ", cols,
+                                                   ", expected ", want_rows, " x ", want_cols));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckData(const SpaceData& data) {
+  if (data.skeleton == nullptr) return absl::InvalidArgumentError("space has no skeleton");
+  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(data.sample_rate));
+  MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(data.pose));
+  MOTIONDB_RETURN_IF_ERROR(CheckYawRateWeight(data.yaw_rate_weight));
+  const int joints = data.skeleton->joint_count();
+  const int dims = PoseDims(joints, data.pose);
+  MOTIONDB_RETURN_IF_ERROR(CheckShape("joint weights", data.joint_weights.size(), 1, joints, 1));
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckShape("references", data.references.rows(), data.references.cols(), joints, 4));
+  MOTIONDB_RETURN_IF_ERROR(CheckShape("mean", data.mean.size(), 1, dims, 1));
+  MOTIONDB_RETURN_IF_ERROR(CheckShape("basis", data.basis.rows(), data.basis.cols(), dims, dims));
+  MOTIONDB_RETURN_IF_ERROR(CheckShape("eigenvalues", data.eigenvalues.size(), 1, dims, 1));
+  if (!data.joint_weights.allFinite() || (data.joint_weights.array() <= 0.0).any()) {
+    return absl::InvalidArgumentError("space joint weights must be finite and positive");
+  }
+  if (!data.references.allFinite() ||
+      ((data.references.rowwise().norm().array() - 1.0).abs() > kStoredTolerance).any()) {
+    return absl::InvalidArgumentError("space references must be unit quaternions");
+  }
+  if (!data.mean.allFinite() || !data.basis.allFinite() || !data.eigenvalues.allFinite()) {
+    return absl::InvalidArgumentError("space contains NaN or infinite values");
+  }
+  if ((data.eigenvalues.array() < 0.0).any() ||
+      (dims > 1 &&
+       (data.eigenvalues.tail(dims - 1).array() > data.eigenvalues.head(dims - 1).array()).any())) {
+    return absl::InvalidArgumentError("space eigenvalues must be non-negative and decreasing");
+  }
+  const RowMatrixXd gram = data.basis.transpose() * data.basis;
+  if (!gram.isIdentity(kStoredTolerance)) {
+    return absl::InvalidArgumentError("space basis is not orthonormal");
+  }
+  for (const TrainingSource& source : data.training) {
+    if (source.frames.first < 0 || source.frames.last < source.frames.first) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("space training range of '", source.source, "' is not a frame range"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// The eigen-decomposition of the weighted covariance, by decreasing eigenvalue. Each column's
+// sign makes its largest entry positive, so that rebuilding a space gives the same axes.
+void SolveBasis(const RowMatrixXd& centred, SpaceData* data) {
+  const Eigen::MatrixXd covariance =
+      (centred.transpose() * centred) / static_cast<double>(centred.rows());
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
+  const Eigen::Index dims = covariance.rows();
+  data->basis.resize(dims, dims);
+  data->eigenvalues.resize(dims);
+  for (Eigen::Index i = 0; i < dims; ++i) {
+    const Eigen::Index source = dims - 1 - i;  // the solver's eigenvalues ascend
+    Eigen::VectorXd column = solver.eigenvectors().col(source);
+    Eigen::Index largest = 0;
+    column.cwiseAbs().maxCoeff(&largest);
+    if (column[largest] < 0.0) column = -column;
+    data->basis.col(i) = column;
+    data->eigenvalues[i] = std::max(solver.eigenvalues()[source], 0.0);
+  }
+}
+
+// The weight of each pose-vector number: each joint's three, then the yaw rate's.
+Eigen::VectorXd PoseWeights(const SpaceData& data) {
+  const Eigen::Index joints = data.joint_weights.size();
+  Eigen::VectorXd weights(PoseDims(static_cast<int>(joints), data.pose));
+  for (Eigen::Index j = 0; j < joints; ++j) {
+    weights.segment<3>(3 * j).setConstant(data.joint_weights[j]);
+  }
+  if (data.pose.remove_heading) weights[3 * joints] = data.yaw_rate_weight;
+  return weights;
+}
+
+}  // namespace
+
+Eigen::VectorXd MetricScales(SpaceMetric metric, const Eigen::VectorXd& eigenvalues, int dims) {
+  if (metric == SpaceMetric::kEigenvalueScaled) return eigenvalues.head(dims);
+  return Eigen::VectorXd::Ones(dims);
+}
+
+absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<ClipRange>& training,
+                                               const SpaceOptions& options) {
+  if (training.empty()) return absl::InvalidArgumentError("a space needs training clips");
+  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate));
+  MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(options.pose));
+  MOTIONDB_RETURN_IF_ERROR(CheckYawRateWeight(options.yaw_rate_weight));
+  SpaceData data;
+  data.skeleton = training.front().clip.shared_skeleton();
+  data.sample_rate = options.sample_rate;
+  data.pose = options.pose;
+  data.yaw_rate_weight = options.yaw_rate_weight;
+  data.metric = options.metric;
+  MOTIONDB_ASSIGN_OR_RETURN(data.joint_weights,
+                            ComputeJointWeights(*data.skeleton, options.weights));
+
+  std::vector<PoseRotations> poses;
+  Eigen::Index frames = 0;
+  for (const ClipRange& range : training) {
+    if (!range.clip.skeleton().SameTopology(*data.skeleton)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(range.source, ": skeleton differs from the first training clip's (",
+                       training.front().source, "): joint names or parents do not match"));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, options.sample_rate));
+    poses.push_back(ComputePoseRotations(sampled, options.pose));
+    frames += sampled.frame_count();
+    const FrameRange all{0, range.clip.frame_count() - 1};
+    data.training.push_back({range.source, range.frames.value_or(all)});
+  }
+
+  const int joints = data.skeleton->joint_count();
+  RowMatrixXd rotations(frames, 4 * joints);
+  Eigen::Index row = 0;
+  for (const PoseRotations& pose : poses) {
+    rotations.middleRows(row, pose.rotations.rows()) = pose.rotations;
+    row += pose.rotations.rows();
+  }
+  data.references.resize(joints, 4);
+  for (int j = 0; j < joints; ++j) {
+    MOTIONDB_ASSIGN_OR_RETURN(const Quat mean, MeanQuaternion(rotations.middleCols(4 * j, 4)));
+    data.references.row(j) << mean.w(), mean.x(), mean.y(), mean.z();
+  }
+
+  const Eigen::VectorXd pose_weights = PoseWeights(data);
+  RowMatrixXd weighted(frames, pose_weights.size());
+  row = 0;
+  for (const PoseRotations& pose : poses) {
+    weighted.middleRows(row, pose.rotations.rows()) =
+        EncodePoses(pose, data.references) * pose_weights.asDiagonal();
+    row += pose.rotations.rows();
+  }
+  data.mean = weighted.colwise().mean().transpose();
+  weighted.rowwise() -= data.mean.transpose();
+  SolveBasis(weighted, &data);
+  if (data.eigenvalues.sum() <= 0.0) {
+    return absl::InvalidArgumentError(
+        "the training poses do not vary: a space needs at least two different poses");
+  }
+  return MotionSpace(std::move(data));
+}
+
+absl::StatusOr<MotionSpace> MotionSpace::FromData(SpaceData data) {
+  MOTIONDB_RETURN_IF_ERROR(CheckData(data));
+  return MotionSpace(std::move(data));
+}
+
+MotionSpace::MotionSpace(SpaceData data)
+    : data_(std::move(data)), pose_weights_(PoseWeights(data_)) {
+  project_ = pose_weights_.asDiagonal() * data_.basis;
+  project_offset_ = -data_.mean.transpose() * data_.basis;
+  unproject_ = data_.basis.transpose() * pose_weights_.cwiseInverse().asDiagonal();
+  unproject_offset_ = data_.mean.cwiseQuotient(pose_weights_).transpose();
+}
+
+Eigen::VectorXd MotionSpace::ExplainedVariance() const {
+  return data_.eigenvalues / data_.eigenvalues.sum();
+}
+
+absl::StatusOr<RowMatrixXd> MotionSpace::Project(const Eigen::Ref<const RowMatrixXd>& poses,
+                                                 int dims) const {
+  if (poses.cols() != this->dims()) {
+    return absl::InvalidArgumentError(absl::StrCat("pose vectors have ", poses.cols(),
+                                                   " numbers, the space expects ", this->dims()));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int n, ResolveDims(dims));
+  RowMatrixXd coordinates = poses * project_.leftCols(n);
+  coordinates.rowwise() += project_offset_.head(n);
+  return coordinates;
+}
+
+absl::StatusOr<RowMatrixXd> MotionSpace::Unproject(
+    const Eigen::Ref<const RowMatrixXd>& coordinates) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const int n, CoordinateDims(coordinates.cols()));
+  RowMatrixXd poses = coordinates * unproject_.topRows(n);
+  poses.rowwise() += unproject_offset_;
+  return poses;
+}
+
+absl::StatusOr<RowMatrixXd> MotionSpace::EncodeClip(const Clip& clip) const {
+  if (!clip.skeleton().SameTopology(skeleton())) {
+    return absl::InvalidArgumentError(
+        "the clip's skeleton differs from the space's: joint names or parents do not match");
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, Resample(clip, data_.sample_rate));
+  return EncodePoses(ComputePoseRotations(sampled, data_.pose), data_.references);
+}
+
+absl::StatusOr<RowMatrixXd> MotionSpace::ProjectClip(const Clip& clip, int dims) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd poses, EncodeClip(clip));
+  return Project(poses, dims);
+}
+
+absl::StatusOr<RowMatrixXd> MotionSpace::Reconstruct(
+    const Eigen::Ref<const RowMatrixXd>& coordinates) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd poses, Unproject(coordinates));
+  return DecodePoses(poses, data_.references);
+}
+
+absl::StatusOr<Eigen::VectorXd> MotionSpace::MetricScales(int dims) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const int n, ResolveDims(dims));
+  return motiondb::MetricScales(data_.metric, data_.eigenvalues, n);
+}
+
+absl::StatusOr<double> MotionSpace::Distance(const Eigen::Ref<const Eigen::RowVectorXd>& p,
+                                             const Eigen::Ref<const Eigen::RowVectorXd>& q) const {
+  if (p.size() != q.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points have ", p.size(), " and ", q.size(), " coordinates"));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int n, CoordinateDims(p.size()));
+  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::VectorXd scales, MetricScales(n));
+  return (p - q).cwiseProduct(scales.transpose()).norm();
+}
+
+absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
+    const std::vector<ClipRange>& clips, const std::vector<int>& dims) const {
+  std::vector<int> levels;
+  for (const int n : dims) {
+    if (n < 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("reconstruction dimensions must be at least 1, got ", n));
+    }
+    if (n < this->dims()) levels.push_back(n);
+  }
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  levels.push_back(this->dims());
+
+  std::vector<ReconstructionError> report;
+  for (const int n : levels) report.push_back({n, 0.0, 0.0});
+  double angles = 0.0;
+  const int joints = skeleton().joint_count();
+  for (const ClipRange& range : clips) {
+    if (!range.clip.skeleton().SameTopology(skeleton())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(range.source, ": skeleton differs from the space's"));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, data_.sample_rate));
+    const PoseRotations pose = ComputePoseRotations(sampled, data_.pose);
+    MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates,
+                              Project(EncodePoses(pose, data_.references)));
+    for (ReconstructionError& level : report) {
+      MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
+                                Reconstruct(coordinates.leftCols(level.dims)));
+      for (Eigen::Index f = 0; f < rebuilt.rows(); ++f) {
+        for (int j = 0; j < joints; ++j) {
+          const auto a = pose.rotations.block<1, 4>(f, 4 * j);
+          const auto b = rebuilt.block<1, 4>(f, 4 * j);
+          const double angle =
+              AngleBetween(Quat(a[0], a[1], a[2], a[3]), Quat(b[0], b[1], b[2], b[3]));
+          level.mean_rad += angle;
+          level.max_rad = std::max(level.max_rad, angle);
+        }
+      }
+    }
+    angles += static_cast<double>(pose.rotations.rows()) * joints;
+  }
+  if (angles == 0.0) return absl::InvalidArgumentError("no clips to reconstruct");
+  for (ReconstructionError& level : report) level.mean_rad /= angles;
+  return report;
+}
+
+absl::StatusOr<int> MotionSpace::ResolveDims(int dims) const {
+  if (dims == -1) return this->dims();
+  if (dims < 0 || dims > this->dims()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("dimensions must be in 0..", this->dims(), " (or -1 for all), got ", dims));
+  }
+  return dims;
+}
+
+absl::StatusOr<int> MotionSpace::CoordinateDims(Eigen::Index columns) const {
+  if (columns > dims()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points have ", columns, " coordinates, the space has ", dims()));
+  }
+  return static_cast<int>(columns);
+}
+
+}  // namespace motiondb

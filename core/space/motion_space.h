@@ -1,0 +1,159 @@
+// A Motion Curve space (thesis 3.2-3.3, SPEC §3): the weighted-PCA basis of the pose vectors of
+// some training clips. Poses project to points, clips to curves; the first dimensions carry the
+// most (weighted) variance, and the Euclidean distance in the space is a weighted joint-angle
+// distance.
+//
+// With per-joint weights w (3 numbers per joint, plus the yaw-rate weight), the training mean m
+// of the weighted pose vectors and the orthonormal basis B (one column per dimension, by
+// decreasing eigenvalue): projection p = (v .* w - m) B, unprojection v = (p B^T + m) ./ w.
+// Every dimension is kept; callers truncate.
+//
+// Immutable once built; thread-safe for concurrent use.
+#ifndef MOTIONDB_CORE_SPACE_MOTION_SPACE_H_
+#define MOTIONDB_CORE_SPACE_MOTION_SPACE_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "absl/status/statusor.h"
+#include "core/motion/clip.h"
+#include "core/motion/matrix.h"
+#include "core/space/joint_weights.h"
+#include "core/space/pose_encoder.h"
+
+namespace motiondb {
+
+// Eq. 3.4: d(p, q) = sqrt(sum_{i < n} s_i^2 (p_i - q_i)^2).
+enum class SpaceMetric {
+  kUnit,              // s_i = 1: plain Euclidean, a weighted joint-angle distance
+  kEigenvalueScaled,  // s_i = eigenvalue i, as the thesis writes it
+};
+
+struct SpaceOptions {
+  // Frames per second at which training clips, and every clip projected later, are sampled.
+  double sample_rate = 30.0;
+  // Facing removal and yaw-rate smoothing.
+  PoseOptions pose = {};
+  // Per-joint weights: preset and overrides.
+  JointWeightOptions weights = {};
+  // Weight of the yaw-rate dimension (rad/s): 0.5 makes a turn at 1 rad/s count like a joint
+  // of weight 1 bent by 0.5 rad. Measured best of 0.03-2 at telling walks from left and right
+  // turns (bandai2-normal, leave-one-out nearest clip). Finite and positive; unused when the
+  // facing is kept.
+  double yaw_rate_weight = 0.5;
+  // The metric the space's distances use.
+  SpaceMetric metric = SpaceMetric::kUnit;
+};
+
+// A clip, or a range of its frames, for training or for the error report.
+struct ClipRange {
+  std::string source;  // where it came from (a file name); recorded in the space
+  Clip clip;
+  std::optional<FrameRange> frames;  // at the clip's own rate; nullopt for the whole clip
+};
+
+// Where a space's training frames came from.
+struct TrainingSource {
+  std::string source;
+  FrameRange frames;  // at the source clip's own rate
+};
+
+// Everything a space is made of: what serialisation stores.
+struct SpaceData {
+  std::shared_ptr<const Skeleton> skeleton;
+  // As built, from SpaceOptions (no defaults here: a space has them all set).
+  double sample_rate = 0.0;
+  PoseOptions pose = {};
+  double yaw_rate_weight = 0.0;
+  SpaceMetric metric = SpaceMetric::kUnit;
+  Eigen::VectorXd joint_weights;  // one per joint, positive
+  RowMatrixXd references;         // joints x 4: each joint's mean orientation, w, x, y, z
+  Eigen::VectorXd mean;           // dims: mean weighted training pose vector
+  RowMatrixXd basis;              // dims x dims, orthonormal; column i is dimension i
+  Eigen::VectorXd eigenvalues;    // dims, decreasing: the weighted variance along each column
+  std::vector<TrainingSource> training;
+};
+
+// Joint-angle error (radians, over every joint of every frame) of a reconstruction from the
+// first `dims` dimensions.
+struct ReconstructionError {
+  int dims = 0;
+  double mean_rad = 0.0;
+  double max_rad = 0.0;
+};
+
+// The per-dimension factors s_i of `metric` for the first `dims` dimensions of a space with
+// these eigenvalues. Coordinates multiplied by them make plain L2 distance the metric.
+Eigen::VectorXd MetricScales(SpaceMetric metric, const Eigen::VectorXd& eigenvalues, int dims);
+
+class MotionSpace {
+ public:
+  // Builds a space from training clips or ranges, which must share one skeleton topology. Each
+  // is cut to its range, resampled to options.sample_rate, freed of its facing (unless
+  // options.pose.remove_heading is false) and linearised about the per-joint mean orientation
+  // of all training frames (thesis Algorithm 2).
+  static absl::StatusOr<MotionSpace> Build(const std::vector<ClipRange>& training,
+                                           const SpaceOptions& options = {});
+  // Checks that the parts are consistent (shapes, finite values, positive weights, orthonormal
+  // basis), e.g. after reading them from storage.
+  static absl::StatusOr<MotionSpace> FromData(SpaceData data);
+
+  const SpaceData& data() const { return data_; }
+  const Skeleton& skeleton() const { return *data_.skeleton; }
+  double sample_rate() const { return data_.sample_rate; }
+  int dims() const { return static_cast<int>(data_.mean.size()); }
+  // The weight of each pose-vector number: joint weights repeated 3 times, then the yaw rate's.
+  const Eigen::VectorXd& pose_weights() const { return pose_weights_; }
+  // Fraction of the training variance along each dimension; sums to 1.
+  Eigen::VectorXd ExplainedVariance() const;
+
+  // Pose vectors (n x dims()) to their first `dims` coordinates (n x dims; -1 for all).
+  absl::StatusOr<RowMatrixXd> Project(const Eigen::Ref<const RowMatrixXd>& poses,
+                                      int dims = -1) const;
+  // Coordinates in the first k <= dims() dimensions (n x k) to pose vectors (n x dims()); the
+  // dimensions beyond k are taken at the training mean.
+  absl::StatusOr<RowMatrixXd> Unproject(const Eigen::Ref<const RowMatrixXd>& coordinates) const;
+  // A clip of the space's skeleton, sampled at the space rate, as pose vectors (n x dims()).
+  absl::StatusOr<RowMatrixXd> EncodeClip(const Clip& clip) const;
+  // The same, projected to its first `dims` coordinates (-1 for all): the clip's motion curve.
+  absl::StatusOr<RowMatrixXd> ProjectClip(const Clip& clip, int dims = -1) const;
+  // Joint rotations (n x 4 * joints) of the poses at `coordinates` (n x k, k <= dims()), as
+  // the pose describes them: facing-free when the space removes the facing.
+  absl::StatusOr<RowMatrixXd> Reconstruct(const Eigen::Ref<const RowMatrixXd>& coordinates) const;
+
+  // The space's metric scales for the first `dims` dimensions (-1 for all; MetricScales above).
+  absl::StatusOr<Eigen::VectorXd> MetricScales(int dims = -1) const;
+  // The metric between two points of equal size, over their first p.size() dimensions.
+  absl::StatusOr<double> Distance(const Eigen::Ref<const Eigen::RowVectorXd>& p,
+                                  const Eigen::Ref<const Eigen::RowVectorXd>& q) const;
+
+  // Thesis 3.3.4: the joint-angle error when the clips' poses are reconstructed from each of
+  // `dims` (sorted, capped at dims(); all dimensions are always reported last).
+  absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
+      const std::vector<ClipRange>& clips, const std::vector<int>& dims = {3, 5, 10, 20}) const;
+
+ private:
+  explicit MotionSpace(SpaceData data);
+  // `dims` checked against the space, -1 meaning all.
+  absl::StatusOr<int> ResolveDims(int dims) const;
+  // The dimensions of points with `columns` coordinates, at most dims().
+  absl::StatusOr<int> CoordinateDims(Eigen::Index columns) const;
+
+  SpaceData data_;
+  Eigen::VectorXd pose_weights_;
+  // Projection and unprojection with the weights and mean folded in, so that each is one
+  // matrix product plus a row offset: p = v * project_ + project_offset_,
+  // v = p * unproject_ + unproject_offset_.
+  RowMatrixXd project_;
+  Eigen::RowVectorXd project_offset_;
+  RowMatrixXd unproject_;
+  Eigen::RowVectorXd unproject_offset_;
+};
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SPACE_MOTION_SPACE_H_

@@ -1,0 +1,20 @@
+// A clip's coordinates for searching in a space: its motion curve at the space rate, truncated
+// to `dims` dimensions and multiplied by the space's metric scales, as float32, so that plain
+// Euclidean distance between rows is the space's pose metric.
+#ifndef MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_
+#define MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_
+
+#include "absl/status/statusor.h"
+#include "core/motion/clip.h"
+#include "core/motion/matrix.h"
+#include "core/space/motion_space.h"
+
+namespace motiondb {
+
+// `dims` -1 means all of the space's dimensions.
+absl::StatusOr<RowMatrixXf> SearchCoordinates(const MotionSpace& space, const Clip& clip,
+                                              int dims = -1);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_

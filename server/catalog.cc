@@ -1,0 +1,133 @@
+#include "server/catalog.h"
+
+#include "absl/strings/str_cat.h"
+#include "core/space/search_coordinates.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+// The database write is done when an index swap fails, so the error says that the write stands
+// and the index is stale until the next write or restart.
+absl::Status StaleIndexError(const std::string& space, const absl::Status& status) {
+  return absl::InternalError(absl::StrCat("stored, but the index of space ", space,
+                                          " could not be rebuilt: ", status.message()));
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::LoadSpace(
+    const storage::SpaceRecord& record) {
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, database_.GetSpace(record.space_id));
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<storage::Projection> projections,
+                            database_.LoadProjections(record.space_id));
+  std::vector<IndexedClip> clips;
+  clips.reserve(projections.size());
+  for (storage::Projection& projection : projections) {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord clip,
+                              database_.GetClipRecord(projection.clip_id));
+    MOTIONDB_ASSIGN_OR_RETURN(const ClipFacts facts, facts_.Get(projection.clip_id));
+    clips.push_back({projection.clip_id,
+                     {clip.name, clip.tags, facts.fps, facts.frame_count},
+                     std::move(projection.coordinates)});
+  }
+  return BuildSnapshot(record, std::make_shared<const MotionSpace>(std::move(space)),
+                       std::move(clips));
+}
+
+absl::Status Library::LoadIndices() {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<storage::SpaceRecord> records,
+                            database_.ListSpaces());
+  for (const storage::SpaceRecord& record : records) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> snapshot = LoadSpace(record);
+    if (!snapshot.ok()) {
+      return absl::Status(
+          snapshot.status().code(),
+          absl::StrCat("loading space ", record.name, ": ", snapshot.status().message()));
+    }
+    registry_.Put(*std::move(snapshot));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<IngestedClip> Library::IngestClip(const storage::ClipRecord& record,
+                                                 const Clip& clip) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database_.FindSkeleton(clip.skeleton()));
+  std::vector<std::shared_ptr<const SpaceSnapshot>> spaces;
+  if (skeleton_id >= 0) spaces = registry_.OfSkeleton(skeleton_id);
+  std::vector<std::pair<int64_t, storage::Projection>> projections;
+  for (const auto& space : spaces) {
+    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space->space, clip));
+    projections.push_back({space->record.space_id, storage::Projection{0, std::move(coordinates)}});
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id, database_.InsertClip(record, clip, projections));
+  facts_.Put(clip_id, ClipFacts::Of(clip));
+
+  IngestedClip ingested{clip_id, {}};
+  const IndexedClipInfo info{record.name, record.tags, clip.fps(), clip.frame_count()};
+  for (size_t i = 0; i < spaces.size(); ++i) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
+        SnapshotWithClip(*spaces[i], {clip_id, info, std::move(projections[i].second.coordinates)});
+    if (!updated.ok()) return StaleIndexError(spaces[i]->record.name, updated.status());
+    registry_.Put(*std::move(updated));
+    ingested.spaces.push_back(spaces[i]->record.name);
+  }
+  return ingested;
+}
+
+absl::Status Library::DeleteClip(int64_t clip_id) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record, database_.GetClipRecord(clip_id));
+  MOTIONDB_RETURN_IF_ERROR(database_.DeleteClip(clip_id));
+  facts_.Erase(clip_id);
+  for (const auto& space : registry_.OfSkeleton(record.skeleton_id)) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
+        SnapshotWithoutClip(*space, clip_id);
+    if (!updated.ok()) return StaleIndexError(space->record.name, updated.status());
+    registry_.Put(*std::move(updated));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::CreateSpace(
+    const SpaceRequest& request, const std::function<bool()>& should_stop) {
+  MOTIONDB_RETURN_IF_ERROR(ValidateSpaceName(request.name));
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  // Checked before the (long) build; the database checks again in the transaction.
+  if (registry_.Find(request.name) != nullptr) {
+    return absl::AlreadyExistsError(absl::StrCat("a space named ", request.name, " exists"));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(BuiltSpace built, BuildSpace(database_, facts_, request, should_stop));
+  std::vector<storage::Projection> projections;
+  projections.reserve(built.clips.size());
+  for (IndexedClip& clip : built.clips) {
+    projections.push_back({clip.clip_id, std::move(clip.coordinates)});
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(built.record.space_id,
+                            database_.InsertSpace(built.record, *built.space, projections));
+  for (size_t i = 0; i < built.clips.size(); ++i) {
+    built.clips[i].coordinates = std::move(projections[i].coordinates);
+  }
+  absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> snapshot =
+      BuildSnapshot(built.record, built.space, std::move(built.clips));
+  if (!snapshot.ok()) {
+    // Without an index the space would be stored but unsearchable; undo the insert.
+    const absl::Status undone = database_.DeleteSpace(request.name);
+    return absl::InternalError(absl::StrCat("the space's index could not be built (",
+                                            snapshot.status().message(), "); space ",
+                                            undone.ok() ? "not stored" : "stored but unusable"));
+  }
+  registry_.Put(*snapshot);
+  return *std::move(snapshot);
+}
+
+absl::Status Library::DeleteSpace(const std::string& name) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  MOTIONDB_RETURN_IF_ERROR(database_.DeleteSpace(name));
+  registry_.Remove(name);
+  return absl::OkStatus();
+}
+
+}  // namespace motiondb::server

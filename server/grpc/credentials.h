@@ -1,0 +1,35 @@
+// The listening port's credentials: plain text or TLS, and, when a bearer token is configured,
+// a check on every call (ours, health and reflection alike) that refuses a missing or wrong
+// "authorization: Bearer <token>" with UNAUTHENTICATED before the call reaches any service.
+//
+// The check is a C-core auth-metadata processor. The C++ API only lets one be attached to TLS
+// credentials (grpc::InsecureServerCredentials() asserts in SetAuthMetadataProcessor, grpc issue
+// #24278), and a server interceptor cannot refuse a call with a status of its choosing; the core
+// supports the processor on insecure credentials too, so the credentials are built at that
+// level.
+#ifndef MOTIONDB_SERVER_GRPC_CREDENTIALS_H_
+#define MOTIONDB_SERVER_GRPC_CREDENTIALS_H_
+
+#include <memory>
+#include <string>
+
+#include <grpcpp/security/server_credentials.h>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace motiondb::server {
+
+// TLS when both PEM strings are given, plain text when neither (INVALID_ARGUMENT for one
+// alone); `bearer_token` empty means no authentication.
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
+    const std::string& tls_cert_pem, const std::string& tls_key_pem,
+    const std::string& bearer_token);
+
+// True when `header` is "Bearer <token>" (scheme case-insensitive, RFC 6750). Takes the same
+// time for every header of a given length, so that the comparison does not leak the token.
+bool BearerTokenMatches(absl::string_view header, absl::string_view token);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_GRPC_CREDENTIALS_H_

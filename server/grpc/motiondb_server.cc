@@ -1,0 +1,141 @@
+#include "server/grpc/motiondb_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/resource_quota.h>
+#include <grpcpp/server_builder.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "grpc/health/v1/health.pb.h"
+#include "server/catalog.h"
+#include "server/clip_facts.h"
+#include "server/grpc/clip_service.h"
+#include "server/grpc/credentials.h"
+#include "server/grpc/request_logger.h"
+#include "server/grpc/search_service.h"
+#include "server/grpc/server_info_service.h"
+#include "server/grpc/space_service.h"
+#include "server/index_registry.h"
+#include "storage/database.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+// Declared in dependency order, so that destruction runs the other way: the gRPC server goes
+// first, while everything its handlers use still exists.
+struct MotionDbServer::State {
+  ServerOptions options;
+  std::unique_ptr<storage::Database> database;
+  IndexRegistry registry;
+  std::unique_ptr<ClipFactsCache> facts;
+  std::unique_ptr<Library> library;
+  std::unique_ptr<ClipServiceImpl> clips;
+  std::unique_ptr<SpaceServiceImpl> spaces;
+  std::unique_ptr<SearchServiceImpl> search;
+  std::unique_ptr<ServerInfoServiceImpl> info;
+  std::unique_ptr<grpc::Server> server;
+};
+
+MotionDbServer::MotionDbServer(std::unique_ptr<State> state) : state_(std::move(state)) {}
+
+MotionDbServer::~MotionDbServer() {
+  if (state_->server) {
+    state_->server->Shutdown(std::chrono::system_clock::now());
+    state_->server->Wait();
+  }
+}
+
+absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
+    const ServerOptions& options) {
+  if (options.max_message_mb < 1 || options.max_message_mb > 2047) {
+    return absl::InvalidArgumentError("--max-message-mb must be in 1..2047");
+  }
+  if (options.threads < 0) {
+    return absl::InvalidArgumentError("--threads must be 0 (no limit) or positive");
+  }
+  auto state = std::make_unique<State>();
+  State& s = *state;
+  s.options = options;
+  absl::StatusOr<std::unique_ptr<storage::Database>> database =
+      storage::Database::Open(options.db_path);
+  if (!database.ok()) {
+    return absl::Status(database.status().code(),
+                        absl::StrCat(options.db_path, ": ", database.status().message()));
+  }
+  s.database = *std::move(database);
+  s.facts = std::make_unique<ClipFactsCache>(*s.database);
+  s.library = std::make_unique<Library>(*s.database, s.registry, *s.facts);
+  const auto load_start = std::chrono::steady_clock::now();
+  MOTIONDB_RETURN_IF_ERROR(s.library->LoadIndices());
+  const auto spaces = s.registry.All();
+  int64_t frames = 0;
+  for (const auto& space : spaces) frames += space->index ? space->index->total_frames() : 0;
+  LogLine(absl::StrFormat(
+      "loaded %d space indices (%d frames) from %s in %.0f ms", spaces.size(), frames,
+      options.db_path,
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
+          .count()));
+
+  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.library, *s.facts, s.options);
+  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.library, s.registry);
+  s.search = std::make_unique<SearchServiceImpl>(*s.database, s.registry,
+                                                 SearchLimits{options.max_bvh_bytes});
+  s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options);
+
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const std::shared_ptr<grpc::ServerCredentials> credentials,
+      MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem, options.auth_token));
+  // Reflection describes services from the generated descriptor pool, which holds health.proto
+  // only if its generated code is linked in; naming a message of it makes sure it is.
+  (void)grpc::health::v1::HealthCheckRequest::descriptor();
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(options.listen, credentials, &port);
+  builder.RegisterService(s.clips.get());
+  builder.RegisterService(s.spaces.get());
+  builder.RegisterService(s.search.get());
+  builder.RegisterService(s.info.get());
+  builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
+  if (options.threads > 0) {
+    // The quota counts the sync server's polling threads too: one polls while the others work,
+    // and gRPC keeps up to two. Measured: a quota of N + 2 runs N calls at once; a call that finds
+    // no thread is refused with RESOURCE_EXHAUSTED ("Server Threadpool Exhausted").
+    grpc::ResourceQuota quota("motiondb");
+    quota.SetMaxThreads(options.threads + 2);
+    builder.SetResourceQuota(quota);
+  }
+  if (options.log_requests) {
+    std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;
+    loggers.push_back(std::make_unique<RequestLoggerFactory>());
+    builder.experimental().SetInterceptorCreators(std::move(loggers));
+  }
+  s.server = builder.BuildAndStart();
+  if (s.server == nullptr || port == 0) {
+    return absl::UnavailableError(
+        absl::StrCat("cannot listen on ", options.listen,
+                     " (address in use or not local, or an unusable TLS certificate or key)"));
+  }
+  LogLine(absl::StrCat("motiondb-server ", MOTIONDB_VERSION, " listening on ", options.listen,
+                       port != 0 ? absl::StrCat(" (port ", port, ")") : "",
+                       options.tls_cert_pem.empty() ? ", plain text" : ", TLS",
+                       options.auth_token.empty() ? "" : ", bearer token required"));
+  auto server = std::unique_ptr<MotionDbServer>(new MotionDbServer(std::move(state)));
+  server->port_ = port;
+  return server;
+}
+
+void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
+  // Health turns NOT_SERVING first, so load balancers and waiting clients look elsewhere.
+  if (grpc::HealthCheckServiceInterface* health = state_->server->GetHealthCheckService()) {
+    health->SetServingStatus(false);
+  }
+  state_->server->Shutdown(deadline);
+}
+
+void MotionDbServer::Wait() { state_->server->Wait(); }
+
+}  // namespace motiondb::server

@@ -1,0 +1,41 @@
+// The motiondb server, assembled: the database, the resident indices loaded from its cached
+// projections, the four motiondb.v1 services, the standard health service, server reflection,
+// the request log and the port's credentials (TLS, bearer token).
+#ifndef MOTIONDB_SERVER_GRPC_MOTIONDB_SERVER_H_
+#define MOTIONDB_SERVER_GRPC_MOTIONDB_SERVER_H_
+
+#include <chrono>
+#include <memory>
+
+#include <grpcpp/server.h>
+
+#include "absl/status/statusor.h"
+#include "server/server_options.h"
+
+namespace motiondb::server {
+
+class MotionDbServer {
+ public:
+  // Opens the database, loads every space's index, and starts serving. Errors name what failed
+  // (the database, a space, the port).
+  static absl::StatusOr<std::unique_ptr<MotionDbServer>> Start(const ServerOptions& options);
+  ~MotionDbServer();
+
+  // The port listened on (useful with port 0 in --listen).
+  int port() const { return port_; }
+  // Stops accepting calls, lets running ones finish until `deadline`, then cancels the rest.
+  void Shutdown(std::chrono::system_clock::time_point deadline);
+  // Blocks until Shutdown() has completed.
+  void Wait();
+
+ private:
+  struct State;
+  explicit MotionDbServer(std::unique_ptr<State> state);
+
+  std::unique_ptr<State> state_;
+  int port_ = 0;
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_GRPC_MOTIONDB_SERVER_H_

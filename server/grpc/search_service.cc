@@ -1,0 +1,59 @@
+#include "server/grpc/search_service.h"
+
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "server/grpc/call_context.h"
+#include "server/grpc/status_conversion.h"
+
+namespace motiondb::server {
+namespace {
+
+constexpr int kMaxBatch = 1000;
+
+}  // namespace
+
+grpc::Status SearchServiceImpl::Search(grpc::ServerContext* context,
+                                       const v1::SearchRequest* request,
+                                       v1::SearchResponse* response) {
+  absl::StatusOr<v1::SearchResponse> found =
+      RunSearch(*request, registry_, database_, limits_, StopWhenCallEnds(context));
+  if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
+  *response = *std::move(found);
+  return grpc::Status::OK;
+}
+
+absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
+                                      grpc::ServerContext* context,
+                                      v1::SearchBatchResponse* response) {
+  if (request.requests_size() > kMaxBatch) {
+    return absl::InvalidArgumentError(absl::StrCat("requests: ", request.requests_size(),
+                                                   " searches; at most ", kMaxBatch, " per batch"));
+  }
+  const std::function<bool()> should_stop = StopWhenCallEnds(context);
+  for (int i = 0; i < request.requests_size(); ++i) {
+    if (should_stop()) {
+      return ExplainStop(absl::CancelledError(absl::StrCat("before requests[", i, "]")), context);
+    }
+    absl::StatusOr<v1::SearchResponse> found =
+        RunSearch(request.requests(i), registry_, database_, limits_, should_stop);
+    // A stop ends the whole batch; any other failure belongs to its item alone.
+    if (absl::IsCancelled(found.status())) return ExplainStop(found.status(), context);
+    v1::SearchBatchItem* item = response->add_items();
+    if (found.ok()) {
+      *item->mutable_response() = *std::move(found);
+    } else {
+      item->set_code(static_cast<int>(found.status().code()));
+      item->set_message(absl::StrCat("requests[", i, "]: ", found.status().message()));
+    }
+  }
+  return absl::OkStatus();
+}
+
+grpc::Status SearchServiceImpl::SearchBatch(grpc::ServerContext* context,
+                                            const v1::SearchBatchRequest* request,
+                                            v1::SearchBatchResponse* response) {
+  return ToGrpcStatus(Batch(*request, context, response));
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,47 @@
+#include "testing/labelled_library.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_split.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/space/search_coordinates.h"
+#include "util/status_macros.h"
+
+namespace motiondb::testing {
+
+std::string ContentLabel(const std::filesystem::path& path) {
+  const std::vector<std::string> parts = absl::StrSplit(path.stem().string(), '_');
+  return parts.size() >= 2 ? parts[1] : path.stem().string();
+}
+
+absl::StatusOr<LabelledLibrary> LoadLabelledLibrary(const std::filesystem::path& folder,
+                                                    const SpaceOptions& space_options,
+                                                    const LibraryIndexOptions& index_options) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() == ".bvh") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  LabelledLibrary library;
+  std::vector<ClipRange> clips;
+  for (const std::filesystem::path& path : files) {
+    MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
+    clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
+    library.labels.push_back(ContentLabel(path));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, MotionSpace::Build(clips, space_options));
+  library.space = std::make_unique<MotionSpace>(std::move(space));
+  std::vector<LibraryClip> projected;
+  for (size_t i = 0; i < clips.size(); ++i) {
+    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates,
+                              SearchCoordinates(*library.space, clips[i].clip));
+    projected.push_back(
+        {static_cast<int64_t>(i), clips[i].source, {library.labels[i]}, std::move(coordinates)});
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      library.index,
+      LibraryIndex::Build(std::move(projected), library.space->sample_rate(), index_options));
+  return library;
+}
+
+}  // namespace motiondb::testing

@@ -1,0 +1,33 @@
+// A labelled folder of BVH files (e.g. ../shared/mocap/bandai2-normal) made searchable: a space
+// trained on every clip, and every clip's projection indexed. Shared by the retrieval-quality
+// test and the search_quality measurement program.
+#ifndef MOTIONDB_TESTING_LABELLED_LIBRARY_H_
+#define MOTIONDB_TESTING_LABELLED_LIBRARY_H_
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/library_index.h"
+#include "core/space/motion_space.h"
+
+namespace motiondb::testing {
+
+struct LabelledLibrary {
+  std::unique_ptr<MotionSpace> space;
+  std::unique_ptr<LibraryIndex> index;
+  std::vector<std::string> labels;  // per clip: the file name's content field
+};
+
+// "dataset-2_raise-up-left-hand_normal_003.bvh" -> "raise-up-left-hand".
+std::string ContentLabel(const std::filesystem::path& path);
+
+absl::StatusOr<LabelledLibrary> LoadLabelledLibrary(const std::filesystem::path& folder,
+                                                    const SpaceOptions& space_options,
+                                                    const LibraryIndexOptions& index_options);
+
+}  // namespace motiondb::testing
+
+#endif  // MOTIONDB_TESTING_LABELLED_LIBRARY_H_

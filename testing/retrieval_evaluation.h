@@ -1,0 +1,48 @@
+// Retrieval quality of a labelled library, leave-one-out: every clip is a query against all the
+// other clips. Measures precision@k of the label for the fast and (on a subset) the exact
+// search, and the fast search's recall against the exact one.
+#ifndef MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_
+#define MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/library_index.h"
+#include "core/search/search_params.h"
+
+namespace motiondb {
+
+struct RetrievalOptions {
+  // Search parameters of every query (filters are set by the evaluation).
+  SearchParams params;
+  // Precision is measured over the first this many results.
+  int precision_at = 5;
+  // Recall of the fast search against the exact search's first this many results.
+  int recall_at = 10;
+  // Every n-th query also runs the exact search (0: never).
+  int exact_every = 10;
+};
+
+struct RetrievalReport {
+  int queries = 0;
+  double precision = 0;  // fast search, mean over queries
+  int exact_queries = 0;
+  double exact_precision = 0;  // exact search, mean over its queries
+  double recall = 0;           // exact results found by the fast search (overlapping by half)
+  double latency_p50_ms = 0;
+  double latency_p99_ms = 0;
+  double exact_latency_p50_ms = 0;
+  std::map<std::string, double> precision_by_label;
+  std::map<std::string, double> mean_stage_ms;  // seeds, clusters, warps, refine, ranking
+};
+
+// `labels[c]` is clip c's label. Queries are the clips' own library coordinates.
+absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
+                                                    const std::vector<std::string>& labels,
+                                                    const RetrievalOptions& options);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_

