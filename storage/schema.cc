@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "storage/sqlite_transaction.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::storage {
 namespace {
@@ -139,10 +140,8 @@ absl::Status MigrateSchema(SqliteConnection& connection) {
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t version, connection.QueryInt64("PRAGMA user_version"));
   if (version == LatestSchemaVersion()) return absl::OkStatus();
   for (int next = static_cast<int>(version) + 1; next <= LatestSchemaVersion(); ++next) {
-    if (absl::Status status = connection.Execute(kMigrations[next - 1]); !status.ok()) {
-      return absl::Status(status.code(),
-                          absl::StrCat("schema migration ", next, ": ", status.message()));
-    }
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("schema migration ", next),
+                                      connection.Execute(kMigrations[next - 1])));
   }
   // PRAGMAs take no parameters; both values are numbers of ours.
   MOTIONDB_RETURN_IF_ERROR(

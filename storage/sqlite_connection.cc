@@ -44,6 +44,10 @@ absl::Status SqliteConnection::Execute(const std::string& sql) {
   return absl::OkStatus();
 }
 
+int64_t SqliteConnection::last_insert_rowid() const { return sqlite3_last_insert_rowid(db_); }
+
+int64_t SqliteConnection::changes() const { return sqlite3_changes64(db_); }
+
 absl::StatusOr<SqliteStatement> SqliteConnection::QueryRow(absl::string_view sql) {
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement statement, Prepare(sql));
   MOTIONDB_ASSIGN_OR_RETURN(const bool row, statement.Step());

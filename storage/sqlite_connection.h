@@ -42,6 +42,13 @@ class SqliteConnection {
   absl::StatusOr<std::string> QueryText(absl::string_view sql);
   absl::StatusOr<int64_t> QueryInt64(absl::string_view sql);
 
+  // The rowid of the row that the last successful INSERT on this connection added (0 before
+  // any), e.g. the id AUTOINCREMENT assigned.
+  int64_t last_insert_rowid() const;
+  // How many rows the last INSERT, UPDATE or DELETE on this connection changed itself, not
+  // counting those of foreign key cascades or triggers; a DELETE that matched nothing gives 0.
+  int64_t changes() const;
+
  private:
   explicit SqliteConnection(sqlite3* db) : db_(db) {}
   // `sql` prepared and stepped to its first row.

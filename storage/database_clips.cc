@@ -1,0 +1,263 @@
+#include <algorithm>
+#include <optional>
+#include <utility>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/container/flat_hash_set.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "storage/blob_codec.h"
+#include "storage/database.h"
+#include "storage/internal/database_impl.h"
+#include "storage/internal/record_checks.h"
+#include "storage/internal/record_rows.h"
+#include "util/status_macros.h"
+#include "util/status_prefix.h"
+
+namespace motiondb::storage {
+namespace {
+
+constexpr int kDefaultPageSize = 100;
+constexpr int kMaxPageSize = 1000;
+
+// The clip id after which a page starts: 0 for the first page, else the token, which is the last
+// clip id of the previous page in decimal.
+absl::StatusOr<int64_t> PageStart(const std::string& page_token) {
+  if (page_token.empty()) return 0;
+  int64_t after = 0;
+  const bool digits = std::all_of(page_token.begin(), page_token.end(),
+                                  [](char c) { return absl::ascii_isdigit(c); });
+  if (!digits || !absl::SimpleAtoi(page_token, &after) || after <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("malformed page_token '", page_token.substr(0, 40), "'"));
+  }
+  return after;
+}
+
+absl::Status InsertTags(SqliteConnection& db, int64_t clip_id,
+                        const std::vector<std::string>& tags) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement insert_tag,
+                            db.Prepare("INSERT INTO clip_tags (clip_id, tag) VALUES (?, ?)"));
+  for (const std::string& tag : tags) {
+    insert_tag.Reset();
+    MOTIONDB_RETURN_IF_ERROR(insert_tag.BindInt64(1, clip_id).BindText(2, tag).Run());
+  }
+  return absl::OkStatus();
+}
+
+// Inserts the new clip's projections, which must be one into every space of its skeleton.
+absl::Status InsertProjectionsOfClip(
+    SqliteConnection& db, int64_t clip_id, int64_t skeleton_id,
+    const std::vector<std::pair<int64_t, Projection>>& projections) {
+  // The spaces of this skeleton, each of which must receive the clip's projection.
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement spaces,
+      db.Prepare("SELECT space_id, name, dims FROM spaces WHERE skeleton_id = ?"));
+  spaces.BindInt64(1, skeleton_id);
+  absl::flat_hash_map<int64_t, std::pair<std::string, int>> needed;
+  while (true) {
+    MOTIONDB_ASSIGN_OR_RETURN(const bool row, spaces.Step());
+    if (!row) break;
+    needed[spaces.ColumnInt64(0)] = {spaces.ColumnText(1), static_cast<int>(spaces.ColumnInt64(2))};
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement insert_projection, PrepareProjectionInsert(db));
+  for (const auto& [space_id, projection] : projections) {
+    const auto space = needed.find(space_id);
+    if (space == needed.end()) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool exists,
+                                Exists(db, "SELECT 1 FROM spaces WHERE space_id = ?", space_id));
+      if (!exists) return absl::NotFoundError(absl::StrCat("space ", space_id, " not found"));
+      return absl::FailedPreconditionError(
+          absl::StrCat("space ", space_id, " belongs to another skeleton than the clip's"));
+    }
+    MOTIONDB_RETURN_IF_ERROR(CheckProjection(projection.coordinates, space->second.second,
+                                             absl::StrCat("projection into space ", space_id)));
+    MOTIONDB_RETURN_IF_ERROR(
+        InsertProjection(insert_projection, space_id, clip_id, projection.coordinates));
+    needed.erase(space);
+  }
+  if (!needed.empty()) {
+    const auto& [space_id, space] = *needed.begin();
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the clip has no projection into space ", space_id, " ('", space.first,
+        "') of its skeleton; a clip is stored with its projection into every such space"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<int64_t> Database::InsertClip(
+    const ClipRecord& record, const Clip& clip,
+    const std::vector<std::pair<int64_t, Projection>>& projections) {
+  MOTIONDB_RETURN_IF_ERROR(CheckName("clip name", record.name, kMaxNameBytes));
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckName("source file name", record.source_file, kMaxNameBytes, /*may_be_empty=*/true));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> tags, CanonicalTags(record.tags));
+  MOTIONDB_RETURN_IF_ERROR(CheckFloat32Range(clip.positions(), "clip position"));
+  absl::flat_hash_set<int64_t> space_ids;
+  for (const auto& [space_id, projection] : projections) {
+    if (!space_ids.insert(space_id).second) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("two projections of the clip into space ", space_id));
+    }
+    // The dimensions are checked against the stored space in InsertProjectionsOfClip.
+    MOTIONDB_RETURN_IF_ERROR(CheckProjection(projection.coordinates, std::nullopt,
+                                             absl::StrCat("projection into space ", space_id)));
+  }
+  // Encoded before the write lock, which other writers wait for.
+  const std::string key = TopologyKey(clip.skeleton());
+  const std::string layout = SkeletonLayoutBlob(clip.skeleton());
+  const std::string rotations = Float32Blob(clip.rotations());
+  const std::string positions = Float32Blob(clip.positions());
+  const int64_t now = CreationTime(record.created_unix_ms);
+
+  int64_t clip_id = 0;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "clips", "clip", record.name));
+    MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id,
+                              FindOrCreateSkeleton(db, clip.skeleton(), key, now));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement insert,
+        db.Prepare("INSERT INTO clips (name, source_file, skeleton_id, frame_time, frame_count, "
+                   "joint_count, position_joint_count, layout, rotations, positions, "
+                   "created_unix_ms) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+    MOTIONDB_RETURN_IF_ERROR(insert.BindText(1, record.name)
+                                 .BindText(2, record.source_file)
+                                 .BindInt64(3, skeleton_id)
+                                 .BindDouble(4, clip.frame_time())
+                                 .BindInt64(5, clip.frame_count())
+                                 .BindInt64(6, clip.skeleton().joint_count())
+                                 .BindInt64(7, clip.skeleton().position_joint_count())
+                                 .BindBlob(8, layout)
+                                 .BindBlob(9, rotations)
+                                 .BindBlob(10, positions)
+                                 .BindInt64(11, now)
+                                 .Run());
+    clip_id = db.last_insert_rowid();
+    MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, tags));
+    return InsertProjectionsOfClip(db, clip_id, skeleton_id, projections);
+  }));
+  return clip_id;
+}
+
+absl::StatusOr<int64_t> Database::FindSkeleton(const Skeleton& skeleton) {
+  const std::string key = TopologyKey(skeleton);
+  int64_t skeleton_id = -1;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement find,
+        db.Prepare("SELECT skeleton_id FROM skeletons WHERE topology_key = ?"));
+    MOTIONDB_ASSIGN_OR_RETURN(const bool found, find.BindText(1, key).Step());
+    if (found) skeleton_id = find.ColumnInt64(0);
+    return absl::OkStatus();
+  }));
+  return skeleton_id;
+}
+
+absl::StatusOr<std::vector<int64_t>> Database::ClipsOfSkeleton(int64_t skeleton_id) {
+  std::vector<int64_t> clip_ids;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const bool exists,
+        Exists(db, "SELECT 1 FROM skeletons WHERE skeleton_id = ?", skeleton_id));
+    if (!exists) return absl::NotFoundError(absl::StrCat("skeleton ", skeleton_id, " not found"));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement query,
+        db.Prepare("SELECT clip_id FROM clips WHERE skeleton_id = ? ORDER BY clip_id"));
+    query.BindInt64(1, skeleton_id);
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
+      if (!row) return absl::OkStatus();
+      clip_ids.push_back(query.ColumnInt64(0));
+    }
+  }));
+  return clip_ids;
+}
+
+absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id) {
+  std::optional<StoredClip> result;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement query,
+        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ", kClipFrameColumns,
+                                " FROM clips c WHERE c.clip_id = ?")));
+    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindInt64(1, clip_id).Step());
+    if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
+    ClipRecord record = ReadClipRecord(query);
+    MOTIONDB_ASSIGN_OR_RETURN(
+        Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id), ReadClip(query, record)));
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
+    MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
+    result.emplace(StoredClip{std::move(record), std::move(clip)});
+    return absl::OkStatus();
+  }));
+  return *std::move(result);
+}
+
+absl::StatusOr<ClipRecord> Database::GetClipRecord(int64_t clip_id) {
+  ClipRecord record;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
+                              db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns,
+                                                      " FROM clips c WHERE c.clip_id = ?")));
+    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindInt64(1, clip_id).Step());
+    if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
+    record = ReadClipRecord(query);
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
+    MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
+    return absl::OkStatus();
+  }));
+  return record;
+}
+
+absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string& tag) {
+  const int page_size = page.page_size == 0 ? kDefaultPageSize : page.page_size;
+  if (page_size < 1 || page_size > kMaxPageSize) {
+    return absl::InvalidArgumentError(absl::StrCat("page_size must be 1 to ", kMaxPageSize,
+                                                   " (0 for ", kDefaultPageSize, "), got ",
+                                                   page.page_size));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t after, PageStart(page.page_token));
+  if (!tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", tag, kMaxTagBytes));
+
+  ClipPage result;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    const std::string sql =
+        tag.empty()
+            ? absl::StrCat("SELECT ", kClipRecordColumns,
+                           " FROM clips c WHERE c.clip_id > ?1 ORDER BY c.clip_id LIMIT ?2")
+            : absl::StrCat("SELECT ", kClipRecordColumns,
+                           " FROM clip_tags t JOIN clips c ON c.clip_id = t.clip_id "
+                           "WHERE t.tag = ?3 AND t.clip_id > ?1 ORDER BY t.clip_id LIMIT ?2");
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query, db.Prepare(sql));
+    // One row more than the page says whether another page follows.
+    query.BindInt64(1, after).BindInt64(2, page_size + 1);
+    if (!tag.empty()) query.BindText(3, tag);
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
+      if (!row) break;
+      if (static_cast<int>(result.clips.size()) == page_size) {
+        result.next_page_token = absl::StrCat(result.clips.back().clip_id);
+        break;
+      }
+      ClipRecord record = ReadClipRecord(query);
+      MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, record.clip_id));
+      result.clips.push_back(std::move(record));
+    }
+    return absl::OkStatus();
+  }));
+  return result;
+}
+
+absl::Status Database::DeleteClip(int64_t clip_id) {
+  return impl_->Write([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement erase,
+                              db.Prepare("DELETE FROM clips WHERE clip_id = ?"));
+    return DeleteRow(db, erase.BindInt64(1, clip_id), absl::StrCat("clip ", clip_id, " not found"));
+  });
+}
+
+}  // namespace motiondb::storage
