@@ -48,7 +48,7 @@ bool LoadCorpus() {
     return false;
   }
   Corpus& corpus = TheCorpus();
-  std::vector<ClipRange> training;
+  std::vector<TrainingClip> training;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".bvh") continue;
     absl::StatusOr<BvhReadResult> read = ReadBvhFile(entry.path().string());

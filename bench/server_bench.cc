@@ -6,7 +6,7 @@
 //     transaction and the resident index rebuilt aside and swapped);
 //  2. searches per second and client-side p50/p99 latency with 1, 4 and 16 concurrent clients,
 //     each on its own connection, every stored clip in turn as the query, default parameters;
-//  3. the baseline: the same searches in process (server::RunSearch on the same database and
+//  3. the baseline: the same searches in process (server::SearchRunner on the same database and
 //     indices loaded as the server loads them, no gRPC) with 1 and 2 threads, measured in turns
 //     interleaved with the served ones;
 //  4. the server's resident memory (VmRSS and its peak, VmHWM);
@@ -38,7 +38,6 @@
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "server/catalog.h"
-#include "server/clip_facts.h"
 #include "server/index_registry.h"
 #include "server/search_runner.h"
 #include "storage/database.h"
@@ -260,9 +259,9 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
   MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
                             storage::Database::Open(db));
   server::IndexRegistry registry;
-  server::ClipFactsCache facts(*database);
-  server::Library library(*database, registry, facts);
-  MOTIONDB_RETURN_IF_ERROR(library.LoadIndices());
+  server::Catalog catalog(*database, registry);
+  MOTIONDB_RETURN_IF_ERROR(catalog.LoadIndices());
+  const server::SearchRunner runner(registry, *database, {});
 
   // Served and in-process searching take turns of a second or so (the server started afresh for
   // each turn, and stopped while the baseline runs), so that a change in the speed of the
@@ -316,12 +315,15 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
     }
     for (Way& way : ways) {
       if (way.served) continue;
-      MOTIONDB_ASSIGN_OR_RETURN(
-          const Throughput part, Measure(way.threads, seconds / turns, [&](int worker, int64_t k) {
-            return server::RunSearch(QueryOf(ids[(worker * 7919 + k) % ids.size()]), registry,
-                                     *database, {}, [] { return false; })
-                .status();
-          }));
+      MOTIONDB_ASSIGN_OR_RETURN(const Throughput part,
+                                Measure(way.threads, seconds / turns, [&](int worker, int64_t k) {
+                                  server::SearchRequest request;
+                                  request.space = "bench";
+                                  server::ClipSelection query;
+                                  query.clip_id = ids[(worker * 7919 + k) % ids.size()];
+                                  request.query = query;
+                                  return runner.Run(request, [] { return false; }).status();
+                                }));
       Add(part, turns, way.total);
     }
   }
@@ -365,22 +367,21 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
     MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
                               storage::Database::Open(db));
     server::IndexRegistry registry;
-    server::ClipFactsCache facts(*database);
-    server::Library library(*database, registry, facts);
+    server::Catalog catalog(*database, registry);
     int64_t first_id = 0;
     for (size_t c = 0; c < generated.clips.size(); ++c) {
       storage::ClipRecord record;
       record.name = absl::StrCat("synthetic_", c);
       record.source_file = record.name + ".bvh";
       MOTIONDB_ASSIGN_OR_RETURN(const server::IngestedClip ingested,
-                                library.IngestClip(record, generated.clips[c]));
-      if (c == 0) first_id = ingested.clip_id;
+                                catalog.IngestClip(record, generated.clips[c]));
+      if (c == 0) first_id = ingested.record.clip_id;
       frames += generated.clips[c].frame_count();
     }
     server::SpaceRequest space;
     space.name = "synthetic";
     space.training = {{first_id, std::nullopt, std::nullopt}};
-    MOTIONDB_RETURN_IF_ERROR(library.CreateSpace(space, [] { return false; }).status());
+    MOTIONDB_RETURN_IF_ERROR(catalog.CreateSpace(space, [] { return false; }).status());
   }
   const double prepare_s = SecondsSince(start);
   const double db_mib = std::filesystem::file_size(db) / 1048576.0;

@@ -9,6 +9,7 @@
 #include "core/motion/resample.h"
 #include "util/command_line.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::cli {
 namespace {
@@ -34,10 +35,7 @@ absl::Status Convert(const CommandLine& line) {
   Clip clip = std::move(read.clip);
   if (from || to) {
     const FrameRange range{from.value_or(0), to.value_or(clip.frame_count() - 1)};
-    absl::StatusOr<Clip> cut = clip.Slice(range);
-    if (!cut.ok())
-      return absl::Status(cut.status().code(), absl::StrCat(in, ": ", cut.status().message()));
-    clip = *std::move(cut);
+    MOTIONDB_ASSIGN_OR_RETURN(clip, Prefixed(in, clip.Slice(range)));
   }
   if (fps) {
     MOTIONDB_ASSIGN_OR_RETURN(clip, Resample(clip, *fps));

@@ -9,6 +9,7 @@
 #include "core/space/space_serialization.h"
 #include "util/command_line.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::cli {
 namespace {
@@ -36,11 +37,9 @@ absl::Status Project(const CommandLine& line) {
   for (const std::string& warning : read.warnings) {
     std::cerr << "motiondb project: warning: " << path << ": " << warning << "\n";
   }
-  absl::StatusOr<RowMatrixXd> curve = space.ProjectClip(read.clip, dims);
-  if (!curve.ok()) {
-    return absl::Status(curve.status().code(),
-                        absl::StrCat(path, " in ", *space_path, ": ", curve.status().message()));
-  }
+  absl::StatusOr<RowMatrixXd> curve =
+      Prefixed(absl::StrCat(path, " in ", *space_path), space.ProjectClip(read.clip, dims));
+  if (!curve.ok()) return curve.status();
   const bool csv = line.flag("csv");
   if (csv) {
     std::string header = "frame,time_s";

@@ -17,6 +17,7 @@
 #include "util/command_line.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::cli {
 namespace {
@@ -35,7 +36,7 @@ constexpr int64_t kMaxWeightsFileBytes = int64_t{1} << 20;
 
 // FILE or FILE:FROM-TO. A suffix after the last ':' that is not digits and one '-' is taken as
 // part of the file name.
-absl::StatusOr<ClipRange> LoadTrainingRange(const std::string& spec) {
+absl::StatusOr<TrainingClip> LoadTrainingRange(const std::string& spec) {
   std::string path = spec;
   std::optional<FrameRange> frames;
   if (const size_t colon = spec.rfind(':'); colon != std::string::npos) {
@@ -57,7 +58,7 @@ absl::StatusOr<ClipRange> LoadTrainingRange(const std::string& spec) {
   for (const std::string& warning : read.warnings) {
     std::cerr << "motiondb space: warning: " << path << ": " << warning << "\n";
   }
-  return ClipRange{spec, std::move(read.clip), frames};
+  return TrainingClip{spec, std::move(read.clip), frames};
 }
 
 absl::Status ApplyWeights(const std::string& weights, SpaceOptions* options) {
@@ -66,12 +67,8 @@ absl::Status ApplyWeights(const std::string& weights, SpaceOptions* options) {
     return absl::OkStatus();
   }
   MOTIONDB_ASSIGN_OR_RETURN(const std::string text, ReadFileBytes(weights, kMaxWeightsFileBytes));
-  absl::StatusOr<std::map<std::string, double>> overrides = ParseWeightOverrides(text);
-  if (!overrides.ok()) {
-    return absl::Status(overrides.status().code(),
-                        absl::StrCat(weights, ": ", overrides.status().message()));
-  }
-  options->weights.overrides = *std::move(overrides);
+  MOTIONDB_ASSIGN_OR_RETURN(options->weights.overrides,
+                            Prefixed(weights, ParseWeightOverrides(text)));
   return absl::OkStatus();
 }
 
@@ -160,20 +157,16 @@ absl::Status Build(const CommandLine& line) {
   const std::optional<std::string> out = line.value("out");
   if (!out) return absl::InvalidArgumentError("no --out file given");
   MOTIONDB_ASSIGN_OR_RETURN(const SpaceOptions options, ParseOptions(line));
-  std::vector<ClipRange> training;
+  std::vector<TrainingClip> training;
   for (const std::string& spec : specs) {
-    MOTIONDB_ASSIGN_OR_RETURN(ClipRange range, LoadTrainingRange(spec));
+    MOTIONDB_ASSIGN_OR_RETURN(TrainingClip range, LoadTrainingRange(spec));
     training.push_back(std::move(range));
   }
   if (const std::optional<std::string> weights = line.value("weights");
       weights && !options.weights.overrides.empty()) {
     // Name the weights file when one of its joints is not in the training skeleton.
-    const absl::StatusOr<Eigen::VectorXd> resolved =
-        ComputeJointWeights(training.front().clip.skeleton(), options.weights);
-    if (!resolved.ok()) {
-      return absl::Status(resolved.status().code(),
-                          absl::StrCat(*weights, ": ", resolved.status().message()));
-    }
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(
+        *weights, ComputeJointWeights(training.front().clip.skeleton(), options.weights).status()));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const MotionSpace space, MotionSpace::Build(training, options));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,

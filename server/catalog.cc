@@ -3,6 +3,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/space/search_coordinates.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::server {
 namespace {
@@ -16,7 +17,7 @@ absl::Status StaleIndexError(const std::string& space, const absl::Status& statu
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::LoadSpace(
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::LoadSpace(
     const storage::SpaceRecord& record) {
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, database_.GetSpace(record.space_id));
   MOTIONDB_ASSIGN_OR_RETURN(std::vector<storage::Projection> projections,
@@ -24,34 +25,31 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::LoadSpace(
   std::vector<IndexedClip> clips;
   clips.reserve(projections.size());
   for (storage::Projection& projection : projections) {
-    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord clip,
+    MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord clip,
                               database_.GetClipRecord(projection.clip_id));
-    MOTIONDB_ASSIGN_OR_RETURN(const ClipFacts facts, facts_.Get(projection.clip_id));
-    clips.push_back({projection.clip_id,
-                     {clip.name, clip.tags, facts.fps, facts.frame_count},
-                     std::move(projection.coordinates)});
+    const ClipTiming timing = ClipTiming::Of(clip);
+    clips.push_back({{projection.clip_id, std::move(clip.name), std::move(clip.tags),
+                      std::move(projection.coordinates)},
+                     timing});
   }
   return BuildSnapshot(record, std::make_shared<const MotionSpace>(std::move(space)),
                        std::move(clips));
 }
 
-absl::Status Library::LoadIndices() {
+absl::Status Catalog::LoadIndices() {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<storage::SpaceRecord> records,
                             database_.ListSpaces());
   for (const storage::SpaceRecord& record : records) {
-    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> snapshot = LoadSpace(record);
-    if (!snapshot.ok()) {
-      return absl::Status(
-          snapshot.status().code(),
-          absl::StrCat("loading space ", record.name, ": ", snapshot.status().message()));
-    }
-    registry_.Put(*std::move(snapshot));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        std::shared_ptr<const SpaceSnapshot> snapshot,
+        Prefixed(absl::StrCat("loading space ", record.name), LoadSpace(record)));
+    registry_.Put(std::move(snapshot));
   }
   return absl::OkStatus();
 }
 
-absl::StatusOr<IngestedClip> Library::IngestClip(const storage::ClipRecord& record,
+absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& record,
                                                  const Clip& clip) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database_.FindSkeleton(clip.skeleton()));
@@ -63,13 +61,14 @@ absl::StatusOr<IngestedClip> Library::IngestClip(const storage::ClipRecord& reco
     projections.push_back({space->record.space_id, storage::Projection{0, std::move(coordinates)}});
   }
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id, database_.InsertClip(record, clip, projections));
-  facts_.Put(clip_id, ClipFacts::Of(clip));
-
-  IngestedClip ingested{clip_id, {}};
-  const IndexedClipInfo info{record.name, record.tags, clip.fps(), clip.frame_count()};
+  IngestedClip ingested;
+  MOTIONDB_ASSIGN_OR_RETURN(ingested.record, database_.GetClipRecord(clip_id));
+  const ClipTiming timing = ClipTiming::Of(ingested.record);
   for (size_t i = 0; i < spaces.size(); ++i) {
     absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
-        SnapshotWithClip(*spaces[i], {clip_id, info, std::move(projections[i].second.coordinates)});
+        SnapshotWithClip(*spaces[i], {{clip_id, ingested.record.name, ingested.record.tags,
+                                       std::move(projections[i].second.coordinates)},
+                                      timing});
     if (!updated.ok()) return StaleIndexError(spaces[i]->record.name, updated.status());
     registry_.Put(*std::move(updated));
     ingested.spaces.push_back(spaces[i]->record.name);
@@ -77,11 +76,10 @@ absl::StatusOr<IngestedClip> Library::IngestClip(const storage::ClipRecord& reco
   return ingested;
 }
 
-absl::Status Library::DeleteClip(int64_t clip_id) {
+absl::Status Catalog::DeleteClip(int64_t clip_id) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record, database_.GetClipRecord(clip_id));
   MOTIONDB_RETURN_IF_ERROR(database_.DeleteClip(clip_id));
-  facts_.Erase(clip_id);
   for (const auto& space : registry_.OfSkeleton(record.skeleton_id)) {
     absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
         SnapshotWithoutClip(*space, clip_id);
@@ -91,7 +89,7 @@ absl::Status Library::DeleteClip(int64_t clip_id) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::CreateSpace(
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::CreateSpace(
     const SpaceRequest& request, const std::function<bool()>& should_stop) {
   MOTIONDB_RETURN_IF_ERROR(ValidateSpaceName(request.name));
   std::lock_guard<std::mutex> lock(write_mutex_);
@@ -99,16 +97,16 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::CreateSpace(
   if (registry_.Find(request.name) != nullptr) {
     return absl::AlreadyExistsError(absl::StrCat("a space named ", request.name, " exists"));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(BuiltSpace built, BuildSpace(database_, facts_, request, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(BuiltSpace built, BuildSpace(database_, request, should_stop));
   std::vector<storage::Projection> projections;
   projections.reserve(built.clips.size());
   for (IndexedClip& clip : built.clips) {
-    projections.push_back({clip.clip_id, std::move(clip.coordinates)});
+    projections.push_back({clip.clip.clip_id, std::move(clip.clip.coordinates)});
   }
   MOTIONDB_ASSIGN_OR_RETURN(built.record.space_id,
                             database_.InsertSpace(built.record, *built.space, projections));
   for (size_t i = 0; i < built.clips.size(); ++i) {
-    built.clips[i].coordinates = std::move(projections[i].coordinates);
+    built.clips[i].clip.coordinates = std::move(projections[i].coordinates);
   }
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> snapshot =
       BuildSnapshot(built.record, built.space, std::move(built.clips));
@@ -123,7 +121,7 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Library::CreateSpace(
   return *std::move(snapshot);
 }
 
-absl::Status Library::DeleteSpace(const std::string& name) {
+absl::Status Catalog::DeleteSpace(const std::string& name) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_RETURN_IF_ERROR(database_.DeleteSpace(name));
   registry_.Remove(name);

@@ -17,7 +17,6 @@
 
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
-#include "server/clip_facts.h"
 #include "server/index_registry.h"
 #include "server/space_builder.h"
 #include "storage/database.h"
@@ -25,21 +24,21 @@
 namespace motiondb::server {
 
 struct IngestedClip {
-  int64_t clip_id = 0;
+  storage::ClipRecord record;       // as stored: with its id, skeleton and creation time
   std::vector<std::string> spaces;  // projected into
 };
 
-class Library {
+class Catalog {
  public:
-  Library(storage::Database& database, IndexRegistry& registry, ClipFactsCache& facts)
-      : database_(database), registry_(registry), facts_(facts) {}
+  Catalog(storage::Database& database, IndexRegistry& registry)
+      : database_(database), registry_(registry) {}
 
   // Loads every stored space and its cached projections into the registry (at start; nothing
   // is recomputed).
   absl::Status LoadIndices();
 
   // Stores the clip with its projection into every space of its skeleton.
-  // The database assigns the clip's id and skeleton.
+  // The database assigns the clip's id, skeleton and creation time.
   absl::StatusOr<IngestedClip> IngestClip(const storage::ClipRecord& record, const Clip& clip);
   absl::Status DeleteClip(int64_t clip_id);
 
@@ -54,7 +53,6 @@ class Library {
 
   storage::Database& database_;
   IndexRegistry& registry_;
-  ClipFactsCache& facts_;
   std::mutex write_mutex_;
 };
 

@@ -34,21 +34,21 @@ class FrameConversion {
   int64_t space_frames_;
 };
 
-// An optional first/last pair from a request, checked against a clip of `frame_count` frames:
-// unset bounds are the clip's ends; INVALID_ARGUMENT names `field` when a bound lies outside the
-// clip or first > last.
+// A stored clip, whole or a range of its frames (at its own rate), as a request names it:
+// unset bounds are the clip's ends.
+struct ClipSelection {
+  int64_t clip_id = 0;
+  std::optional<int> first_frame;
+  std::optional<int> last_frame;
+};
+
+// The selection's frames, checked against a clip of `frame_count` frames: INVALID_ARGUMENT
+// naming `field` when a bound lies outside the clip or first > last.
 absl::StatusOr<FrameRange> ResolveFrameRange(std::optional<int> first, std::optional<int> last,
                                              int frame_count, absl::string_view field);
-
-// The same for a request message with `optional int32 first_frame` and `last_frame`
-// (motiondb.v1.ClipRange, BvhQuery).
-template <typename RangeMessage>
-absl::StatusOr<FrameRange> ResolveFrameRange(const RangeMessage& message, int frame_count,
-                                             absl::string_view field) {
-  return ResolveFrameRange(
-      message.has_first_frame() ? std::optional<int>(message.first_frame()) : std::nullopt,
-      message.has_last_frame() ? std::optional<int>(message.last_frame()) : std::nullopt,
-      frame_count, field);
+inline absl::StatusOr<FrameRange> ResolveFrameRange(const ClipSelection& selection, int frame_count,
+                                                    absl::string_view field) {
+  return ResolveFrameRange(selection.first_frame, selection.last_frame, frame_count, field);
 }
 
 }  // namespace motiondb::server

@@ -8,17 +8,15 @@
 namespace motiondb::server {
 namespace {
 
-// The kd-tree's dimensions: the search's default seed dimensions, or fewer for a small space.
-constexpr int kAnnDims = 10;
-
 // Every clip of `base`, except `skip_id`, as clips to index again.
 std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
   std::vector<IndexedClip> clips;
   if (!base.index) return clips;
   for (int c = 0; c < base.index->clip_count(); ++c) {
-    const int64_t id = base.index->clip(c).clip_id;
-    if (id == skip_id) continue;
-    clips.push_back({id, base.clips.at(id), base.index->CopyClipCoordinates(c)});
+    const LibraryIndex::ClipEntry& entry = base.index->clip(c);
+    if (entry.clip_id == skip_id) continue;
+    clips.push_back({{entry.clip_id, entry.name, entry.tags, base.index->CopyClipCoordinates(c)},
+                     base.clips.at(entry.clip_id)});
   }
   return clips;
 }
@@ -26,9 +24,9 @@ std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
 }  // namespace
 
 FrameConversion SpaceSnapshot::Conversion(int64_t clip_id) const {
-  const IndexedClipInfo& info = clips.at(clip_id);
+  const ClipTiming& timing = clips.at(clip_id);
   const LibraryIndex::ClipEntry& entry = index->clip(index->FindClip(clip_id));
-  return FrameConversion(info.fps, info.frame_count, space->sample_rate(), entry.frame_count);
+  return FrameConversion(timing.fps, timing.frame_count, space->sample_rate(), entry.frame_count);
 }
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
@@ -38,16 +36,18 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
   snapshot->record = std::move(record);
   snapshot->space = std::move(space);
   if (clips.empty()) return snapshot;
-  std::sort(clips.begin(), clips.end(),
-            [](const IndexedClip& a, const IndexedClip& b) { return a.clip_id < b.clip_id; });
+  std::sort(clips.begin(), clips.end(), [](const IndexedClip& a, const IndexedClip& b) {
+    return a.clip.clip_id < b.clip.clip_id;
+  });
   std::vector<LibraryClip> library;
   library.reserve(clips.size());
   for (IndexedClip& clip : clips) {
-    library.push_back({clip.clip_id, clip.info.name, clip.info.tags, std::move(clip.coordinates)});
-    snapshot->clips.emplace(clip.clip_id, std::move(clip.info));
+    snapshot->clips.emplace(clip.clip.clip_id, clip.timing);
+    library.push_back(std::move(clip.clip));
   }
+  // The kd-tree's dimensions: the search's default seed dimensions, or all of a smaller space's.
   LibraryIndexOptions options;
-  options.ann_dims = std::min(kAnnDims, snapshot->space->dims());
+  options.ann_dims = std::min(options.ann_dims, snapshot->space->dims());
   MOTIONDB_ASSIGN_OR_RETURN(
       std::unique_ptr<LibraryIndex> index,
       LibraryIndex::Build(std::move(library), snapshot->space->sample_rate(), options));
@@ -57,19 +57,19 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
                                                                       IndexedClip clip) {
-  if (base.index && !base.clips.contains(clip.clip_id)) {
+  if (base.index && !base.clips.contains(clip.clip.clip_id)) {
     // A new clip: added beside the base's index, sharing its coordinates and kd-trees.
     auto snapshot = std::make_shared<SpaceSnapshot>();
     snapshot->record = base.record;
     snapshot->space = base.space;
     snapshot->clips = base.clips;
-    MOTIONDB_ASSIGN_OR_RETURN(snapshot->index,
-                              base.index->WithClips({{clip.clip_id, clip.info.name, clip.info.tags,
-                                                      std::move(clip.coordinates)}}));
-    snapshot->clips.emplace(clip.clip_id, std::move(clip.info));
+    snapshot->clips.emplace(clip.clip.clip_id, clip.timing);
+    std::vector<LibraryClip> added;
+    added.push_back(std::move(clip.clip));
+    MOTIONDB_ASSIGN_OR_RETURN(snapshot->index, base.index->WithClips(std::move(added)));
     return snapshot;
   }
-  std::vector<IndexedClip> clips = ClipsOf(base, clip.clip_id);
+  std::vector<IndexedClip> clips = ClipsOf(base, clip.clip.clip_id);
   clips.push_back(std::move(clip));
   return BuildSnapshot(base.record, base.space, std::move(clips));
 }

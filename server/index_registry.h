@@ -22,20 +22,22 @@
 
 namespace motiondb::server {
 
-// What the search needs to know about an indexed clip beyond its coordinates.
-struct IndexedClipInfo {
-  std::string name;
-  std::vector<std::string> tags;
-  double fps = 0;       // original rate
-  int frame_count = 0;  // original frames
+// An indexed clip's own rate and frame count, which its index entry (at the space rate) does
+// not know and every frame conversion needs.
+struct ClipTiming {
+  double fps = 0;
+  int frame_count = 0;
+
+  static ClipTiming Of(const storage::ClipRecord& record) {
+    return {1.0 / record.frame_time, static_cast<int>(record.frame_count)};
+  }
 };
 
-// A clip to index: its info and its projection (frames at the space rate x the space's dims,
-// pre-scaled by the metric, as storage::Projection holds it).
+// A clip to index: its id, name, tags and projection (frames at the space rate x the space's
+// dims, pre-scaled by the metric, as storage::Projection holds it), and its timing.
 struct IndexedClip {
-  int64_t clip_id = 0;
-  IndexedClipInfo info;
-  RowMatrixXf coordinates;
+  LibraryClip clip;
+  ClipTiming timing;
 };
 
 struct SpaceSnapshot {
@@ -43,7 +45,8 @@ struct SpaceSnapshot {
   std::shared_ptr<const MotionSpace> space;
   // Null when the space's skeleton has no clips left.
   std::shared_ptr<const LibraryIndex> index;
-  absl::flat_hash_map<int64_t, IndexedClipInfo> clips;
+  // Every indexed clip's timing; names and tags are the index's.
+  absl::flat_hash_map<int64_t, ClipTiming> clips;
 
   // The indexed clip's frame mapping; the clip must be indexed.
   FrameConversion Conversion(int64_t clip_id) const;

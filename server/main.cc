@@ -17,7 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "server/grpc/motiondb_server.h"
 #include "server/grpc/request_logger.h"
-#include "server/server_options.h"
+#include "server/grpc/server_options.h"
 #include "util/command_line.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
@@ -74,7 +74,7 @@ absl::StatusOr<motiondb::server::ServerOptions> ParseOptions(
   MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> bvh_mb, line.integer("max-bvh-mb"));
   if (bvh_mb) {
     if (*bvh_mb < 1) return absl::InvalidArgumentError("--max-bvh-mb must be at least 1");
-    options.max_bvh_bytes = int64_t{*bvh_mb} << 20;
+    options.uploads.max_bvh_bytes = int64_t{*bvh_mb} << 20;
   }
   if (const std::optional<std::string> path = line.value("auth-token-file")) {
     MOTIONDB_ASSIGN_OR_RETURN(options.auth_token, ReadToken(*path));

@@ -1,30 +1,87 @@
-// One search, from request message to response message: the query's coordinates (rows of a
-// stored clip's cached projection, or an uploaded BVH projected on the spot), the parameters
-// with the thesis's defaults for what is unset, and the results with frame numbers converted
-// back to each clip's own rate.
+// One search, from request to ranked hits: the query's coordinates (rows of a stored clip's
+// cached projection, or an uploaded BVH projected on the spot), the parameters with the
+// thesis's defaults for what is unset, and the hits with frame numbers converted back to each
+// clip's own rate.
 #ifndef MOTIONDB_SERVER_SEARCH_RUNNER_H_
 #define MOTIONDB_SERVER_SEARCH_RUNNER_H_
 
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
 
 #include "absl/status/statusor.h"
-#include "motiondb/v1/search_service.pb.h"
+#include "core/search/search_params.h"
+#include "core/search/search_result.h"
+#include "server/frame_conversion.h"
 #include "server/index_registry.h"
+#include "server/upload.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
-struct SearchLimits {
-  int64_t max_bvh_bytes = int64_t{1} << 30;  // for uploaded queries
+// A query sent as a BVH file, whole or a range of its frames (at its own rate).
+struct UploadedQuery {
+  std::string bvh;
+  std::optional<int> first_frame;
+  std::optional<int> last_frame;
 };
 
-// Runs `request` against the space it names. `should_stop` ends the search with CANCELLED.
-absl::StatusOr<v1::SearchResponse> RunSearch(const v1::SearchRequest& request,
-                                             const IndexRegistry& registry,
-                                             storage::Database& database,
-                                             const SearchLimits& limits,
-                                             const std::function<bool()>& should_stop);
+struct SearchRequest {
+  std::string space;
+  // A stored clip's frames or an uploaded file's; monostate is INVALID_ARGUMENT.
+  std::variant<std::monostate, ClipSelection, UploadedQuery> query;
+  // Every parameter but the three below, which the request states in its own terms.
+  SearchParams params;
+  // Unset: SearchParams' defaults, or all of a smaller space's dimensions.
+  std::optional<int> ann_dims;
+  std::optional<int> dtw_dims;
+  // A query frame at the query clip's own rate, inside its range; unset: found automatically.
+  std::optional<int> characteristic_frame;
+  // The exhaustive search instead of the seeded one.
+  bool exact = false;
+};
+
+// A ranked time range, in the clip's own frames (inclusive).
+struct SearchHit {
+  int64_t clip_id = 0;
+  std::string clip_name;
+  double start_s = 0;
+  double end_s = 0;
+  int start_frame = 0;
+  int end_frame = 0;
+  double score = 0;       // mean pose distance along the warp; lower is better
+  int seed_frame = -1;    // the frame matched to the characteristic query frame; -1 in exact mode
+  std::vector<int> path;  // per query sample at the space rate, when requested
+};
+
+struct SearchOutcome {
+  std::vector<SearchHit> hits;
+  SearchStats stats;              // zero when the space holds no clips
+  int characteristic_frame = -1;  // at the query clip's rate; -1 when none was used
+  int64_t query_frames = 0;       // at the space rate
+  int64_t library_frames = 0;
+  double request_ms = 0;  // the whole request, query projection included
+};
+
+// Thread-safe: searches run concurrently on immutable snapshots.
+class SearchRunner {
+ public:
+  SearchRunner(const IndexRegistry& registry, storage::Database& database,
+               const UploadLimits& limits)
+      : registry_(registry), database_(database), limits_(limits) {}
+
+  // Runs `request` against the space it names. `should_stop` ends the search with CANCELLED.
+  absl::StatusOr<SearchOutcome> Run(const SearchRequest& request,
+                                    const std::function<bool()>& should_stop) const;
+
+ private:
+  const IndexRegistry& registry_;
+  storage::Database& database_;
+  UploadLimits limits_;
+};
 
 }  // namespace motiondb::server
 

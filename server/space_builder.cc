@@ -1,10 +1,10 @@
 #include "server/space_builder.h"
 
 #include <chrono>
-#include <cmath>
 #include <map>
 
 #include "absl/strings/str_cat.h"
+#include "core/motion/resample.h"
 #include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
 #include "server/space_report.h"
@@ -66,11 +66,6 @@ absl::StatusOr<int64_t> ResolveSkeleton(storage::Database& database, const Space
   return page.clips.front().skeleton_id;
 }
 
-// Samples Resample() makes of `frames` frames: every k with k / rate within the span.
-int64_t SampleCount(int frames, double fps, double rate) {
-  return static_cast<int64_t>(std::floor((frames - 1) / fps * rate + 1e-9)) + 1;
-}
-
 }  // namespace
 
 absl::Status ValidateSpaceName(const std::string& name) {
@@ -88,8 +83,7 @@ absl::Status ValidateSpaceName(const std::string& name) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCache& facts,
-                                      const SpaceRequest& request,
+absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRequest& request,
                                       const std::function<bool()>& should_stop) {
   const auto start = std::chrono::steady_clock::now();
   auto check_stop = [&]() -> absl::Status {
@@ -104,13 +98,13 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCach
   }
 
   // Training clips are kept loaded: they are trained on, measured, and projected.
-  std::vector<TrainingRange> ranges = request.training;
+  std::vector<ClipSelection> ranges = request.training;
   if (ranges.empty()) {
     for (const int64_t id : clip_ids) ranges.push_back({id, std::nullopt, std::nullopt});
   }
   std::map<int64_t, storage::StoredClip> loaded;
-  std::vector<ClipRange> training;
-  v1::SpaceBuildReport report;
+  std::vector<TrainingClip> training;
+  std::vector<TrainingReport> used;
   int64_t training_frames = 0;
   for (size_t i = 0; i < ranges.size(); ++i) {
     MOTIONDB_RETURN_IF_ERROR(check_stop());
@@ -122,14 +116,11 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCach
     const Clip& clip = it->second.clip;
     MOTIONDB_ASSIGN_OR_RETURN(
         const FrameRange frames,
-        ResolveFrameRange(ranges[i].first_frame, ranges[i].last_frame, clip.frame_count(),
-                          absl::StrCat("training[", i, "]")));
+        ResolveFrameRange(ranges[i], clip.frame_count(), absl::StrCat("training[", i, "]")));
     training.push_back({it->second.record.name, clip, frames});
-    v1::ClipRange* used = report.add_training();
-    used->set_clip_id(ranges[i].clip_id);
-    used->set_first_frame(frames.first);
-    used->set_last_frame(frames.last);
-    training_frames += SampleCount(frames.size(), clip.fps(), request.options.sample_rate);
+    used.push_back({ranges[i].clip_id, frames});
+    training_frames +=
+        ResampledFrameCount(frames.size(), clip.frame_time(), request.options.sample_rate);
   }
 
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built, MotionSpace::Build(training, request.options));
@@ -151,23 +142,18 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCach
     }
     MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, std::move(loaded_clip));
     MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space, stored.clip));
-    facts.Put(id, ClipFacts::Of(stored.clip));
-    result.clips.push_back(
-        {id,
-         {stored.record.name, stored.record.tags, stored.clip.fps(), stored.clip.frame_count()},
-         std::move(coordinates)});
+    result.clips.push_back({{id, stored.record.name, stored.record.tags, std::move(coordinates)},
+                            ClipTiming::Of(stored.record)});
   }
 
-  // The training list was filled above; the rest describes the finished space.
-  v1::SpaceBuildReport description = DescribeSpace(*space);
-  description.mutable_training()->Swap(report.mutable_training());
-  report = std::move(description);
-  report.set_weight_preset(ToProto(request.options.weights.preset));
-  report.set_training_frames(training_frames);
-  AddReconstructionErrors(errors, &report);
-  report.set_projected_clips(static_cast<int64_t>(result.clips.size()));
-  report.set_build_ms(
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  SpaceReport report = DescribeSpace(*space);
+  report.training = std::move(used);
+  report.weight_preset = request.options.weights.preset;
+  report.training_frames = training_frames;
+  report.reconstruction_error = errors;
+  report.projected_clips = static_cast<int64_t>(result.clips.size());
+  report.build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
   result.record.name = request.name;
   result.record.skeleton_id = skeleton_id;

@@ -1,6 +1,6 @@
 // Building a space from the database (SpaceService.CreateSpace): resolve the skeleton and the
 // training ranges, learn the space, measure its reconstruction error, and project every clip of
-// the skeleton into it. Writes nothing: server/library.h stores the result.
+// the skeleton into it. Writes nothing: server/catalog.h stores the result.
 #ifndef MOTIONDB_SERVER_SPACE_BUILDER_H_
 #define MOTIONDB_SERVER_SPACE_BUILDER_H_
 
@@ -13,25 +13,18 @@
 
 #include "absl/status/statusor.h"
 #include "core/space/motion_space.h"
-#include "server/clip_facts.h"
+#include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
-
-// Frames of a stored clip at its own rate; unset bounds are the clip's ends.
-struct TrainingRange {
-  int64_t clip_id = 0;
-  std::optional<int> first_frame;
-  std::optional<int> last_frame;
-};
 
 struct SpaceRequest {
   std::string name;
   // The skeleton; optional when `training` is given or the database holds one skeleton.
   std::optional<int64_t> skeleton_id;
   // Empty: every clip of the skeleton, whole.
-  std::vector<TrainingRange> training;
+  std::vector<ClipSelection> training;
   SpaceOptions options;
 };
 
@@ -45,8 +38,7 @@ struct BuiltSpace {
 absl::Status ValidateSpaceName(const std::string& name);
 
 // `should_stop` is polled between clips; when it returns true the build ends with CANCELLED.
-absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, ClipFactsCache& facts,
-                                      const SpaceRequest& request,
+absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRequest& request,
                                       const std::function<bool()>& should_stop);
 
 }  // namespace motiondb::server

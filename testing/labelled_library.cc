@@ -23,7 +23,7 @@ absl::StatusOr<LabelledLibrary> LoadLabelledLibrary(const std::filesystem::path&
   }
   std::sort(files.begin(), files.end());
   LabelledLibrary library;
-  std::vector<ClipRange> clips;
+  std::vector<TrainingClip> clips;
   for (const std::filesystem::path& path : files) {
     MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
     clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});

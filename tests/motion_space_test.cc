@@ -25,8 +25,8 @@ using ::testing::HasSubstr;
 
 constexpr double kPi = std::numbers::pi;
 
-std::vector<ClipRange> Whole(const std::vector<Clip>& clips) {
-  std::vector<ClipRange> ranges;
+std::vector<TrainingClip> Whole(const std::vector<Clip>& clips) {
+  std::vector<TrainingClip> ranges;
   for (const Clip& clip : clips) {
     ranges.push_back({absl::StrCat("clip", ranges.size()), clip, std::nullopt});
   }
@@ -64,7 +64,7 @@ class MotionSpaceTest : public ::testing::Test {
         space_(*MotionSpace::Build(training_)) {}
 
   std::shared_ptr<const Skeleton> skeleton_;
-  std::vector<ClipRange> training_;
+  std::vector<TrainingClip> training_;
   MotionSpace space_;
 };
 
@@ -87,7 +87,7 @@ TEST_F(MotionSpaceTest, KeepsEveryDimensionInDecreasingVarianceOnAnOrthonormalBa
 }
 
 TEST_F(MotionSpaceTest, TrainingPosesRoundTripExactlyWithAllDimensions) {
-  for (const ClipRange& range : training_) {
+  for (const TrainingClip& range : training_) {
     const Clip sampled = *Resample(range.clip, 30.0);
     const PoseRotations pose = ComputePoseRotations(sampled, space_.data().pose);
     const RowMatrixXd coordinates = *space_.ProjectClip(range.clip);
@@ -103,7 +103,7 @@ TEST_F(MotionSpaceTest, TrainingPosesRoundTripExactlyWithAllDimensions) {
 
 TEST_F(MotionSpaceTest, ErrorShrinksAsDimensionsGrow) {
   const Clip unseen = testing::SyntheticClip(skeleton_, {.turn_rate = -0.3, .seed = 7});
-  for (const std::vector<ClipRange>& clips : {training_, Whole({unseen})}) {
+  for (const std::vector<TrainingClip>& clips : {training_, Whole({unseen})}) {
     const std::vector<ReconstructionError> report = *space_.RepresentationalError(clips);
     ASSERT_EQ(report.size(), 5u);
     const int expected_dims[] = {3, 5, 10, 20, space_.dims()};
@@ -258,7 +258,7 @@ TEST_F(MotionSpaceTest, ClipsAreSampledAtTheSpaceRate) {
 }
 
 TEST_F(MotionSpaceTest, TrainingRangesUseOnlyTheirFrames) {
-  std::vector<ClipRange> ranges = training_;
+  std::vector<TrainingClip> ranges = training_;
   ranges[0].frames = FrameRange{10, 69};
   const MotionSpace space = *MotionSpace::Build(ranges);
   EXPECT_EQ(space.data().training[0].frames.first, 10);
@@ -269,7 +269,7 @@ TEST_F(MotionSpaceTest, TrainingRangesUseOnlyTheirFrames) {
 
 TEST_F(MotionSpaceTest, CmuStyleRootPelvis) {
   const auto cmu = testing::HumanoidSkeleton(/*still_root=*/false);
-  const std::vector<ClipRange> training =
+  const std::vector<TrainingClip> training =
       Whole({testing::SyntheticClip(cmu, {.turn_rate = 0.8, .seed = 4})});
   const MotionSpace space = *MotionSpace::Build(training);
   const Clip& clip = training[0].clip;
@@ -282,7 +282,7 @@ TEST_F(MotionSpaceTest, CmuStyleRootPelvis) {
 
 TEST_F(MotionSpaceTest, RejectsBadTrainingAndOptions) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const auto fails = [&](const std::vector<ClipRange>& training, const SpaceOptions& options,
+  const auto fails = [&](const std::vector<TrainingClip>& training, const SpaceOptions& options,
                          const std::string& message) {
     const absl::StatusOr<MotionSpace> space = MotionSpace::Build(training, options);
     ASSERT_FALSE(space.ok()) << message;
@@ -301,11 +301,11 @@ TEST_F(MotionSpaceTest, RejectsBadTrainingAndOptions) {
   fails(training_, {.weights = {.overrides = {{"Hips", nan}}}}, "'Hips'");
   fails(training_, {.weights = {.overrides = {{"Hips", -1.0}}}}, "'Hips'");
 
-  std::vector<ClipRange> mixed = training_;
+  std::vector<TrainingClip> mixed = training_;
   mixed.push_back({"other.bvh", testing::SyntheticClip(testing::HumanoidSkeleton(false)), {}});
   fails(mixed, {}, "other.bvh: skeleton differs");
 
-  std::vector<ClipRange> out_of_range = training_;
+  std::vector<TrainingClip> out_of_range = training_;
   out_of_range[1].frames = FrameRange{50, 500};
   const absl::StatusOr<MotionSpace> space = MotionSpace::Build(out_of_range);
   ASSERT_FALSE(space.ok());
@@ -365,7 +365,7 @@ TEST(MotionSpaceRealDataTest, Cmu0101) {
   if (!dir) GTEST_SKIP() << "assimp-testmodels is not installed; skipped";
   const absl::StatusOr<BvhReadResult> read = ReadBvhFile((*dir / "01_01.bvh").string());
   ASSERT_TRUE(read.ok()) << read.status();
-  const std::vector<ClipRange> training = {{"01_01", read->clip, std::nullopt}};
+  const std::vector<TrainingClip> training = {{"01_01", read->clip, std::nullopt}};
   const MotionSpace space = *MotionSpace::Build(training);
   EXPECT_EQ(space.dims(), 3 * 31 + 1);
   const std::vector<ReconstructionError> report = *space.RepresentationalError(training);
@@ -394,7 +394,7 @@ TEST(MotionSpaceRealDataTest, Cmu0101) {
 // Bandai: joint_Root is still and Hips carries the facing; turns show in the yaw rate.
 TEST(MotionSpaceRealDataTest, BandaiTurnsAndRoundTrip) {
   MOTIONDB_REQUIRE_MOCAP(mocap);
-  std::vector<ClipRange> training;
+  std::vector<TrainingClip> training;
   for (const char* name : {"walk", "walk-turn-left", "walk-turn-right", "raise-up-right-hand"}) {
     const std::string file = absl::StrCat("dataset-2_", name, "_normal_001.bvh");
     absl::StatusOr<BvhReadResult> read = ReadBvhFile((mocap / "bandai2-normal" / file).string());

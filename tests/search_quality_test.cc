@@ -22,7 +22,7 @@ class SyntheticValidation : public ::testing::Test {
     absl::StatusOr<SyntheticLibrary> generated = GenerateSyntheticLibrary({});
     ASSERT_TRUE(generated.ok()) << generated.status();
     synthetic_ = new SyntheticLibrary(*std::move(generated));
-    std::vector<ClipRange> training;
+    std::vector<TrainingClip> training;
     for (const Clip& clip : synthetic_->clips)
       training.push_back({"synthetic", clip, std::nullopt});
     absl::StatusOr<MotionSpace> space = MotionSpace::Build(training, {});

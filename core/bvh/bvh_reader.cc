@@ -13,6 +13,7 @@
 #include "absl/strings/str_format.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb {
 namespace {
@@ -428,12 +429,7 @@ absl::StatusOr<BvhReadResult> ReadBvh(absl::string_view text, const BvhReadOptio
 
 absl::StatusOr<BvhReadResult> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::string text, ReadFileBytes(path, options.max_bytes));
-  absl::StatusOr<BvhReadResult> result = ReadBvh(text, options);
-  if (!result.ok()) {
-    return absl::Status(result.status().code(),
-                        absl::StrCat(path, ": ", result.status().message()));
-  }
-  return result;
+  return Prefixed(path, ReadBvh(text, options));
 }
 
 }  // namespace motiondb

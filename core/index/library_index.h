@@ -32,9 +32,13 @@ struct LibraryClip {
   RowMatrixXf coordinates;
 };
 
+// The seed search's dimensions unless a search says otherwise (thesis Table 6.2): the kd-tree's
+// default dimensions too, since a search over other dimensions cannot use the tree.
+inline constexpr int kDefaultAnnDims = 10;
+
 struct LibraryIndexOptions {
   // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
-  int ann_dims = 10;
+  int ann_dims = kDefaultAnnDims;
   // Points per kd-tree leaf.
   int leaf_size = 32;
 };

@@ -11,7 +11,17 @@ namespace {
 // Output larger than this many frames is refused (a day at 1 kHz).
 constexpr double kMaxOutputFrames = 86'400'000;
 
+// A sample within 1% of a frame past the end takes the last frame: files write the frame time
+// rounded (0.0333333 for 1/30 s), and the last frame should not be lost to that rounding.
+double SampleCount(int frame_count, double frame_time, double target_fps) {
+  return std::floor((frame_count - 1) * frame_time * target_fps + 0.01) + 1;
+}
+
 }  // namespace
+
+int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fps) {
+  return static_cast<int64_t>(SampleCount(frame_count, frame_time, target_fps));
+}
 
 absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
   if (!std::isfinite(target_fps) || target_fps <= 0.0 || target_fps > 10000.0) {
@@ -19,10 +29,7 @@ absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
         absl::StrCat("target rate must be in (0, 10000] frames per second, got ", target_fps));
   }
   const int n = clip.frame_count();
-  const double span = (n - 1) * clip.frame_time();
-  // A sample within 1% of a frame past the end takes the last frame: files write the frame time
-  // rounded (0.0333333 for 1/30 s), and the last frame should not be lost to that rounding.
-  const double samples = std::floor(span * target_fps + 0.01) + 1;
+  const double samples = SampleCount(n, clip.frame_time(), target_fps);
   if (samples > kMaxOutputFrames) {
     return absl::ResourceExhaustedError(
         absl::StrCat("resampling would produce ", samples, " frames"));

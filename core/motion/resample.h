@@ -2,6 +2,8 @@
 #ifndef MOTIONDB_CORE_MOTION_RESAMPLE_H_
 #define MOTIONDB_CORE_MOTION_RESAMPLE_H_
 
+#include <cstdint>
+
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
 
@@ -12,6 +14,10 @@ namespace motiondb {
 // the last frame) so that rounded frame times such as 0.0333333 keep every frame. `target_fps` must
 // be finite and in (0, 10000].
 absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps);
+
+// The number of frames Resample() makes of `frame_count` frames `frame_time` apart (without its
+// limit on the output's size).
+int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fps);
 
 }  // namespace motiondb
 

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "core/index/library_index.h"
+#include "core/search/warp/time_warp.h"
 
 namespace motiondb {
 
@@ -19,16 +21,17 @@ enum class NeutralPose {
 };
 
 struct SearchParams {
-  // Dimensions of the nearest-neighbour seed search.
-  int ann_dims = 10;
+  // Dimensions of the nearest-neighbour seed search (the index's kd-tree dimensions: others
+  // fall back to a linear scan).
+  int ann_dims = kDefaultAnnDims;
   // Seeds: nearest library frames to the characteristic pose.
   int neighbours = 1000;
   // Approximation bound of the seed search (0 = exact).
   float epsilon = 0.0f;
   // Dimensions of the pose distance inside the time warp.
-  int dtw_dims = 5;
+  int dtw_dims = kDefaultWarpDims;
   // The warp never runs more than this many times faster or slower than the query.
-  int slope_limit = 2;
+  int slope_limit = kDefaultSlopeLimit;
   // Results returned after overlap suppression.
   int max_results = 20;
   // The query frame (at the space rate) that every warp passes through; -1 finds it

@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/motion/resample.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb {
 namespace {
@@ -17,12 +18,8 @@ namespace {
 // Tolerance for the unit length of stored references and the orthonormality of a stored basis.
 constexpr double kStoredTolerance = 1e-6;
 
-absl::Status Prefixed(absl::string_view source, const absl::Status& status) {
-  return absl::Status(status.code(), absl::StrCat(source, ": ", status.message()));
-}
-
 // The range's frames sampled at `rate`, with errors naming the source.
-absl::StatusOr<Clip> SampleRange(const ClipRange& range, double rate) {
+absl::StatusOr<Clip> SampleRange(const TrainingClip& range, double rate) {
   absl::StatusOr<Clip> cut = range.frames ? range.clip.Slice(*range.frames) : range.clip;
   if (!cut.ok()) return Prefixed(range.source, cut.status());
   absl::StatusOr<Clip> sampled = Resample(*cut, rate);
@@ -137,7 +134,7 @@ Eigen::VectorXd MetricScales(SpaceMetric metric, const Eigen::VectorXd& eigenval
   return Eigen::VectorXd::Ones(dims);
 }
 
-absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<ClipRange>& training,
+absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& training,
                                                const SpaceOptions& options) {
   if (training.empty()) return absl::InvalidArgumentError("a space needs training clips");
   MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate));
@@ -154,7 +151,7 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<ClipRange>& tra
 
   std::vector<PoseRotations> poses;
   Eigen::Index frames = 0;
-  for (const ClipRange& range : training) {
+  for (const TrainingClip& range : training) {
     if (!range.clip.skeleton().SameTopology(*data.skeleton)) {
       return absl::InvalidArgumentError(
           absl::StrCat(range.source, ": skeleton differs from the first training clip's (",
@@ -272,7 +269,7 @@ absl::StatusOr<double> MotionSpace::Distance(const Eigen::Ref<const Eigen::RowVe
 }
 
 absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
-    const std::vector<ClipRange>& clips, const std::vector<int>& dims) const {
+    const std::vector<TrainingClip>& clips, const std::vector<int>& dims) const {
   std::vector<int> levels;
   for (const int n : dims) {
     if (n < 1) {
@@ -289,7 +286,7 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
   for (const int n : levels) report.push_back({n, 0.0, 0.0});
   double angles = 0.0;
   const int joints = skeleton().joint_count();
-  for (const ClipRange& range : clips) {
+  for (const TrainingClip& range : clips) {
     if (!range.clip.skeleton().SameTopology(skeleton())) {
       return absl::InvalidArgumentError(
           absl::StrCat(range.source, ": skeleton differs from the space's"));

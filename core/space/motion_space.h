@@ -50,7 +50,7 @@ struct SpaceOptions {
 };
 
 // A clip, or a range of its frames, for training or for the error report.
-struct ClipRange {
+struct TrainingClip {
   std::string source;  // where it came from (a file name); recorded in the space
   Clip clip;
   std::optional<FrameRange> frames;  // at the clip's own rate; nullopt for the whole clip
@@ -96,7 +96,7 @@ class MotionSpace {
   // is cut to its range, resampled to options.sample_rate, freed of its facing (unless
   // options.pose.remove_heading is false) and linearised about the per-joint mean orientation
   // of all training frames (thesis Algorithm 2).
-  static absl::StatusOr<MotionSpace> Build(const std::vector<ClipRange>& training,
+  static absl::StatusOr<MotionSpace> Build(const std::vector<TrainingClip>& training,
                                            const SpaceOptions& options = {});
   // Checks that the parts are consistent (shapes, finite values, positive weights, orthonormal
   // basis), e.g. after reading them from storage.
@@ -134,7 +134,7 @@ class MotionSpace {
   // Thesis 3.3.4: the joint-angle error when the clips' poses are reconstructed from each of
   // `dims` (sorted, capped at dims(); all dimensions are always reported last).
   absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
-      const std::vector<ClipRange>& clips, const std::vector<int>& dims = {3, 5, 10, 20}) const;
+      const std::vector<TrainingClip>& clips, const std::vector<int>& dims = {3, 5, 10, 20}) const;
 
  private:
   explicit MotionSpace(SpaceData data);

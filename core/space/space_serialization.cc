@@ -9,6 +9,7 @@
 #include "util/crc32.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 // Payload, in order (u8/u32/i32/u64 integers, f64 doubles, str = u32 length + bytes):
 //   skeleton: u32 joints; per joint: str name, i32 parent, 3 f64 offset, u8 channel count,
@@ -180,11 +181,7 @@ absl::Status WriteSpaceFile(const std::string& path, const MotionSpace& space) {
 
 absl::StatusOr<MotionSpace> ReadSpaceFile(const std::string& path) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::string bytes, ReadFileBytes(path, kMaxFileBytes));
-  absl::StatusOr<MotionSpace> space = ParseSpace(bytes);
-  if (!space.ok()) {
-    return absl::Status(space.status().code(), absl::StrCat(path, ": ", space.status().message()));
-  }
-  return space;
+  return Prefixed(path, ParseSpace(bytes));
 }
 
 }  // namespace motiondb

@@ -2,24 +2,18 @@
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
-#include <string>
-#include <vector>
-
 #include "absl/status/status.h"
-#include "absl/strings/string_view.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/catalog.h"
-#include "server/clip_facts.h"
-#include "server/server_options.h"
+#include "server/upload.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
 class ClipServiceImpl final : public v1::ClipService::Service {
  public:
-  ClipServiceImpl(storage::Database& database, Library& library, ClipFactsCache& facts,
-                  const ServerOptions& options)
-      : database_(database), library_(library), facts_(facts), options_(options) {}
+  ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits)
+      : database_(database), catalog_(catalog), limits_(limits) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
@@ -36,20 +30,12 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                           v1::ExportClipResponse* response) override;
 
  private:
-  // Parses, stores and indexes one uploaded file.
-  absl::Status Ingest(const std::string& file_name, const std::string& name,
-                      const std::vector<std::string>& tags, absl::string_view bvh,
-                      v1::IngestClipResponse* response);
   absl::Status ReadStream(grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                           v1::IngestClipResponse* response);
-  absl::Status List(const v1::ListClipsRequest& request, v1::ListClipsResponse* response);
-  absl::Status Get(int64_t clip_id, v1::Clip* response);
-  absl::Status Export(const v1::ClipRange& range, v1::ExportClipResponse* response);
 
   storage::Database& database_;
-  Library& library_;
-  ClipFactsCache& facts_;
-  const ServerOptions& options_;
+  Catalog& catalog_;
+  UploadLimits limits_;
 };
 
 }  // namespace motiondb::server

@@ -9,7 +9,6 @@
 #include "absl/strings/str_format.h"
 #include "grpc/health/v1/health.pb.h"
 #include "server/catalog.h"
-#include "server/clip_facts.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
 #include "server/grpc/request_logger.h"
@@ -17,8 +16,10 @@
 #include "server/grpc/server_info_service.h"
 #include "server/grpc/space_service.h"
 #include "server/index_registry.h"
+#include "server/search_runner.h"
 #include "storage/database.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::server {
 
@@ -28,8 +29,8 @@ struct MotionDbServer::State {
   ServerOptions options;
   std::unique_ptr<storage::Database> database;
   IndexRegistry registry;
-  std::unique_ptr<ClipFactsCache> facts;
-  std::unique_ptr<Library> library;
+  std::unique_ptr<Catalog> catalog;
+  std::unique_ptr<SearchRunner> runner;
   std::unique_ptr<ClipServiceImpl> clips;
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
@@ -57,17 +58,11 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   auto state = std::make_unique<State>();
   State& s = *state;
   s.options = options;
-  absl::StatusOr<std::unique_ptr<storage::Database>> database =
-      storage::Database::Open(options.db_path);
-  if (!database.ok()) {
-    return absl::Status(database.status().code(),
-                        absl::StrCat(options.db_path, ": ", database.status().message()));
-  }
-  s.database = *std::move(database);
-  s.facts = std::make_unique<ClipFactsCache>(*s.database);
-  s.library = std::make_unique<Library>(*s.database, s.registry, *s.facts);
+  MOTIONDB_ASSIGN_OR_RETURN(s.database,
+                            Prefixed(options.db_path, storage::Database::Open(options.db_path)));
+  s.catalog = std::make_unique<Catalog>(*s.database, s.registry);
   const auto load_start = std::chrono::steady_clock::now();
-  MOTIONDB_RETURN_IF_ERROR(s.library->LoadIndices());
+  MOTIONDB_RETURN_IF_ERROR(s.catalog->LoadIndices());
   const auto spaces = s.registry.All();
   int64_t frames = 0;
   for (const auto& space : spaces) frames += space->index ? space->index->total_frames() : 0;
@@ -77,10 +72,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
           .count()));
 
-  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.library, *s.facts, s.options);
-  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.library, s.registry);
-  s.search = std::make_unique<SearchServiceImpl>(*s.database, s.registry,
-                                                 SearchLimits{options.max_bvh_bytes});
+  s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
+  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads);
+  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry);
+  s.search = std::make_unique<SearchServiceImpl>(*s.runner);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options);
 
   MOTIONDB_ASSIGN_OR_RETURN(

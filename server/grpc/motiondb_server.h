@@ -10,7 +10,7 @@
 #include <grpcpp/server.h>
 
 #include "absl/status/statusor.h"
-#include "server/server_options.h"
+#include "server/grpc/server_options.h"
 
 namespace motiondb::server {
 

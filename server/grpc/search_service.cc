@@ -4,7 +4,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "server/grpc/call_context.h"
+#include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 namespace {
@@ -13,11 +15,19 @@ constexpr int kMaxBatch = 1000;
 
 }  // namespace
 
+absl::StatusOr<v1::SearchResponse> SearchServiceImpl::SearchOne(
+    const v1::SearchRequest& request, const std::function<bool()>& should_stop) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const SearchRequest search, FromProto(request));
+  MOTIONDB_ASSIGN_OR_RETURN(const SearchOutcome outcome, runner_.Run(search, should_stop));
+  v1::SearchResponse response;
+  ToProto(outcome, &response);
+  return response;
+}
+
 grpc::Status SearchServiceImpl::Search(grpc::ServerContext* context,
                                        const v1::SearchRequest* request,
                                        v1::SearchResponse* response) {
-  absl::StatusOr<v1::SearchResponse> found =
-      RunSearch(*request, registry_, database_, limits_, StopWhenCallEnds(context));
+  absl::StatusOr<v1::SearchResponse> found = SearchOne(*request, StopWhenCallEnds(context));
   if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
   *response = *std::move(found);
   return grpc::Status::OK;
@@ -35,8 +45,7 @@ absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
     if (should_stop()) {
       return ExplainStop(absl::CancelledError(absl::StrCat("before requests[", i, "]")), context);
     }
-    absl::StatusOr<v1::SearchResponse> found =
-        RunSearch(request.requests(i), registry_, database_, limits_, should_stop);
+    absl::StatusOr<v1::SearchResponse> found = SearchOne(request.requests(i), should_stop);
     // A stop ends the whole batch; any other failure belongs to its item alone.
     if (absl::IsCancelled(found.status())) return ExplainStop(found.status(), context);
     v1::SearchBatchItem* item = response->add_items();

@@ -2,18 +2,17 @@
 #ifndef MOTIONDB_SERVER_GRPC_SEARCH_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_SEARCH_SERVICE_H_
 
+#include <functional>
+
+#include "absl/status/statusor.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
-#include "server/index_registry.h"
 #include "server/search_runner.h"
-#include "storage/database.h"
 
 namespace motiondb::server {
 
 class SearchServiceImpl final : public v1::SearchService::Service {
  public:
-  SearchServiceImpl(storage::Database& database, const IndexRegistry& registry,
-                    const SearchLimits& limits)
-      : database_(database), registry_(registry), limits_(limits) {}
+  explicit SearchServiceImpl(const SearchRunner& runner) : runner_(runner) {}
 
   grpc::Status Search(grpc::ServerContext* context, const v1::SearchRequest* request,
                       v1::SearchResponse* response) override;
@@ -24,9 +23,11 @@ class SearchServiceImpl final : public v1::SearchService::Service {
   absl::Status Batch(const v1::SearchBatchRequest& request, grpc::ServerContext* context,
                      v1::SearchBatchResponse* response);
 
-  storage::Database& database_;
-  const IndexRegistry& registry_;
-  SearchLimits limits_;
+  // One search through the runner, as the response message.
+  absl::StatusOr<v1::SearchResponse> SearchOne(const v1::SearchRequest& request,
+                                               const std::function<bool()>& should_stop) const;
+
+  const SearchRunner& runner_;
 };
 
 }  // namespace motiondb::server

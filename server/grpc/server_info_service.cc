@@ -1,10 +1,10 @@
 #include "server/grpc/server_info_service.h"
 
+#include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
-#include "server/space_report.h"
 
 #ifndef MOTIONDB_VERSION
-#error "MOTIONDB_VERSION must be defined by the build (server/CMakeLists.txt)"
+#error "MOTIONDB_VERSION must be defined by the build (server/grpc/CMakeLists.txt)"
 #endif
 
 namespace motiondb::server {
@@ -28,12 +28,12 @@ grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* /*context
   for (const auto& snapshot : registry_.All()) {
     v1::SpaceIndexInfo* info = response->add_indices();
     info->set_space(snapshot->record.name);
-    FillSpaceIndex(*snapshot, info->mutable_index());
+    ToProto(*snapshot, info->mutable_index());
     index_bytes += snapshot->coordinate_bytes() + snapshot->tree_bytes();
   }
   response->set_index_bytes(index_bytes);
   response->set_max_message_bytes(int64_t{options_.max_message_mb} << 20);
-  response->set_max_bvh_bytes(options_.max_bvh_bytes);
+  response->set_max_bvh_bytes(options_.uploads.max_bvh_bytes);
   response->set_auth_required(!options_.auth_token.empty());
   response->set_tls(!options_.tls_cert_pem.empty());
   return grpc::Status::OK;

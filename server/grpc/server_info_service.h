@@ -6,8 +6,8 @@
 #include <chrono>
 
 #include "motiondb/v1/server_service.grpc.pb.h"
+#include "server/grpc/server_options.h"
 #include "server/index_registry.h"
-#include "server/server_options.h"
 #include "storage/database.h"
 
 namespace motiondb::server {

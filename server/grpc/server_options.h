@@ -1,9 +1,11 @@
 // What motiondb-server is told on its command line (server/main.cc parses the flags).
-#ifndef MOTIONDB_SERVER_SERVER_OPTIONS_H_
-#define MOTIONDB_SERVER_SERVER_OPTIONS_H_
+#ifndef MOTIONDB_SERVER_GRPC_SERVER_OPTIONS_H_
+#define MOTIONDB_SERVER_GRPC_SERVER_OPTIONS_H_
 
 #include <cstdint>
 #include <string>
+
+#include "server/upload.h"
 
 namespace motiondb::server {
 
@@ -20,8 +22,8 @@ struct ServerOptions {
   // before any handler runs (--max-message-mb).
   int max_message_mb = 256;
   // Largest BVH file accepted by IngestClip, IngestClipStream (all chunks together) and BVH
-  // queries, in bytes; larger ones fail with RESOURCE_EXHAUSTED (--max-bvh-mb, in MiB).
-  int64_t max_bvh_bytes = int64_t{1} << 30;
+  // queries (--max-bvh-mb, in MiB).
+  UploadLimits uploads;
   // When non-empty, every call must carry the metadata "authorization: Bearer <token>"
   // (read from --auth-token-file).
   std::string auth_token;
@@ -29,10 +31,10 @@ struct ServerOptions {
   // --tls-cert and --tls-key).
   std::string tls_cert_pem;
   std::string tls_key_pem;
-  // One line per call on stderr (server/request_logger.h).
+  // One line per call on stderr (server/grpc/request_logger.h).
   bool log_requests = true;
 };
 
 }  // namespace motiondb::server
 
-#endif  // MOTIONDB_SERVER_SERVER_OPTIONS_H_
+#endif  // MOTIONDB_SERVER_GRPC_SERVER_OPTIONS_H_

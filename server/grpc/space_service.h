@@ -6,18 +6,14 @@
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "server/catalog.h"
 #include "server/index_registry.h"
-#include "server/space_builder.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
-// The request's options and training ranges; INVALID_ARGUMENT names a bad field.
-absl::StatusOr<SpaceRequest> ToSpaceRequest(const v1::CreateSpaceRequest& request);
-
 class SpaceServiceImpl final : public v1::SpaceService::Service {
  public:
-  SpaceServiceImpl(storage::Database& database, Library& library, const IndexRegistry& registry)
-      : database_(database), library_(library), registry_(registry) {}
+  SpaceServiceImpl(storage::Database& database, Catalog& catalog, const IndexRegistry& registry)
+      : database_(database), catalog_(catalog), registry_(registry) {}
 
   grpc::Status CreateSpace(grpc::ServerContext* context, const v1::CreateSpaceRequest* request,
                            v1::Space* response) override;
@@ -31,13 +27,8 @@ class SpaceServiceImpl final : public v1::SpaceService::Service {
                         v1::GetCurveResponse* response) override;
 
  private:
-  absl::Status Create(const v1::CreateSpaceRequest& request, grpc::ServerContext* context,
-                      v1::Space* response);
-  absl::Status List(const v1::ListSpacesRequest& request, v1::ListSpacesResponse* response);
-  absl::Status Curve(const v1::GetCurveRequest& request, v1::GetCurveResponse* response);
-
   storage::Database& database_;
-  Library& library_;
+  Catalog& catalog_;
   const IndexRegistry& registry_;
 };
 

@@ -19,12 +19,16 @@
 
 namespace motiondb {
 
+// The thesis's warp defaults (Table 6.2), which the search's parameters start from too.
+inline constexpr int kDefaultSlopeLimit = 2;
+inline constexpr int kDefaultWarpDims = 5;
+
 struct WarpConstraints {
   // Clip frames advance 0..slope_limit per query frame, pausing at most slope_limit - 1 times
   // in a row; 1 means no warping at all. At most kMaxSlopeLimit.
-  int slope_limit = 2;
+  int slope_limit = kDefaultSlopeLimit;
   // Dimensions of the pose distance.
-  int dims = 5;
+  int dims = kDefaultWarpDims;
 };
 
 inline constexpr int kMaxSlopeLimit = 8;

@@ -1,0 +1,24 @@
+#include "server/clip_export.h"
+
+#include "absl/strings/str_cat.h"
+#include "core/bvh/bvh_writer.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+absl::StatusOr<ExportedBvh> ExportClip(storage::Database& database,
+                                       const ClipSelection& selection) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, database.GetClip(selection.clip_id));
+  ExportedBvh exported;
+  MOTIONDB_ASSIGN_OR_RETURN(exported.frames,
+                            ResolveFrameRange(selection, stored.clip.frame_count(), "clip"));
+  MOTIONDB_ASSIGN_OR_RETURN(exported.bvh, WriteBvh(stored.clip, exported.frames));
+  const bool whole =
+      exported.frames.first == 0 && exported.frames.last == stored.clip.frame_count() - 1;
+  exported.file_name = whole ? absl::StrCat(stored.record.name, ".bvh")
+                             : absl::StrCat(stored.record.name, "_", exported.frames.first, "-",
+                                            exported.frames.last, ".bvh");
+  return exported;
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,25 @@
+// Exporting a stored clip, or a range of it, as a BVH file (ClipService.ExportClip).
+#ifndef MOTIONDB_SERVER_CLIP_EXPORT_H_
+#define MOTIONDB_SERVER_CLIP_EXPORT_H_
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/motion/clip.h"
+#include "server/frame_conversion.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+struct ExportedBvh {
+  std::string file_name;  // suggested: "<name>.bvh", or "<name>_<first>-<last>.bvh" for a range
+  std::string bvh;
+  FrameRange frames;  // at the clip's rate
+};
+
+// NOT_FOUND for an unknown clip; INVALID_ARGUMENT naming "clip" for a range outside it.
+absl::StatusOr<ExportedBvh> ExportClip(storage::Database& database, const ClipSelection& selection);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_CLIP_EXPORT_H_

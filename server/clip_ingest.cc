@@ -1,0 +1,36 @@
+#include "server/clip_ingest.h"
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+absl::StatusOr<std::string> ClipName(const IngestRequest& request) {
+  if (request.file_name.empty()) return absl::InvalidArgumentError("file_name is required");
+  if (!request.name.empty()) return request.name;
+  absl::string_view base = request.file_name;
+  if (const size_t slash = base.find_last_of("/\\"); slash != absl::string_view::npos) {
+    base.remove_prefix(slash + 1);
+  }
+  if (absl::EndsWithIgnoreCase(base, ".bvh")) base.remove_suffix(4);
+  if (base.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("file_name '", request.file_name, "' leaves no clip name; give `name`"));
+  }
+  return std::string(base);
+}
+
+absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
+                                           absl::string_view bvh, const UploadLimits& limits) {
+  storage::ClipRecord record;
+  MOTIONDB_ASSIGN_OR_RETURN(record.name, ClipName(request));
+  record.source_file = request.file_name;
+  record.tags = request.tags;
+  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
+  MOTIONDB_ASSIGN_OR_RETURN(IngestedClip ingested, catalog.IngestClip(record, read.clip));
+  return IngestOutcome{std::move(ingested.record), std::move(read.warnings),
+                       std::move(ingested.spaces)};
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,270 @@
+#include "server/grpc/proto_conversion.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/space/joint_weights.h"
+#include "util/byte_coding.h"
+#include "util/status_macros.h"
+#include "util/status_prefix.h"
+
+namespace motiondb::server {
+namespace {
+
+absl::StatusOr<NeutralPose> FromProto(v1::NeutralPose neutral) {
+  switch (neutral) {
+    case v1::NEUTRAL_POSE_UNSPECIFIED:
+    case v1::NEUTRAL_POSE_QUERY_MEAN:
+      return NeutralPose::kQueryMean;
+    case v1::NEUTRAL_POSE_BOUNDARY_MEAN:
+      return NeutralPose::kBoundaryMean;
+    case v1::NEUTRAL_POSE_ORIGIN:
+      return NeutralPose::kOrigin;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("neutral: unknown value ", neutral));
+  }
+}
+
+absl::StatusOr<WeightPreset> FromProto(v1::WeightPreset preset) {
+  switch (preset) {
+    case v1::WEIGHT_PRESET_UNSPECIFIED:
+    case v1::WEIGHT_PRESET_MASS:
+      return WeightPreset::kMass;
+    case v1::WEIGHT_PRESET_UNIFORM:
+      return WeightPreset::kUniform;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("weight_preset: unknown value ", preset));
+  }
+}
+
+absl::StatusOr<SpaceMetric> FromProto(v1::SpaceMetric metric) {
+  switch (metric) {
+    case v1::SPACE_METRIC_UNSPECIFIED:
+    case v1::SPACE_METRIC_UNIT:
+      return SpaceMetric::kUnit;
+    case v1::SPACE_METRIC_EIGENVALUE_SCALED:
+      return SpaceMetric::kEigenvalueScaled;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("metric: unknown value ", metric));
+  }
+}
+
+v1::SpaceMetric ToProto(SpaceMetric metric) {
+  return metric == SpaceMetric::kUnit ? v1::SPACE_METRIC_UNIT : v1::SPACE_METRIC_EIGENVALUE_SCALED;
+}
+
+v1::WeightPreset ToProto(WeightPreset preset) {
+  return preset == WeightPreset::kMass ? v1::WEIGHT_PRESET_MASS : v1::WEIGHT_PRESET_UNIFORM;
+}
+
+template <typename T>
+std::optional<T> Optional(bool has, T value) {
+  return has ? std::optional<T>(value) : std::nullopt;
+}
+
+// Only what the request sets replaces SearchParams' defaults.
+absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
+  SearchParams params;
+  if (request.has_neighbours()) params.neighbours = request.neighbours();
+  if (request.has_epsilon()) params.epsilon = request.epsilon();
+  if (request.has_slope_limit()) params.slope_limit = request.slope_limit();
+  if (request.has_max_results()) params.max_results = request.max_results();
+  MOTIONDB_ASSIGN_OR_RETURN(params.neutral, FromProto(request.neutral()));
+  if (request.has_cluster_gap_s()) params.cluster_gap_s = request.cluster_gap_s();
+  if (request.has_max_overlap()) params.max_overlap = request.max_overlap();
+  params.return_path = request.return_path();
+  if (request.has_refine()) params.refine = request.refine();
+  params.clip_ids.assign(request.clip_ids().begin(), request.clip_ids().end());
+  params.tags.assign(request.tags().begin(), request.tags().end());
+  return params;
+}
+
+}  // namespace
+
+ClipSelection FromProto(const v1::ClipRange& range) {
+  return {range.clip_id(), Optional(range.has_first_frame(), range.first_frame()),
+          Optional(range.has_last_frame(), range.last_frame())};
+}
+
+absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
+  SearchRequest out;
+  out.space = request.space();
+  switch (request.query_case()) {
+    case v1::SearchRequest::kClip:
+      out.query = FromProto(request.clip());
+      break;
+    case v1::SearchRequest::kBvh: {
+      const v1::BvhQuery& bvh = request.bvh();
+      out.query = UploadedQuery{bvh.bvh(), Optional(bvh.has_first_frame(), bvh.first_frame()),
+                                Optional(bvh.has_last_frame(), bvh.last_frame())};
+      break;
+    }
+    default:
+      break;  // the runner names the missing query
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(out.params, ParamsFromProto(request));
+  out.ann_dims = Optional(request.has_ann_dims(), request.ann_dims());
+  out.dtw_dims = Optional(request.has_dtw_dims(), request.dtw_dims());
+  // -1 asks for the automatic choice, as unset does.
+  if (request.has_characteristic_frame() && request.characteristic_frame() != -1) {
+    out.characteristic_frame = request.characteristic_frame();
+  }
+  out.exact = request.exact();
+  return out;
+}
+
+absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request) {
+  SpaceRequest out;
+  out.name = request.name();
+  if (request.has_skeleton_id()) out.skeleton_id = request.skeleton_id();
+  for (const v1::ClipRange& range : request.training()) out.training.push_back(FromProto(range));
+  SpaceOptions& options = out.options;
+  if (request.has_sample_rate()) options.sample_rate = request.sample_rate();
+  MOTIONDB_ASSIGN_OR_RETURN(options.weights.preset, FromProto(request.weight_preset()));
+  if (!request.weight_overrides().empty() && !request.weights_json().empty()) {
+    return absl::InvalidArgumentError("give weight_overrides or weights_json, not both");
+  }
+  for (const auto& [joint, weight] : request.weight_overrides()) {
+    options.weights.overrides[joint] = weight;
+  }
+  if (!request.weights_json().empty()) {
+    absl::StatusOr<std::map<std::string, double>> overrides =
+        Prefixed("weights_json", ParseWeightOverrides(request.weights_json()));
+    if (!overrides.ok()) return absl::InvalidArgumentError(overrides.status().message());
+    options.weights.overrides = *std::move(overrides);
+  }
+  options.pose.remove_heading = !request.keep_heading();
+  if (request.has_yaw_rate_weight()) options.yaw_rate_weight = request.yaw_rate_weight();
+  MOTIONDB_ASSIGN_OR_RETURN(options.metric, FromProto(request.metric()));
+  return out;
+}
+
+CurveRequest FromProto(const v1::GetCurveRequest& request) {
+  return {request.space(), FromProto(request.clip()), Optional(request.has_dims(), request.dims())};
+}
+
+void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
+  const double fps = record.frame_time > 0 ? 1.0 / record.frame_time : 0.0;
+  clip->set_clip_id(record.clip_id);
+  clip->set_name(record.name);
+  clip->set_source_file(record.source_file);
+  for (const std::string& tag : record.tags) clip->add_tags(tag);
+  clip->set_skeleton_id(record.skeleton_id);
+  clip->set_created_unix_ms(record.created_unix_ms);
+  clip->set_frame_count(static_cast<int32_t>(record.frame_count));
+  clip->set_fps(fps);
+  clip->set_duration_s(fps > 0 ? record.frame_count / fps : 0.0);
+  clip->set_joint_count(record.joint_count);
+}
+
+void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
+  ToProto(outcome.clip, response->mutable_clip());
+  for (const std::string& warning : outcome.warnings) response->add_warnings(warning);
+  for (const std::string& space : outcome.spaces) response->add_projected_spaces(space);
+}
+
+void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response) {
+  response->set_bvh(exported.bvh);
+  response->set_file_name(exported.file_name);
+  response->set_first_frame(exported.frames.first);
+  response->set_last_frame(exported.frames.last);
+}
+
+void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
+  for (const SearchHit& hit : outcome.hits) {
+    v1::SearchResult* out = response->add_results();
+    out->set_clip_id(hit.clip_id);
+    out->set_clip_name(hit.clip_name);
+    out->set_start_s(hit.start_s);
+    out->set_end_s(hit.end_s);
+    out->set_start_frame(hit.start_frame);
+    out->set_end_frame(hit.end_frame);
+    out->set_score(hit.score);
+    out->set_seed_frame(hit.seed_frame);
+    for (const int frame : hit.path) out->add_path(frame);
+  }
+  response->set_characteristic_frame(outcome.characteristic_frame);
+  const SearchStats& stats = outcome.stats;
+  v1::SearchTimings* timings = response->mutable_timings();
+  timings->set_characteristic_ms(stats.characteristic_ms);
+  timings->set_seeds_ms(stats.seeds_ms);
+  timings->set_clusters_ms(stats.clusters_ms);
+  timings->set_warps_ms(stats.warps_ms);
+  timings->set_refine_ms(stats.refine_ms);
+  timings->set_ranking_ms(stats.ranking_ms);
+  timings->set_total_ms(stats.total_ms);
+  timings->set_request_ms(outcome.request_ms);
+  v1::SearchCounts* counts = response->mutable_counts();
+  counts->set_query_frames(outcome.query_frames);
+  counts->set_library_frames(outcome.library_frames);
+  counts->set_seeds(stats.seeds);
+  counts->set_clusters(stats.clusters);
+  counts->set_warps(stats.warps);
+  counts->set_cells(stats.cells);
+  counts->set_pruned_blocks(stats.pruned_blocks);
+}
+
+void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out) {
+  out->set_dims(report.dims);
+  out->set_joint_count(report.joint_count);
+  out->set_pelvis(report.pelvis);
+  out->set_sample_rate(report.sample_rate);
+  out->set_heading_removed(report.heading_removed);
+  out->set_yaw_rate_weight(report.yaw_rate_weight);
+  out->set_metric(ToProto(report.metric));
+  out->set_weight_preset(ToProto(report.weight_preset));
+  for (const JointWeightReport& weight : report.joint_weights) {
+    v1::JointWeight* joint = out->add_joint_weights();
+    joint->set_joint(weight.joint);
+    joint->set_weight(weight.weight);
+  }
+  for (const TrainingReport& range : report.training) {
+    v1::ClipRange* used = out->add_training();
+    used->set_clip_id(range.clip_id);
+    used->set_first_frame(range.frames.first);
+    used->set_last_frame(range.frames.last);
+  }
+  out->set_training_frames(report.training_frames);
+  for (const double value : report.explained_variance) out->add_explained_variance(value);
+  for (const ReconstructionError& error : report.reconstruction_error) {
+    v1::ReconstructionError* measured = out->add_reconstruction_error();
+    measured->set_dims(error.dims);
+    measured->set_mean_rad(error.mean_rad);
+    measured->set_max_rad(error.max_rad);
+  }
+  out->set_projected_clips(report.projected_clips);
+  out->set_build_ms(report.build_ms);
+}
+
+void ToProto(const SpaceSnapshot& snapshot, v1::SpaceIndex* index) {
+  index->set_dims(snapshot.space->dims());
+  if (!snapshot.index) return;
+  index->set_clips(snapshot.index->clip_count());
+  index->set_frames(snapshot.index->total_frames());
+  index->set_ann_dims(snapshot.index->ann_dims());
+  index->set_coordinate_bytes(snapshot.coordinate_bytes());
+  index->set_tree_bytes(snapshot.tree_bytes());
+}
+
+void ToProto(const SpaceSnapshot& snapshot, v1::Space* space) {
+  const storage::SpaceRecord& record = snapshot.record;
+  space->set_space_id(record.space_id);
+  space->set_name(record.name);
+  space->set_skeleton_id(record.skeleton_id);
+  space->set_version(record.version);
+  space->set_created_unix_ms(record.created_unix_ms);
+  ToProto(ReportFromJson(record.build_report_json, *snapshot.space), space->mutable_report());
+  ToProto(snapshot, space->mutable_index());
+}
+
+void ToProto(const Curve& curve, v1::GetCurveResponse* response) {
+  response->set_dims(static_cast<int32_t>(curve.coordinates.cols()));
+  response->set_frames(static_cast<int32_t>(curve.coordinates.rows()));
+  response->set_sample_rate(curve.sample_rate);
+  AppendFloat32s(curve.coordinates.data(), curve.coordinates.size(),
+                 response->mutable_coordinates());
+  response->set_first_frame(curve.frames.first);
+  response->set_last_frame(curve.frames.last);
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,44 @@
+// Every conversion between motiondb.v1 messages and the application layer's types, in one
+// place: requests to the application's request structs (INVALID_ARGUMENT naming the field for
+// values no struct can hold, such as unknown enum values), and results to response messages.
+// Defaults for unset fields are the application's, not decided here.
+#ifndef MOTIONDB_SERVER_GRPC_PROTO_CONVERSION_H_
+#define MOTIONDB_SERVER_GRPC_PROTO_CONVERSION_H_
+
+#include "absl/status/statusor.h"
+#include "motiondb/v1/clip_service.pb.h"
+#include "motiondb/v1/search_service.pb.h"
+#include "motiondb/v1/space_service.pb.h"
+#include "server/clip_export.h"
+#include "server/clip_ingest.h"
+#include "server/frame_conversion.h"
+#include "server/index_registry.h"
+#include "server/search_runner.h"
+#include "server/space_builder.h"
+#include "server/space_curve.h"
+#include "server/space_report.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+// Requests.
+ClipSelection FromProto(const v1::ClipRange& range);
+absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request);
+absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request);
+CurveRequest FromProto(const v1::GetCurveRequest& request);
+
+// Results.
+void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
+void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
+void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response);
+void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response);
+void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out);
+// The space's record, stored report and resident index.
+void ToProto(const SpaceSnapshot& snapshot, v1::Space* space);
+void ToProto(const SpaceSnapshot& snapshot, v1::SpaceIndex* index);
+// Coordinates as little-endian float32, as the API promises.
+void ToProto(const Curve& curve, v1::GetCurveResponse* response);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_GRPC_PROTO_CONVERSION_H_

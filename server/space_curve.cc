@@ -1,0 +1,47 @@
+#include "server/space_curve.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+constexpr int kDefaultCurveDims = 3;  // the thesis's plots
+
+}  // namespace
+
+absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database& database,
+                                const CurveRequest& request) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(registry, request.space));
+  const int64_t clip_id = request.clip.clip_id;
+  MOTIONDB_RETURN_IF_ERROR(CheckClipInSpace(database, *snapshot, clip_id));
+  const int space_dims = snapshot->space->dims();
+  const int dims = request.dims.value_or(std::min(kDefaultCurveDims, space_dims));
+  if (dims < 1 || dims > space_dims) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("dims: ", dims, " is outside 1..", space_dims, " (the space's dimensions)"));
+  }
+  Curve curve;
+  MOTIONDB_ASSIGN_OR_RETURN(
+      curve.frames,
+      ResolveFrameRange(request.clip, snapshot->clips.at(clip_id).frame_count, "clip"));
+  const auto [first, last] = snapshot->Conversion(clip_id).ToSpace(curve.frames);
+  const CoordinateView rows = snapshot->index->clip_coordinates(snapshot->index->FindClip(clip_id))
+                                  .middle_rows(first, last - first + 1);
+  // The index holds coordinates multiplied by the metric's scales; a plot wants the projection.
+  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::VectorXd scales, snapshot->space->MetricScales(dims));
+  curve.coordinates.resize(rows.rows, dims);
+  for (int64_t r = 0; r < rows.rows; ++r) {
+    for (int d = 0; d < dims; ++d) {
+      curve.coordinates(r, d) = scales[d] > 0 ? static_cast<float>(rows.row(r)[d] / scales[d]) : 0;
+    }
+  }
+  curve.sample_rate = snapshot->space->sample_rate();
+  return curve;
+}
+
+}  // namespace motiondb::server

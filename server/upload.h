@@ -1,0 +1,31 @@
+// A BVH file sent by a client, to ingest or to search with: its size checked against the
+// server's limit, parsed, and its errors prefixed with what the client called it, so that every
+// upload fails the same way ("walk.bvh: line 19: expected ...").
+#ifndef MOTIONDB_SERVER_UPLOAD_H_
+#define MOTIONDB_SERVER_UPLOAD_H_
+
+#include <cstdint>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "core/bvh/bvh_reader.h"
+
+namespace motiondb::server {
+
+struct UploadLimits {
+  // Largest BVH file, in bytes, whether sent whole or streamed (--max-bvh-mb): larger ones fail
+  // with RESOURCE_EXHAUSTED before they are parsed.
+  int64_t max_bvh_bytes = int64_t{1} << 30;
+};
+
+// RESOURCE_EXHAUSTED when `bytes` (an upload's size, or a stream's so far) exceeds the limit;
+// streams call it as chunks arrive, so an oversize upload is refused before it is all buffered.
+absl::Status CheckUploadSize(int64_t bytes, const UploadLimits& limits);
+
+// The parsed file; errors (the size check's too) begin with `name`.
+absl::StatusOr<BvhReadResult> ReadUpload(absl::string_view bvh, absl::string_view name,
+                                         const UploadLimits& limits);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_UPLOAD_H_
