@@ -20,15 +20,17 @@ IngestRequest IngestRequestOf(const std::string& file_name, const std::string& n
 
 }  // namespace
 
-grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* /*context*/,
+grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
                                          const v1::IngestClipRequest* request,
                                          v1::IngestClipResponse* response) {
-  const absl::StatusOr<IngestOutcome> outcome = IngestUpload(
-      catalog_, IngestRequestOf(request->file_name(), request->name(), request->tags()),
-      request->bvh(), limits_);
-  if (!outcome.ok()) return ToGrpcStatus(outcome.status());
-  ToProto(*outcome, response);
-  return grpc::Status::OK;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<IngestOutcome> outcome = IngestUpload(
+        catalog_, IngestRequestOf(request->file_name(), request->name(), request->tags()),
+        request->bvh(), limits_);
+    if (!outcome.ok()) return ToGrpcStatus(outcome.status());
+    ToProto(*outcome, response);
+    return grpc::Status::OK;
+  });
 }
 
 absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
@@ -54,45 +56,55 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStream
 }
 
 grpc::Status ClipServiceImpl::IngestClipStream(
-    grpc::ServerContext* /*context*/, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+    grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
     v1::IngestClipResponse* response) {
-  return ToGrpcStatus(ReadStream(reader, response));
+  return gate_.Run(context,
+                   [&]() -> grpc::Status { return ToGrpcStatus(ReadStream(reader, response)); });
 }
 
-grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* /*context*/,
+grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
                                         const v1::ListClipsRequest* request,
                                         v1::ListClipsResponse* response) {
-  const absl::StatusOr<storage::ClipPage> page =
-      server::ListClips(database_, {request->page_size(), request->page_token()}, request->tag());
-  if (!page.ok()) return ToGrpcStatus(page.status());
-  for (const storage::ClipRecord& record : page->clips) ToProto(record, response->add_clips());
-  response->set_next_page_token(page->next_page_token);
-  return grpc::Status::OK;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<storage::ClipPage> page =
+        server::ListClips(database_, {request->page_size(), request->page_token()}, request->tag());
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    for (const storage::ClipRecord& record : page->clips) ToProto(record, response->add_clips());
+    response->set_next_page_token(page->next_page_token);
+    return grpc::Status::OK;
+  });
 }
 
-grpc::Status ClipServiceImpl::GetClip(grpc::ServerContext* /*context*/,
+grpc::Status ClipServiceImpl::GetClip(grpc::ServerContext* context,
                                       const v1::GetClipRequest* request, v1::Clip* response) {
-  const absl::StatusOr<storage::StoredClip> stored = database_.GetClip(request->clip_id());
-  if (!stored.ok()) return ToGrpcStatus(stored.status());
-  ToProto(stored->record, response);
-  for (const Joint& joint : stored->clip.skeleton().joints()) response->add_joint_names(joint.name);
-  return grpc::Status::OK;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<storage::StoredClip> stored = database_.GetClip(request->clip_id());
+    if (!stored.ok()) return ToGrpcStatus(stored.status());
+    ToProto(stored->record, response);
+    for (const Joint& joint : stored->clip.skeleton().joints())
+      response->add_joint_names(joint.name);
+    return grpc::Status::OK;
+  });
 }
 
-grpc::Status ClipServiceImpl::DeleteClip(grpc::ServerContext* /*context*/,
+grpc::Status ClipServiceImpl::DeleteClip(grpc::ServerContext* context,
                                          const v1::DeleteClipRequest* request,
                                          v1::DeleteClipResponse* /*response*/) {
-  return ToGrpcStatus(catalog_.DeleteClip(request->clip_id()));
+  return gate_.Run(context, [&]() -> grpc::Status {
+    return ToGrpcStatus(catalog_.DeleteClip(request->clip_id()));
+  });
 }
 
-grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* /*context*/,
+grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
                                          const v1::ExportClipRequest* request,
                                          v1::ExportClipResponse* response) {
-  const absl::StatusOr<ExportedBvh> exported =
-      server::ExportClip(database_, FromProto(request->clip()));
-  if (!exported.ok()) return ToGrpcStatus(exported.status());
-  ToProto(*exported, response);
-  return grpc::Status::OK;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<ExportedBvh> exported =
+        server::ExportClip(database_, FromProto(request->clip()));
+    if (!exported.ok()) return ToGrpcStatus(exported.status());
+    ToProto(*exported, response);
+    return grpc::Status::OK;
+  });
 }
 
 }  // namespace motiondb::server

@@ -5,6 +5,7 @@
 #include "absl/status/status.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/catalog.h"
+#include "server/grpc/call_gate.h"
 #include "server/upload.h"
 #include "storage/database.h"
 
@@ -12,8 +13,9 @@ namespace motiondb::server {
 
 class ClipServiceImpl final : public v1::ClipService::Service {
  public:
-  ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits)
-      : database_(database), catalog_(catalog), limits_(limits) {}
+  ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits,
+                  CallGate& gate)
+      : database_(database), catalog_(catalog), limits_(limits), gate_(gate) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
@@ -36,6 +38,7 @@ class ClipServiceImpl final : public v1::ClipService::Service {
   storage::Database& database_;
   Catalog& catalog_;
   UploadLimits limits_;
+  CallGate& gate_;
 };
 
 }  // namespace motiondb::server

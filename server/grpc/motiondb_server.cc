@@ -2,13 +2,13 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
-#include <grpcpp/resource_quota.h>
 #include <grpcpp/server_builder.h>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "grpc/health/v1/health.pb.h"
 #include "server/catalog.h"
+#include "server/grpc/call_gate.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
 #include "server/grpc/request_logger.h"
@@ -31,6 +31,7 @@ struct MotionDbServer::State {
   IndexRegistry registry;
   std::unique_ptr<Catalog> catalog;
   std::unique_ptr<SearchRunner> runner;
+  std::unique_ptr<CallGate> gate;
   std::unique_ptr<ClipServiceImpl> clips;
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
@@ -73,10 +74,11 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
           .count()));
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
-  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads);
-  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry);
-  s.search = std::make_unique<SearchServiceImpl>(*s.runner);
-  s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options);
+  s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
+  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.gate);
+  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
+  s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
+  s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,
@@ -95,14 +97,6 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.search.get());
   builder.RegisterService(s.info.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
-  if (options.threads > 0) {
-    // The quota counts the sync server's polling threads too: one polls while the others work,
-    // and gRPC keeps up to two. Measured: a quota of N + 2 runs N calls at once; a call that finds
-    // no thread is refused with RESOURCE_EXHAUSTED ("Server Threadpool Exhausted").
-    grpc::ResourceQuota quota("motiondb");
-    quota.SetMaxThreads(options.threads + 2);
-    builder.SetResourceQuota(quota);
-  }
   if (options.log_requests) {
     std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;
     loggers.push_back(std::make_unique<RequestLoggerFactory>());

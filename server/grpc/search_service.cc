@@ -27,10 +27,12 @@ absl::StatusOr<v1::SearchResponse> SearchServiceImpl::SearchOne(
 grpc::Status SearchServiceImpl::Search(grpc::ServerContext* context,
                                        const v1::SearchRequest* request,
                                        v1::SearchResponse* response) {
-  absl::StatusOr<v1::SearchResponse> found = SearchOne(*request, StopWhenCallEnds(context));
-  if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
-  *response = *std::move(found);
-  return grpc::Status::OK;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    absl::StatusOr<v1::SearchResponse> found = SearchOne(*request, StopWhenCallEnds(context));
+    if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
+    *response = *std::move(found);
+    return grpc::Status::OK;
+  });
 }
 
 absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
@@ -62,7 +64,8 @@ absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
 grpc::Status SearchServiceImpl::SearchBatch(grpc::ServerContext* context,
                                             const v1::SearchBatchRequest* request,
                                             v1::SearchBatchResponse* response) {
-  return ToGrpcStatus(Batch(*request, context, response));
+  return gate_.Run(
+      context, [&]() -> grpc::Status { return ToGrpcStatus(Batch(*request, context, response)); });
 }
 
 }  // namespace motiondb::server

@@ -6,13 +6,14 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
+#include "server/grpc/call_gate.h"
 #include "server/search_runner.h"
 
 namespace motiondb::server {
 
 class SearchServiceImpl final : public v1::SearchService::Service {
  public:
-  explicit SearchServiceImpl(const SearchRunner& runner) : runner_(runner) {}
+  SearchServiceImpl(const SearchRunner& runner, CallGate& gate) : runner_(runner), gate_(gate) {}
 
   grpc::Status Search(grpc::ServerContext* context, const v1::SearchRequest* request,
                       v1::SearchResponse* response) override;
@@ -28,6 +29,7 @@ class SearchServiceImpl final : public v1::SearchService::Service {
                                                const std::function<bool()>& should_stop) const;
 
   const SearchRunner& runner_;
+  CallGate& gate_;
 };
 
 }  // namespace motiondb::server

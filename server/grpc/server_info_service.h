@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "motiondb/v1/server_service.grpc.pb.h"
+#include "server/grpc/call_gate.h"
 #include "server/grpc/server_options.h"
 #include "server/index_registry.h"
 #include "storage/database.h"
@@ -15,10 +16,11 @@ namespace motiondb::server {
 class ServerInfoServiceImpl final : public v1::ServerService::Service {
  public:
   ServerInfoServiceImpl(storage::Database& database, const IndexRegistry& registry,
-                        const ServerOptions& options)
+                        const ServerOptions& options, CallGate& gate)
       : database_(database),
         registry_(registry),
         options_(options),
+        gate_(gate),
         start_(std::chrono::steady_clock::now()) {}
 
   grpc::Status GetServerInfo(grpc::ServerContext* context, const v1::GetServerInfoRequest* request,
@@ -28,6 +30,7 @@ class ServerInfoServiceImpl final : public v1::ServerService::Service {
   storage::Database& database_;
   const IndexRegistry& registry_;
   const ServerOptions& options_;
+  CallGate& gate_;
   std::chrono::steady_clock::time_point start_;
 };
 

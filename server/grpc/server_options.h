@@ -15,9 +15,11 @@ struct ServerOptions {
   // host:port to listen on; port 0 picks a free one, reported by MotionDbServer::port()
   // (--listen).
   std::string listen = "127.0.0.1:50051";
-  // Most calls handled at once; further calls are refused with RESOURCE_EXHAUSTED rather than
-  // queued (gRPC's sync-server thread quota). 0: no limit (--threads).
+  // Most calls run at once; further calls wait their turn (server/grpc/call_gate.h). 0: no
+  // limit (--threads).
   int threads = 0;
+  // With `threads`, the most calls waiting; beyond, calls are refused with RESOURCE_EXHAUSTED.
+  int max_waiting_calls = 64;
   // Largest request message, in MiB: gRPC itself refuses larger ones with RESOURCE_EXHAUSTED
   // before any handler runs (--max-message-mb).
   int max_message_mb = 256;

@@ -5,6 +5,7 @@
 #include "absl/status/statusor.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "server/catalog.h"
+#include "server/grpc/call_gate.h"
 #include "server/index_registry.h"
 #include "storage/database.h"
 
@@ -12,8 +13,9 @@ namespace motiondb::server {
 
 class SpaceServiceImpl final : public v1::SpaceService::Service {
  public:
-  SpaceServiceImpl(storage::Database& database, Catalog& catalog, const IndexRegistry& registry)
-      : database_(database), catalog_(catalog), registry_(registry) {}
+  SpaceServiceImpl(storage::Database& database, Catalog& catalog, const IndexRegistry& registry,
+                   CallGate& gate)
+      : database_(database), catalog_(catalog), registry_(registry), gate_(gate) {}
 
   grpc::Status CreateSpace(grpc::ServerContext* context, const v1::CreateSpaceRequest* request,
                            v1::Space* response) override;
@@ -30,6 +32,7 @@ class SpaceServiceImpl final : public v1::SpaceService::Service {
   storage::Database& database_;
   Catalog& catalog_;
   const IndexRegistry& registry_;
+  CallGate& gate_;
 };
 
 }  // namespace motiondb::server
