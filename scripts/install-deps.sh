@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# Installs the Debian packages in scripts/packages.txt that are not installed yet.
+# Installs the Debian 12 packages motiondb needs that are not installed yet.
+#   scripts/install-deps.sh               everything: build, tests, benchmarks, tools
+#   scripts/install-deps.sh --build-only  what a Release server and CLI build needs (Docker)
 # Idempotent: does nothing (and needs no network) when everything is present.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-mapfile -t wanted < <(grep -v '^\s*#' "$here/packages.txt" | awk 'NF {print $1}')
+lists=("$here/packages-build.txt")
+[[ "${1:-}" == "--build-only" ]] || lists+=("$here/packages-dev.txt")
+mapfile -t wanted < <(grep -hv '^\s*#' "${lists[@]}" | awk 'NF {print $1}')
 
 missing=()
 for pkg in "${wanted[@]}"; do

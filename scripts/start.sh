@@ -7,6 +7,9 @@
 #                              Debian's assimp-testmodels, and ../shared/mocap/bandai2-normal
 #                              when it is there, with a space called "demo" to search in
 # Extra arguments after the options go to motiondb-server (e.g. --listen 0.0.0.0:50051).
+# Only the server and the CLI are built here (scripts/test.sh builds the rest). The server's log
+# (one line per request) goes to $MOTIONDB_LOG, default ./motiondb-server.log, so that this
+# terminal stays free for the CLI.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 demo=0
@@ -15,7 +18,7 @@ if [[ "${1:-}" == "--demo" ]]; then
   shift
 fi
 "$root/scripts/install-deps.sh"
-"$root/scripts/build.sh"
+"$root/scripts/build.sh" motiondb-server motiondb
 server="$root/build/server/motiondb-server"
 cli="$root/build/client/motiondb"
 # The CLI talks to wherever the server was told to listen (a wildcard host is reached locally).
@@ -26,12 +29,14 @@ for ((i = 0; i + 1 < ${#args[@]}; i++)); do
 done
 address="${listen/#0.0.0.0:/127.0.0.1:}"
 
-"$server" --db "${MOTIONDB_DB:-./motiondb.sqlite}" "$@" &
+log="${MOTIONDB_LOG:-./motiondb-server.log}"
+"$server" --db "${MOTIONDB_DB:-./motiondb.sqlite}" "$@" 2>>"$log" &
 pid=$!
+echo "motiondb-server: log in $log"
 trap 'kill -TERM "$pid" 2>/dev/null || true' INT TERM
 for _ in $(seq 100); do
   "$cli" info --server "$address" --timeout 1 >/dev/null 2>&1 && break
-  kill -0 "$pid" 2>/dev/null || { wait "$pid"; exit $?; }
+  kill -0 "$pid" 2>/dev/null || { tail -5 "$log" >&2; wait "$pid"; exit $?; }
   sleep 0.2
 done
 "$cli" info --server "$address"
