@@ -445,6 +445,17 @@ TEST_F(SearchTest, ExactSearchFindsThePlantedCopiesAndPrunes) {
       << "early abandoning should skip most cells";
 }
 
+TEST_F(SearchTest, ExactSearchTimesItsWarpsInsideTheTotal) {
+  absl::StatusOr<SearchResponse> exact = ExactSearch(*library_, query(), SearchParams());
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  const SearchStats& stats = exact->stats;
+  EXPECT_GT(stats.warps_ms, 0);
+  // The total adds the query's checks and the ranking, which the warps' time leaves out.
+  EXPECT_LT(stats.warps_ms, stats.total_ms);
+  EXPECT_EQ(stats.seeds_ms, 0);
+  EXPECT_EQ(stats.refine_ms, 0);
+}
+
 TEST(SearchRecall, FastSearchFindsWhatExactSearchFinds) {
   // Eight copies of the pattern at speeds 0.75x to 1.4x among noise: exact search ranks them
   // first, and the fast search must find every one of them.

@@ -192,15 +192,16 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   const auto start = std::chrono::steady_clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
   SearchResponse response;
+  const auto warps = std::chrono::steady_clock::now();
   StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
   for (int c = 0; c < library.clip_count(); ++c) {
     if (!allowed.empty() && !allowed[c]) continue;
     ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
     MOTIONDB_RETURN_IF_ERROR(scan.Run(c, params, top, response.stats));
   }
+  response.stats.warps_ms = MillisecondsSince(warps);
   response.results = FinishResults(library, top.Take(), params);
-  response.stats.warps_ms = response.stats.total_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  response.stats.total_ms = MillisecondsSince(start);
   return response;
 }
 

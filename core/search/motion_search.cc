@@ -14,10 +14,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 // Refinement lowers scores, so it considers this many candidates per result returned.
 constexpr int kRefinePoolFactor = 2;
 

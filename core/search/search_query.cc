@@ -79,4 +79,9 @@ absl::Status CheckStop(const SearchParams& params) {
   return absl::OkStatus();
 }
 
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 }  // namespace motiondb

@@ -30,13 +30,14 @@ struct SearchStats {
   int64_t warps = 0;          // warps completed (inside their clip, not abandoned)
   int64_t cells = 0;          // exact mode: DTW cells evaluated
   int64_t pruned_blocks = 0;  // exact mode: column blocks skipped by the lower bound
+  // Milliseconds per stage; the exact mode has one stage, its warps, and leaves the others 0.
   double characteristic_ms = 0;
   double seeds_ms = 0;
   double clusters_ms = 0;
-  double warps_ms = 0;
+  double warps_ms = 0;  // the warps alone: anchored (fast mode) or over every clip (exact mode)
   double refine_ms = 0;
   double ranking_ms = 0;
-  double total_ms = 0;
+  double total_ms = 0;  // the whole search, checking the query included: at least the stages' sum
 };
 
 struct SearchResponse {

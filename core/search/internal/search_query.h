@@ -1,8 +1,9 @@
 // What the fast and the exact search share: checking a query against a library, the clip filter,
-// and turning a warp into a result.
+// turning a warp into a result, and timing the stages.
 #ifndef MOTIONDB_CORE_SEARCH_INTERNAL_SEARCH_QUERY_H_
 #define MOTIONDB_CORE_SEARCH_INTERNAL_SEARCH_QUERY_H_
 
+#include <chrono>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -30,6 +31,9 @@ std::vector<SearchResult> FinishResults(const LibraryIndex& library,
 
 // CANCELLED when the caller's should_stop says so.
 absl::Status CheckStop(const SearchParams& params);
+
+// Milliseconds since `start`, for SearchStats' timings.
+double MillisecondsSince(std::chrono::steady_clock::time_point start);
 
 }  // namespace motiondb
 

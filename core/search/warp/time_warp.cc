@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/search/warp/internal/dims_major_frames.h"
 #include "util/vector_clones.h"
@@ -12,6 +13,9 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
+// A range of offsets, both ends included; empty when first > last.
+using OffsetRange = std::pair<int64_t, int64_t>;
+
 struct HalfWarp {
   double cost = 0;               // sum of distances over the half's rows, anchor included
   int64_t end_offset = 0;        // clip frames from the anchor to the end of the half
@@ -20,201 +24,265 @@ struct HalfWarp {
 
 // One half of an anchored warp: query rows query_anchor, query_anchor + direction, ... to the
 // query's end, matched to clip frames clip_anchor + direction * offset. At row r the offsets lie
-// in the slope band [r / s, s * r], clipped to the clip. Costs are kept per row and pause state
-// z (state-major, so each row is a few passes of plain array arithmetic):
-//   cost[z = 0][o] = d[o] + min over advance 1..s and any z' of cost_prev[z'][o - advance]
-//   cost[z > 0][o] = d[o] + cost_prev[z - 1][o]      (a pause: the clip frame repeats)
-// Cells reaching `budget` are dropped (early abandoning); nullopt when a whole row is.
+// in the slope band [r / s, s * r] clipped to the clip, [low(r), high(r)]. Row r's cells start at
+// row_offsets[r] in the workspace's table: s arrays (one per pause state) of the row's width.
+struct HalfBand {
+  CoordinateView query;
+  int query_anchor = 0;
+  int direction = 1;
+  int dims = 0;
+  int s = 1;               // the slope limit
+  int rows = 0;            // query rows in the half, the anchor's included
+  int64_t max_offset = 0;  // the clip's end
+  int64_t span = 0;        // offsets [0, span): the copied clip frames, all the half can reach
+
+  const float* query_row(int r) const { return query.row(query_anchor + direction * r); }
+  int64_t low(int64_t r) const { return r / s; }
+  int64_t high(int64_t r) const { return std::min<int64_t>(s * r, max_offset); }
+  int64_t width(int64_t r) const { return high(r) - low(r) + 1; }
+};
+
+// The pieces of WarpHalf below are always inlined into it: WarpHalf is compiled once per
+// MOTIONDB_VECTOR_CLONES target, and an out-of-line piece would run the baseline build in the
+// AVX2 clone too.
+
+// Any valid path bounds the optimum, and no cell at or above its cost can lead to a better
+// half (costs only grow). The greedy path, taking the cheapest allowed step on every row,
+// follows the valley closely, so the cells that survive hug the best paths. Returns the bound
+// for the cells: `budget`, or just above the greedy path's cost when that is lower.
+[[gnu::always_inline]] inline float GreedyBound(const HalfBand& band,
+                                                const std::vector<float>& frames,
+                                                float anchor_distance, float budget) {
+  float greedy = anchor_distance;
+  int64_t o = 0;
+  int pauses = 0;
+  for (int r = 1; r < band.rows && greedy < budget; ++r) {
+    const float* q = band.query_row(r);
+    float step_best = kInfinity;
+    int step_advance = 0;
+    for (int advance = pauses + 1 < band.s ? 0 : 1; advance <= band.s; ++advance) {
+      if (o + advance > band.max_offset || o + advance < band.low(r)) continue;
+      float d = 0.0f;
+      for (int k = 0; k < band.dims; ++k) {
+        const float diff = q[k] - frames[k * band.span + o + advance];
+        d += diff * diff;
+      }
+      if (d < step_best) {
+        step_best = d;
+        step_advance = advance;
+      }
+    }
+    if (step_best == kInfinity) {
+      greedy = kInfinity;  // the greedy path ran out of clip
+      break;
+    }
+    o += step_advance;
+    pauses = step_advance == 0 ? pauses + 1 : 0;
+    greedy += std::sqrt(step_best);
+  }
+  return std::min(budget, std::nextafter(greedy, kInfinity));
+}
+
+// The element-wise passes of a row. The arrays of one call do not overlap unless said so, and
+// __restrict lets the vectoriser rely on that instead of checking on every call.
+
+// out[i] = min(out[i], in[i]).
+[[gnu::always_inline]] inline void MinInto(const float* __restrict in, int64_t count,
+                                           float* __restrict out) {
+  for (int64_t i = 0; i < count; ++i) out[i] = std::min(out[i], in[i]);
+}
+
+// out[i] = in[i] + d[i], made infinite when it reaches `bound`; `in` may be `out`.
+[[gnu::always_inline]] inline void AddBelow(const float* in, const float* __restrict d,
+                                            int64_t count, float bound, float* out) {
+  for (int64_t i = 0; i < count; ++i) {
+    const float c = in[i] + d[i];
+    out[i] = c < bound ? c : kInfinity;
+  }
+}
+
+// best[s + i] = the cheapest pause state of the previous row's offset prev_low + i, for the
+// survivors `alive`, padded with s infinities on both sides so that every advance of 1..s
+// indexes it without a bounds check. Only as much is written as the advances will read.
+[[gnu::always_inline]] inline void BestOfCells(const float* prev, int64_t prev_low,
+                                               int64_t prev_width, int s, OffsetRange alive,
+                                               std::vector<float>& best) {
+  best.resize(prev_width + 2 * s);
+  {
+    const int64_t from = std::max<int64_t>(0, alive.first - prev_low);
+    const int64_t to = std::min<int64_t>(prev_width + 2 * s, alive.second - prev_low + 2 * s + 1);
+    std::fill(best.begin() + from, best.begin() + to, kInfinity);
+  }
+  const int64_t from = alive.first - prev_low, count = alive.second - alive.first + 1;
+  float* out = best.data() + s + from;
+  std::copy(prev + from, prev + from + count, out);
+  for (int z = 1; z < s; ++z) MinInto(prev + z * prev_width + from, count, out);
+}
+
+// Row r of the table from row r - 1, whose finite cells lie on the offsets `alive`: fills the
+// offsets those can reach and returns them (empty: none can), every cell that reaches `bound`
+// made infinite (early abandoning). Costs are kept per pause state z (state-major, so that the
+// row is a few passes of plain array arithmetic):
+//   row[z = 0][o] = d[o] + min over advance 1..s and any z' of prev[z'][o - advance]
+//   row[z > 0][o] = d[o] + prev[z - 1][o]      (a pause: the clip frame repeats)
+[[gnu::always_inline]] inline OffsetRange StepRow(const HalfBand& band, int r, OffsetRange alive,
+                                                  float bound, WarpWorkspace& ws) {
+  const int s = band.s;
+  const int64_t prev_low = band.low(r - 1), prev_width = band.width(r - 1);
+  const int64_t row_low = band.low(r), width = band.width(r);
+  const float* prev = ws.cost[0].data() + ws.row_offsets[r - 1];
+  float* row = ws.cost[0].data() + ws.row_offsets[r];
+  BestOfCells(prev, prev_low, prev_width, s, alive, ws.best_of_cell);
+  // Reachable now: a pause stays on an offset, an advance moves up to s further.
+  const int64_t first = std::max(row_low, alive.first);
+  const int64_t last = std::min(row_low + width - 1, alive.second + s);
+  if (first > last) return {first, last};
+  const int64_t count = last - first + 1;
+  for (int z = 1; z < s; ++z) {
+    std::fill(row + z * width + (first - row_low), row + z * width + (last - row_low) + 1,
+              kInfinity);
+  }
+  std::vector<float>& distances = ws.cost[1];
+  distances.resize(count);
+  DistancesToCopied(band.query_row(r), ws.frames, band.span, band.dims, first, count,
+                    distances.data());
+  float* cells = row + (first - row_low);
+  const float* base = ws.best_of_cell.data() + (first - prev_low + s);
+  std::copy(base - 1, base - 1 + count, cells);
+  for (int advance = 2; advance <= s; ++advance) MinInto(base - advance, count, cells);
+  AddBelow(cells, distances.data(), count, bound, cells);
+  // Pauses reach only the offsets where the previous row has cells.
+  const int64_t paused =
+      std::min(last, std::min(prev_low + prev_width - 1, alive.second)) - first + 1;
+  for (int z = 1; z < s; ++z) {
+    AddBelow(prev + (z - 1) * prev_width + (first - prev_low), distances.data(), paused, bound,
+             row + z * width + (first - row_low));
+  }
+  return {first, last};
+}
+
+// The offsets of row r (`row`, filled over `computed`) with a finite cell in some state (empty:
+// none). Scanned inwards from both ends, which stops at once in the usual case of survivors at
+// the edges.
+[[gnu::always_inline]] inline OffsetRange SurvivorRange(const HalfBand& band, int r,
+                                                        const float* row, OffsetRange computed) {
+  const int64_t row_low = band.low(r), width = band.width(r);
+  const auto alive = [&](int64_t o) {
+    for (int z = 0; z < band.s; ++z) {
+      if (row[z * width + (o - row_low)] < kInfinity) return true;
+    }
+    return false;
+  };
+  int64_t first = computed.first;
+  while (first <= computed.second && !alive(first)) ++first;
+  int64_t last = computed.second;
+  while (last >= first && !alive(last)) --last;
+  return {first, last};
+}
+
+struct HalfEnd {
+  float cost = kInfinity;
+  int64_t offset = 0;
+  int state = 0;  // pause state
+};
+
+// The cheapest cell on the half's last row, the query's boundary.
+[[gnu::always_inline]] inline HalfEnd BestEnd(const HalfBand& band, const WarpWorkspace& ws) {
+  const int r = band.rows - 1;
+  const int64_t row_low = band.low(r), width = band.width(r);
+  const float* row = ws.cost[0].data() + ws.row_offsets[r];
+  HalfEnd end;
+  for (int z = 0; z < band.s; ++z) {
+    for (int64_t o = ws.computed[r].first; o <= ws.computed[r].second; ++o) {
+      const float c = row[z * width + (o - row_low)];
+      if (c < end.cost) end = {c, o, z};
+    }
+  }
+  return end;
+}
+
+// The offset of every row on the best path to `end`, walking back through the table and
+// re-deriving each step from the stored costs.
+[[gnu::always_inline]] inline void Backtrack(const HalfBand& band, const WarpWorkspace& ws,
+                                             const HalfEnd& end, std::vector<int64_t>& offsets) {
+  offsets.resize(band.rows);
+  int64_t o = end.offset;
+  int z = end.state;
+  for (int r = band.rows - 1; r > 0; --r) {
+    offsets[r] = o;
+    if (z > 0) {
+      --z;  // the pause: same offset, one pause fewer
+      continue;
+    }
+    const int64_t prev_low = band.low(r - 1), prev_width = band.width(r - 1);
+    const float* prev = ws.cost[0].data() + ws.row_offsets[r - 1];
+    const OffsetRange computed = ws.computed[r - 1];
+    float m = kInfinity;
+    int64_t best_o = o;
+    int best_z = 0;
+    for (int advance = 1; advance <= band.s; ++advance) {
+      if (o - advance < computed.first || o - advance > computed.second) continue;
+      const int64_t i = o - advance - prev_low;
+      for (int state = 0; state < band.s; ++state) {
+        if (prev[state * prev_width + i] < m) {
+          m = prev[state * prev_width + i];
+          best_o = o - advance;
+          best_z = state;
+        }
+      }
+    }
+    o = best_o;
+    z = best_z;
+  }
+  offsets[0] = 0;
+}
+
+// One half of an anchored warp (see HalfBand), row by row from the anchor. Cells reaching
+// `budget` are dropped (early abandoning); nullopt when a whole row is, or when the clip ends
+// before the query does.
 MOTIONDB_VECTOR_CLONES std::optional<HalfWarp> WarpHalf(
     CoordinateView query, CoordinateView clip, int query_anchor, int64_t clip_anchor, int direction,
     const WarpConstraints& constraints, bool with_path, float budget, WarpWorkspace& ws) {
-  const int s = constraints.slope_limit;
-  const int rows = direction > 0 ? static_cast<int>(query.rows) - query_anchor : query_anchor + 1;
-  const int64_t max_offset = direction > 0 ? clip.rows - 1 - clip_anchor : clip_anchor;
-  if ((rows - 1) / s > max_offset) return std::nullopt;  // the clip ends before the query does
-
-  // Row r's cells start at row_start[r] in the table: s arrays of the row's band width.
-  auto low = [s](int64_t r) { return r / s; };
-  auto high = [s, max_offset](int64_t r) { return std::min<int64_t>(s * r, max_offset); };
-  ws.row_offsets.resize(rows + 1);
+  HalfBand band;
+  band.query = query;
+  band.query_anchor = query_anchor;
+  band.direction = direction;
+  band.dims = constraints.dims;
+  band.s = constraints.slope_limit;
+  band.rows = direction > 0 ? static_cast<int>(query.rows) - query_anchor : query_anchor + 1;
+  band.max_offset = direction > 0 ? clip.rows - 1 - clip_anchor : clip_anchor;
+  if ((band.rows - 1) / band.s > band.max_offset) return std::nullopt;  // the clip ends first
+  band.span = band.high(band.rows - 1) + 1;
+  ws.row_offsets.resize(band.rows + 1);
   ws.row_offsets[0] = 0;
-  for (int r = 0; r < rows; ++r) {
-    ws.row_offsets[r + 1] = ws.row_offsets[r] + (high(r) - low(r) + 1) * s;
+  for (int r = 0; r < band.rows; ++r) {
+    ws.row_offsets[r + 1] = ws.row_offsets[r] + band.width(r) * band.s;
   }
+  CopyDimsMajor(clip, clip_anchor, direction, band.span, band.dims, ws.frames);
+  const float anchor = Distance(query.row(query_anchor), clip.row(clip_anchor), band.dims);
+  const float bound = GreedyBound(band, ws.frames, anchor, budget);
+
+  // Only each row's computed range is initialised; every cell outside it is infinite.
   std::vector<float>& table = ws.cost[0];
-  std::vector<float>& best = ws.best_of_cell;  // per previous-row cell: min over its states
-  std::vector<float>& distances = ws.cost[1];
-  const int64_t span = high(rows - 1) + 1;
-  CopyDimsMajor(clip, clip_anchor, direction, span, constraints.dims, ws.frames);
-  // Any valid path bounds the optimum, and no cell at or above its cost can lead to a better
-  // half (costs only grow). The greedy path, taking the cheapest allowed step on every row,
-  // follows the valley closely, so the cells that survive hug the best paths, and each row only
-  // computes the offsets the previous row's survivors can reach.
-  float bound = budget;
-  {
-    float greedy = Distance(query.row(query_anchor), clip.row(clip_anchor), constraints.dims);
-    int64_t o = 0;
-    int pauses = 0;
-    for (int r = 1; r < rows && greedy < bound; ++r) {
-      const float* q = query.row(query_anchor + direction * r);
-      float step_best = kInfinity;
-      int step_advance = 0;
-      for (int advance = pauses + 1 < s ? 0 : 1; advance <= s; ++advance) {
-        if (o + advance > max_offset || o + advance < low(r)) continue;
-        float d = 0.0f;
-        for (int k = 0; k < constraints.dims; ++k) {
-          const float diff = q[k] - ws.frames[k * span + o + advance];
-          d += diff * diff;
-        }
-        if (d < step_best) {
-          step_best = d;
-          step_advance = advance;
-        }
-      }
-      if (step_best == kInfinity) {
-        greedy = kInfinity;  // the greedy path ran out of clip
-        break;
-      }
-      o += step_advance;
-      pauses = step_advance == 0 ? pauses + 1 : 0;
-      greedy += std::sqrt(step_best);
-    }
-    bound = std::min(bound, std::nextafter(greedy, kInfinity));
-  }
-  // Only each row's computed range [computed[r].first, .second] is initialised; every cell
-  // outside it is infinite.
-  table.resize(ws.row_offsets[rows]);
-  std::vector<std::pair<int64_t, int64_t>>& computed = ws.computed;
-  computed.assign(rows, {0, -1});
-  std::fill(table.begin(), table.begin() + s, kInfinity);
-  table[0] = Distance(query.row(query_anchor), clip.row(clip_anchor), constraints.dims);
-  computed[0] = {0, 0};
+  table.resize(ws.row_offsets[band.rows]);
+  ws.computed.assign(band.rows, {0, -1});
+  std::fill(table.begin(), table.begin() + band.s, kInfinity);
+  table[0] = anchor;
+  ws.computed[0] = {0, 0};
   if (table[0] >= bound) return std::nullopt;
-  int64_t alive_first = 0, alive_last = 0;  // offsets with a finite cell in the previous row
-
-  for (int r = 1; r < rows; ++r) {
-    const int64_t prev_low = low(r - 1), prev_width = high(r - 1) - prev_low + 1;
-    const int64_t row_low = low(r), width = high(r) - row_low + 1;
-    const float* prev = table.data() + ws.row_offsets[r - 1];
-    float* row = table.data() + ws.row_offsets[r];
-    // best[s + i] is the previous row's offset prev_low + i, padded with s infinities on both
-    // sides so that every advance of 1..s indexes it without a bounds check.
-    best.resize(prev_width + 2 * s);
-    {
-      // Infinities around the survivors, as far as any advance reads.
-      const int64_t from = std::max<int64_t>(0, alive_first - prev_low);
-      const int64_t to = std::min<int64_t>(prev_width + 2 * s, alive_last - prev_low + 2 * s + 1);
-      std::fill(best.begin() + from, best.begin() + to, kInfinity);
-    }
-    {
-      const int64_t from = alive_first - prev_low, count = alive_last - alive_first + 1;
-      float* out = best.data() + s + from;
-      std::copy(prev + from, prev + from + count, out);
-      for (int z = 1; z < s; ++z) {
-        const float* state = prev + z * prev_width + from;
-        for (int64_t i = 0; i < count; ++i) out[i] = std::min(out[i], state[i]);
-      }
-    }
-    // Reachable now: a pause stays on an offset, an advance moves up to s further.
-    const int64_t first = std::max(row_low, alive_first);
-    const int64_t last = std::min(row_low + width - 1, alive_last + s);
-    if (first > last) return std::nullopt;
-    const int64_t count = last - first + 1;
-    computed[r] = {first, last};
-    for (int z = 1; z < s; ++z) {
-      std::fill(row + z * width + (first - row_low), row + z * width + (last - row_low) + 1,
-                kInfinity);
-    }
-    distances.resize(count);
-    DistancesToCopied(query.row(query_anchor + direction * r), ws.frames, span, constraints.dims,
-                      first, count, distances.data());
-    // Advance 1..s, from any state, ends in state 0: row[o] = d[o] + min_a best[o - a].
-    float* cells = row + (first - row_low);
-    const float* base = best.data() + (first - prev_low + s);
-    std::copy(base - 1, base - 1 + count, cells);
-    for (int advance = 2; advance <= s; ++advance) {
-      const float* from = base - advance;
-      for (int64_t o = 0; o < count; ++o) cells[o] = std::min(cells[o], from[o]);
-    }
-    for (int64_t o = 0; o < count; ++o) {
-      const float c = cells[o] + distances[o];
-      cells[o] = c < bound ? c : kInfinity;
-    }
-    // A pause keeps the offset and adds one to the pause count.
-    for (int z = 1; z < s; ++z) {
-      float* paused = row + z * width;
-      const float* from = prev + (z - 1) * prev_width;
-      const int64_t stop = std::min(last, std::min(prev_low + prev_width - 1, alive_last));
-      for (int64_t o = first; o <= stop; ++o) {
-        const float c = from[o - prev_low] + distances[o - first];
-        paused[o - row_low] = c < bound ? c : kInfinity;
-      }
-    }
-    // The survivors' range, for the next row: scanned inwards from both ends, which stops at
-    // once in the usual case of survivors at the edges.
-    const auto alive = [&](int64_t o) {
-      for (int z = 0; z < s; ++z) {
-        if (row[z * width + (o - row_low)] < kInfinity) return true;
-      }
-      return false;
-    };
-    alive_first = first;
-    while (alive_first <= last && !alive(alive_first)) ++alive_first;
-    alive_last = last;
-    while (alive_last >= alive_first && !alive(alive_last)) --alive_last;
-    if (alive_first > alive_last) return std::nullopt;
+  OffsetRange alive = {0, 0};  // offsets with a finite cell in the previous row
+  for (int r = 1; r < band.rows; ++r) {
+    const OffsetRange computed = StepRow(band, r, alive, bound, ws);
+    if (computed.first > computed.second) return std::nullopt;
+    ws.computed[r] = computed;
+    alive = SurvivorRange(band, r, table.data() + ws.row_offsets[r], computed);
+    if (alive.first > alive.second) return std::nullopt;
   }
 
-  // The best end on the query's boundary row.
-  const int64_t last_low = low(rows - 1), last_width = high(rows - 1) - last_low + 1;
-  const float* last = table.data() + ws.row_offsets[rows - 1];
-  float end_cost = kInfinity;
-  int64_t end_offset = 0;
-  int end_state = 0;
-  for (int z = 0; z < s; ++z) {
-    for (int64_t o = computed[rows - 1].first; o <= computed[rows - 1].second; ++o) {
-      const float c = last[z * last_width + (o - last_low)];
-      if (c < end_cost) {
-        end_cost = c;
-        end_offset = o;
-        end_state = z;
-      }
-    }
-  }
-  if (end_cost == kInfinity) return std::nullopt;
-  HalfWarp half{end_cost, end_offset, {}};
-  if (with_path) {
-    // Walk back through the table, re-deriving each step from the stored costs.
-    half.offsets.resize(rows);
-    int64_t o = half.end_offset;
-    int z = end_state;
-    for (int r = rows - 1; r > 0; --r) {
-      half.offsets[r] = o;
-      const int64_t prev_low = low(r - 1), prev_width = high(r - 1) - prev_low + 1;
-      const float* prev = table.data() + ws.row_offsets[r - 1];
-      if (z > 0) {
-        --z;  // the pause: same offset, one pause fewer
-        continue;
-      }
-      float m = kInfinity;
-      int64_t best_o = o;
-      int best_z = 0;
-      for (int advance = 1; advance <= s; ++advance) {
-        const int64_t i = o - advance - prev_low;
-        if (o - advance < computed[r - 1].first || o - advance > computed[r - 1].second) continue;
-        for (int state = 0; state < s; ++state) {
-          if (prev[state * prev_width + i] < m) {
-            m = prev[state * prev_width + i];
-            best_o = o - advance;
-            best_z = state;
-          }
-        }
-      }
-      o = best_o;
-      z = best_z;
-    }
-    half.offsets[0] = 0;
-  }
+  const HalfEnd end = BestEnd(band, ws);
+  if (end.cost == kInfinity) return std::nullopt;
+  HalfWarp half{end.cost, end.offset, {}};
+  if (with_path) Backtrack(band, ws, end, half.offsets);
   return half;
 }
 
