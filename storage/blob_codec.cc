@@ -6,13 +6,13 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/motion/skeleton_coding.h"
 #include "util/byte_coding.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
-// Layout blob, version 1 (little-endian):
-//   u8 version, u32 joint count; per joint: u32 name length, name bytes, i32 parent,
-//   3 f64 offset, u8 channel count, that many u8 Channel values, u8 End Site flag,
-//   [3 f64 End Site].
+// Layout blob, version 1: u8 version, then the skeleton as core/motion/skeleton_coding.h
+// writes it.
 
 namespace motiondb::storage {
 namespace {
@@ -84,16 +84,7 @@ absl::StatusOr<RowMatrixXd> ParseRotationBlob(absl::string_view blob, int64_t fr
 std::string SkeletonLayoutBlob(const Skeleton& skeleton) {
   ByteWriter out;
   out.U8(kLayoutVersion);
-  out.U32(skeleton.joint_count());
-  for (const Joint& joint : skeleton.joints()) {
-    out.Str(joint.name);
-    out.I32(joint.parent);
-    out.F64s(joint.offset.data(), 3);
-    out.U8(static_cast<uint8_t>(joint.channels.size()));
-    for (const Channel channel : joint.channels) out.U8(static_cast<uint8_t>(channel));
-    out.U8(joint.end_site.has_value());
-    if (joint.end_site) out.F64s(joint.end_site->data(), 3);
-  }
+  WriteSkeleton(skeleton, out);
   return std::move(out.bytes());
 }
 
@@ -103,31 +94,12 @@ absl::StatusOr<std::shared_ptr<const Skeleton>> ParseSkeletonLayout(absl::string
   if (version != kLayoutVersion) {
     return absl::DataLossError(absl::StrCat("clip layout has unknown version ", version));
   }
-  // A joint takes at least 35 bytes, so a damaged count cannot cause a huge allocation.
-  MOTIONDB_ASSIGN_OR_RETURN(const uint32_t count, in.Count("joint count", 35));
-  std::vector<Joint> joints(count);
-  for (Joint& joint : joints) {
-    MOTIONDB_ASSIGN_OR_RETURN(joint.name, in.Str("joint name"));
-    MOTIONDB_ASSIGN_OR_RETURN(joint.parent, in.I32("joint parent"));
-    MOTIONDB_RETURN_IF_ERROR(in.F64s("joint offset", joint.offset.data(), 3));
-    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t channels, in.U8("channel count"));
-    for (uint8_t c = 0; c < channels; ++c) {
-      MOTIONDB_ASSIGN_OR_RETURN(const uint8_t channel, in.U8("channel"));
-      if (channel > static_cast<uint8_t>(Channel::kZrotation)) {
-        return absl::DataLossError(absl::StrCat("clip layout has unknown channel ", channel));
-      }
-      joint.channels.push_back(static_cast<Channel>(channel));
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t has_end_site, in.U8("End Site flag"));
-    if (has_end_site != 0) {
-      MOTIONDB_RETURN_IF_ERROR(in.F64s("End Site", joint.end_site.emplace().data(), 3));
-    }
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(std::shared_ptr<const Skeleton> skeleton,
+                            Prefixed("clip layout", ReadSkeleton(in)));
   if (in.remaining() != 0) {
     return absl::DataLossError(absl::StrCat("clip layout has ", in.remaining(), " extra bytes"));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(std::move(joints)));
-  return std::make_shared<const Skeleton>(std::move(skeleton));
+  return skeleton;
 }
 
 std::string TopologyKey(const Skeleton& skeleton) {

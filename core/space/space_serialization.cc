@@ -5,6 +5,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/motion/skeleton_coding.h"
 #include "util/byte_coding.h"
 #include "util/crc32.h"
 #include "util/file_io.h"
@@ -27,46 +28,6 @@ constexpr size_t kHeaderSize = 8 + 4 + 8;
 constexpr size_t kChecksumSize = 4;
 // Files larger than this are refused before reading: a 1000-joint space is about 72 MB.
 constexpr int64_t kMaxFileBytes = int64_t{1} << 30;
-
-void WriteSkeleton(const Skeleton& skeleton, ByteWriter& out) {
-  out.U32(skeleton.joint_count());
-  for (const Joint& joint : skeleton.joints()) {
-    out.Str(joint.name);
-    out.I32(joint.parent);
-    out.F64s(joint.offset.data(), 3);
-    out.U8(static_cast<uint8_t>(joint.channels.size()));
-    for (const Channel channel : joint.channels) out.U8(static_cast<uint8_t>(channel));
-    out.U8(joint.end_site ? 1 : 0);
-    if (joint.end_site) out.F64s(joint.end_site->data(), 3);
-  }
-}
-
-absl::StatusOr<std::shared_ptr<const Skeleton>> ReadSkeleton(ByteReader& in) {
-  // A joint takes at least a name length, a parent, an offset and two counts.
-  MOTIONDB_ASSIGN_OR_RETURN(const uint32_t joints, in.Count("joint count", 4 + 4 + 24 + 2));
-  std::vector<Joint> parsed(joints);
-  for (Joint& joint : parsed) {
-    MOTIONDB_ASSIGN_OR_RETURN(joint.name, in.Str("joint name"));
-    MOTIONDB_ASSIGN_OR_RETURN(joint.parent, in.I32("joint parent"));
-    MOTIONDB_RETURN_IF_ERROR(in.F64s("joint offset", joint.offset.data(), 3));
-    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t channels, in.U8("channel count"));
-    for (uint8_t c = 0; c < channels; ++c) {
-      MOTIONDB_ASSIGN_OR_RETURN(const uint8_t channel, in.U8("channel"));
-      if (channel > static_cast<uint8_t>(Channel::kZrotation)) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("space joint '", joint.name, "' has unknown channel ", channel));
-      }
-      joint.channels.push_back(static_cast<Channel>(channel));
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t has_end_site, in.U8("End Site flag"));
-    if (has_end_site) {
-      joint.end_site.emplace();
-      MOTIONDB_RETURN_IF_ERROR(in.F64s("End Site", joint.end_site->data(), 3));
-    }
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(std::move(parsed)));
-  return std::make_shared<const Skeleton>(std::move(skeleton));
-}
 
 absl::StatusOr<SpaceData> ReadPayload(ByteReader& in) {
   SpaceData data;
