@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "testing/corpus_paths.h"
+
 namespace motiondb::bench {
 
 using Clock = std::chrono::steady_clock;
@@ -37,14 +39,8 @@ inline double StatusMiB(pid_t pid, const std::string& field) {
   return 0;
 }
 
-// The shared mocap folder: $MOTIONDB_MOCAP_DIR when set and not empty, else the build's
-// MOTIONDB_MOCAP_DIR (../shared/mocap beside the checkout), as the tests find it.
-inline std::filesystem::path MocapRoot() {
-  if (const char* env = std::getenv("MOTIONDB_MOCAP_DIR"); env != nullptr && *env != '\0') {
-    return env;
-  }
-  return MOTIONDB_MOCAP_DIR;
-}
+// The shared mocap folder, as the tests find it.
+using testing::MocapRoot;
 
 }  // namespace motiondb::bench
 

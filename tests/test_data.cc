@@ -21,13 +21,6 @@ std::optional<std::filesystem::path> ExistingDir(const std::filesystem::path& pa
 
 }  // namespace
 
-std::optional<std::filesystem::path> MocapDir() {
-  if (const char* env = std::getenv("MOTIONDB_MOCAP_DIR"); env != nullptr && *env != '\0') {
-    return ExistingDir(env);
-  }
-  return ExistingDir(MOTIONDB_MOCAP_DIR);
-}
-
 std::optional<std::filesystem::path> AssimpBvhDir() { return ExistingDir(MOTIONDB_ASSIMP_BVH_DIR); }
 
 std::string CliPath() { return MOTIONDB_CLI_PATH; }

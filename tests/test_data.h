@@ -9,12 +9,10 @@
 #include <vector>
 
 #include "core/motion/clip.h"
+#include "testing/corpus_paths.h"  // MocapDir()
 
 namespace motiondb::testing {
 
-// The shared corpus (env MOTIONDB_MOCAP_DIR overrides the build-time path), or nullopt when it
-// is absent.
-std::optional<std::filesystem::path> MocapDir();
 // Debian's assimp-testmodels BVH folder, or nullopt when the package is not installed.
 std::optional<std::filesystem::path> AssimpBvhDir();
 // The built motiondb CLI.
