@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/space/search_coordinates.h"
+#include "storage/content_hash.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -49,9 +50,85 @@ absl::Status Catalog::LoadIndices() {
   return absl::OkStatus();
 }
 
+absl::Status Catalog::ChangeIndices(
+    int64_t skeleton_id,
+    const std::function<absl::StatusOr<std::shared_ptr<const SpaceSnapshot>>(const SpaceSnapshot&)>&
+        change) {
+  for (const auto& space : registry_.OfSkeleton(skeleton_id)) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated = change(*space);
+    if (!updated.ok()) return StaleIndexError(space->record.name, updated.status());
+    registry_.Put(*std::move(updated));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::optional<IngestedClip>> Catalog::ResolveConflict(
+    const storage::ClipRecord& existing, const Clip& clip, OnConflict on_conflict) {
+  const std::string taken = absl::StrCat("a clip named '", existing.name, "' already exists (clip ",
+                                         existing.clip_id, ")");
+  IngestedClip skipped;
+  skipped.record = existing;
+  skipped.result = IngestResult::kSkipped;
+  switch (on_conflict) {
+    case OnConflict::kReplace:
+      return std::nullopt;
+    case OnConflict::kSkip:
+      return skipped;
+    case OnConflict::kError:
+      return absl::AlreadyExistsError(taken);
+    case OnConflict::kSkipIdentical:
+      break;
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string content_hash, storage::ContentHash(clip));
+  if (content_hash == existing.content_hash) return skipped;
+  return absl::AlreadyExistsError(
+      absl::StrCat(taken,
+                   " with other content; pass on_conflict skip to keep it, or replace to "
+                   "store this file in its place"));
+}
+
+absl::Status Catalog::IndexIngested(
+    IngestedClip& ingested, const std::vector<std::shared_ptr<const SpaceSnapshot>>& spaces,
+    std::vector<std::pair<int64_t, storage::Projection>> projections,
+    const std::optional<storage::ClipRecord>& replaced) {
+  const storage::ClipRecord& record = ingested.record;
+  const int64_t replaced_id = replaced ? replaced->clip_id : 0;
+  const ClipTiming timing = ClipTiming::Of(record);
+  for (size_t i = 0; i < spaces.size(); ++i) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated = SnapshotWithClip(
+        *spaces[i],
+        {{record.clip_id, record.name, record.tags, std::move(projections[i].second.coordinates)},
+         timing},
+        replaced_id);
+    if (!updated.ok()) return StaleIndexError(spaces[i]->record.name, updated.status());
+    registry_.Put(*std::move(updated));
+    ingested.spaces.push_back(spaces[i]->record.name);
+  }
+  // The spaces above have dropped the replaced clip if it was theirs; another skeleton's have not.
+  if (replaced && replaced->skeleton_id != record.skeleton_id) {
+    return ChangeIndices(replaced->skeleton_id, [&](const SpaceSnapshot& space) {
+      return SnapshotWithoutClip(space, replaced_id);
+    });
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& record,
-                                                 const Clip& clip) {
+                                                 const Clip& clip, OnConflict on_conflict) {
   std::lock_guard<std::mutex> lock(write_mutex_);
+  // Decided before the projections are computed, which a skip or a refusal does not need. The
+  // database checks the name again in the insert's transaction.
+  std::optional<storage::ClipRecord> replaced;
+  absl::StatusOr<storage::ClipRecord> existing = database_.GetClipRecordByName(record.name);
+  if (existing.ok()) {
+    MOTIONDB_ASSIGN_OR_RETURN(std::optional<IngestedClip> kept,
+                              ResolveConflict(*existing, clip, on_conflict));
+    if (kept) return *std::move(kept);
+    replaced = *std::move(existing);
+  } else if (!absl::IsNotFound(existing.status())) {
+    return existing.status();
+  }
+
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database_.FindSkeleton(clip.skeleton()));
   std::vector<std::shared_ptr<const SpaceSnapshot>> spaces;
   if (skeleton_id >= 0) spaces = registry_.OfSkeleton(skeleton_id);
@@ -60,19 +137,28 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
     MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space->space, clip));
     projections.push_back({space->record.space_id, storage::Projection{0, std::move(coordinates)}});
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id, database_.InsertClip(record, clip, projections));
+  storage::InsertClipOptions options;
+  if (replaced) options.replace_clip_id = replaced->clip_id;
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id,
+                            database_.InsertClip(record, clip, projections, options));
   IngestedClip ingested;
   MOTIONDB_ASSIGN_OR_RETURN(ingested.record, database_.GetClipRecord(clip_id));
-  const ClipTiming timing = ClipTiming::Of(ingested.record);
-  for (size_t i = 0; i < spaces.size(); ++i) {
-    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
-        SnapshotWithClip(*spaces[i], {{clip_id, ingested.record.name, ingested.record.tags,
-                                       std::move(projections[i].second.coordinates)},
-                                      timing});
-    if (!updated.ok()) return StaleIndexError(spaces[i]->record.name, updated.status());
-    registry_.Put(*std::move(updated));
-    ingested.spaces.push_back(spaces[i]->record.name);
+  if (replaced) {
+    ingested.result = IngestResult::kReplaced;
+    ingested.replaced_clip_id = replaced->clip_id;
   }
+  MOTIONDB_RETURN_IF_ERROR(IndexIngested(ingested, spaces, std::move(projections), replaced));
+
+  // One more than reported, since the new clip is among them.
+  absl::StatusOr<std::vector<storage::ClipRecord>> same =
+      database_.FindClipsByContentHash(ingested.record.content_hash, kMaxDuplicatesReported + 1);
+  if (!same.ok()) {
+    return Prefixed(absl::StrCat("stored as clip ", clip_id, ", but its duplicates are unknown"),
+                    same.status());
+  }
+  std::erase_if(*same, [&](const storage::ClipRecord& other) { return other.clip_id == clip_id; });
+  if (same->size() > static_cast<size_t>(kMaxDuplicatesReported)) same->pop_back();
+  ingested.duplicates = *std::move(same);
   return ingested;
 }
 
@@ -80,13 +166,19 @@ absl::Status Catalog::DeleteClip(int64_t clip_id) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record, database_.GetClipRecord(clip_id));
   MOTIONDB_RETURN_IF_ERROR(database_.DeleteClip(clip_id));
-  for (const auto& space : registry_.OfSkeleton(record.skeleton_id)) {
-    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> updated =
-        SnapshotWithoutClip(*space, clip_id);
-    if (!updated.ok()) return StaleIndexError(space->record.name, updated.status());
-    registry_.Put(*std::move(updated));
-  }
-  return absl::OkStatus();
+  return ChangeIndices(record.skeleton_id, [&](const SpaceSnapshot& space) {
+    return SnapshotWithoutClip(space, clip_id);
+  });
+}
+
+absl::StatusOr<storage::ClipRecord> Catalog::UpdateClip(int64_t clip_id,
+                                                        const storage::ClipUpdate& update) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record, database_.UpdateClip(clip_id, update));
+  MOTIONDB_RETURN_IF_ERROR(ChangeIndices(record.skeleton_id, [&](const SpaceSnapshot& space) {
+    return SnapshotWithClipInfo(space, clip_id, record.name, record.tags);
+  }));
+  return record;
 }
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::CreateSpace(

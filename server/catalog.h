@@ -1,7 +1,8 @@
-// The database and the resident indices, kept in step. Every write (ingest, delete, space
-// creation and deletion) goes through here: it is stored in one transaction first, and the
-// affected indices are rebuilt aside and swapped in afterwards, so a search sees either the
-// library before the write or after it, never half of it, and never waits.
+// The database and the resident indices, kept in step. Every write (ingest or replace, rename
+// and re-tag, delete, space creation and deletion) goes through here: it is stored in one
+// transaction first, and the affected indices are rebuilt aside and swapped in afterwards, so a
+// search sees either the library before the write or after it, never half of it, and never
+// waits.
 //
 // Writes are serialised by one mutex: an ingest must see every space of its skeleton, and a new
 // space must see every clip, so they cannot interleave. Reads do not take it.
@@ -12,7 +13,9 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -23,10 +26,32 @@
 
 namespace motiondb::server {
 
-struct IngestedClip {
-  storage::ClipRecord record;       // as stored: with its id, skeleton and creation time
-  std::vector<std::string> spaces;  // projected into
+// What an ingest does when a clip of its name exists.
+enum class OnConflict {
+  // Skip when the existing clip's content is identical (the same content hash), refuse with
+  // ALREADY_EXISTS otherwise: re-running a batch ingest is idempotent, and a real conflict is
+  // never silently dropped or overwritten.
+  kSkipIdentical,
+  kError,    // ALREADY_EXISTS
+  kSkip,     // keep the existing clip, store nothing
+  kReplace,  // delete the existing clip and store the new one, in one transaction
 };
+
+enum class IngestResult { kStored, kSkipped, kReplaced };
+
+struct IngestedClip {
+  // As stored, with its id, skeleton, creation time and content hash; when skipped, the
+  // existing clip.
+  storage::ClipRecord record;
+  IngestResult result = IngestResult::kStored;
+  int64_t replaced_clip_id = 0;  // kReplaced: the deleted clip's id
+  // Stored or replaced: other clips of identical content (up to kMaxDuplicatesReported, in id
+  // order). Stored all the same: two names for one take can be deliberate.
+  std::vector<storage::ClipRecord> duplicates;
+  std::vector<std::string> spaces;  // projected into; none when skipped
+};
+
+inline constexpr int kMaxDuplicatesReported = 10;
 
 class Catalog {
  public:
@@ -37,10 +62,18 @@ class Catalog {
   // is recomputed).
   absl::Status LoadIndices();
 
-  // Stores the clip with its projection into every space of its skeleton.
-  // The database assigns the clip's id, skeleton and creation time.
-  absl::StatusOr<IngestedClip> IngestClip(const storage::ClipRecord& record, const Clip& clip);
+  // Stores the clip with its projection into every space of its skeleton, or, when a clip of
+  // its name exists, does what `on_conflict` says: ALREADY_EXISTS (whose message, for
+  // kSkipIdentical, says how to skip or replace), skip, or replace the existing clip in the
+  // database and in every resident index. The database assigns the clip's id, skeleton,
+  // creation time and content hash.
+  absl::StatusOr<IngestedClip> IngestClip(const storage::ClipRecord& record, const Clip& clip,
+                                          OnConflict on_conflict = OnConflict::kSkipIdentical);
   absl::Status DeleteClip(int64_t clip_id);
+  // Renames and re-tags a clip (storage::Database::UpdateClip's rules and errors), and gives
+  // every space of its skeleton a snapshot that shows the new name and tags.
+  absl::StatusOr<storage::ClipRecord> UpdateClip(int64_t clip_id,
+                                                 const storage::ClipUpdate& update);
 
   // `should_stop` is polled between clips while the space is built (CANCELLED).
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> CreateSpace(
@@ -50,6 +83,23 @@ class Catalog {
  private:
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> LoadSpace(
       const storage::SpaceRecord& record);
+  // For IngestClip, under write_mutex_: the ingest of a clip whose name `existing` has, when
+  // `on_conflict` says not to replace it (skipped, or the error); nullopt when it is replaced.
+  absl::StatusOr<std::optional<IngestedClip>> ResolveConflict(const storage::ClipRecord& existing,
+                                                              const Clip& clip,
+                                                              OnConflict on_conflict);
+  // Under write_mutex_: replaces the snapshot of every space of the skeleton with `change`'s
+  // (INTERNAL saying the index is stale when that fails).
+  absl::Status ChangeIndices(
+      int64_t skeleton_id, const std::function<absl::StatusOr<std::shared_ptr<const SpaceSnapshot>>(
+                               const SpaceSnapshot&)>& change);
+  // For IngestClip, under write_mutex_: puts `ingested` (stored, replacing `replaced` when
+  // given) into the indices of `spaces`, its skeleton's, whose projections those are, and drops
+  // `replaced` from the indices of its own skeleton when that is another.
+  absl::Status IndexIngested(IngestedClip& ingested,
+                             const std::vector<std::shared_ptr<const SpaceSnapshot>>& spaces,
+                             std::vector<std::pair<int64_t, storage::Projection>> projections,
+                             const std::optional<storage::ClipRecord>& replaced);
 
   storage::Database& database_;
   IndexRegistry& registry_;

@@ -1,6 +1,7 @@
 #include "server/clip_export.h"
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_writer.h"
 #include "util/status_macros.h"
 
@@ -15,9 +16,13 @@ absl::StatusOr<ExportedBvh> ExportClip(storage::Database& database,
   MOTIONDB_ASSIGN_OR_RETURN(exported.bvh, WriteBvh(stored.clip, exported.frames));
   const bool whole =
       exported.frames.first == 0 && exported.frames.last == stored.clip.frame_count() - 1;
-  exported.file_name = whole ? absl::StrCat(stored.record.name, ".bvh")
-                             : absl::StrCat(stored.record.name, "_", exported.frames.first, "-",
-                                            exported.frames.last, ".bvh");
+  // A clip name's '/' separates folders ("session1/take_001"); the suggestion stays one file
+  // name, which a client can write into any folder without making or leaving folders. A
+  // backslash too, which separates folders on Windows.
+  const std::string base = absl::StrReplaceAll(stored.record.name, {{"/", "_"}, {"\\", "_"}});
+  exported.file_name =
+      whole ? absl::StrCat(base, ".bvh")
+            : absl::StrCat(base, "_", exported.frames.first, "-", exported.frames.last, ".bvh");
   return exported;
 }
 

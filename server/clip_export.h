@@ -12,7 +12,9 @@
 namespace motiondb::server {
 
 struct ExportedBvh {
-  std::string file_name;  // suggested: "<name>.bvh", or "<name>_<first>-<last>.bvh" for a range
+  // Suggested: "<name>.bvh", or "<name>_<first>-<last>.bvh" for a range, with each '/' (or
+  // backslash) in the name as '_': "session1/take_001" suggests "session1_take_001.bvh".
+  std::string file_name;
   std::string bvh;
   FrameRange frames;  // at the clip's rate
 };

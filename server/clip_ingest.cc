@@ -28,9 +28,21 @@ absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest
   record.source_file = request.file_name;
   record.tags = request.tags;
   MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
-  MOTIONDB_ASSIGN_OR_RETURN(IngestedClip ingested, catalog.IngestClip(record, read.clip));
-  return IngestOutcome{std::move(ingested.record), std::move(read.warnings),
-                       std::move(ingested.spaces)};
+  MOTIONDB_ASSIGN_OR_RETURN(IngestedClip ingested,
+                            catalog.IngestClip(record, read.clip, request.on_conflict));
+  IngestOutcome outcome;
+  outcome.clip = std::move(ingested.record);
+  outcome.result = ingested.result;
+  outcome.replaced_clip_id = ingested.replaced_clip_id;
+  outcome.warnings = std::move(read.warnings);
+  // Said in the warnings too, which clients print, since the fields are easy to overlook.
+  for (const storage::ClipRecord& duplicate : ingested.duplicates) {
+    outcome.warnings.push_back(
+        absl::StrCat("identical content to clip ", duplicate.clip_id, " '", duplicate.name, "'"));
+  }
+  outcome.duplicates = std::move(ingested.duplicates);
+  outcome.spaces = std::move(ingested.spaces);
+  return outcome;
 }
 
 }  // namespace motiondb::server

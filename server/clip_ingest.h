@@ -17,22 +17,29 @@ namespace motiondb::server {
 struct IngestRequest {
   // The uploaded file's name, as the client knows it (required; errors begin with it).
   std::string file_name;
-  // The clip's name; empty: the file name without folders and ".bvh".
+  // The clip's name, which may be a relative path ("session1/take_001"); empty: the file name
+  // without folders and ".bvh".
   std::string name;
   std::vector<std::string> tags;
+  // When a clip of that name exists.
+  OnConflict on_conflict = OnConflict::kSkipIdentical;
 };
 
 struct IngestOutcome {
-  storage::ClipRecord clip;           // as stored, with its id and skeleton
-  std::vector<std::string> warnings;  // the reader's, e.g. a Frames: header that disagrees
-  std::vector<std::string> spaces;    // projected into
+  storage::ClipRecord clip;  // as stored, with its id and skeleton; when skipped, the existing
+  IngestResult result = IngestResult::kStored;
+  int64_t replaced_clip_id = 0;                 // kReplaced: the deleted clip's id
+  std::vector<storage::ClipRecord> duplicates;  // other clips of identical content
+  // The reader's (e.g. a Frames: header that disagrees), then one line a duplicate.
+  std::vector<std::string> warnings;
+  std::vector<std::string> spaces;  // projected into
 };
 
 // The clip's name for `request`; INVALID_ARGUMENT without a file name, or when the file name
 // leaves no name. Lengths and characters of names and tags are the database's to check.
 absl::StatusOr<std::string> ClipName(const IngestRequest& request);
 
-// Parses, stores and indexes one uploaded file.
+// Parses, stores and indexes one uploaded file, or skips it (Catalog::IngestClip).
 absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
                                            absl::string_view bvh, const UploadLimits& limits);
 

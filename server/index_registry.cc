@@ -1,6 +1,7 @@
 #include "server/index_registry.h"
 
 #include <algorithm>
+#include <initializer_list>
 #include <utility>
 
 #include "util/status_macros.h"
@@ -8,17 +9,27 @@
 namespace motiondb::server {
 namespace {
 
-// Every clip of `base`, except `skip_id`, as clips to index again.
-std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base, int64_t skip_id) {
+// Every clip of `base`, except `skip_ids`, as clips to index again.
+std::vector<IndexedClip> ClipsOf(const SpaceSnapshot& base,
+                                 std::initializer_list<int64_t> skip_ids) {
   std::vector<IndexedClip> clips;
   if (!base.index) return clips;
   for (int c = 0; c < base.index->clip_count(); ++c) {
     const LibraryIndex::ClipEntry& entry = base.index->clip(c);
-    if (entry.clip_id == skip_id) continue;
+    if (std::find(skip_ids.begin(), skip_ids.end(), entry.clip_id) != skip_ids.end()) continue;
     clips.push_back({{entry.clip_id, entry.name, entry.tags, base.index->CopyClipCoordinates(c)},
                      base.clips.at(entry.clip_id)});
   }
   return clips;
+}
+
+// A copy of `base`'s record, space and timings, to which an index is given.
+std::shared_ptr<SpaceSnapshot> CopyOfSnapshot(const SpaceSnapshot& base) {
+  auto snapshot = std::make_shared<SpaceSnapshot>();
+  snapshot->record = base.record;
+  snapshot->space = base.space;
+  snapshot->clips = base.clips;
+  return snapshot;
 }
 
 }  // namespace
@@ -56,20 +67,19 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
 }
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
-                                                                      IndexedClip clip) {
-  if (base.index && !base.clips.contains(clip.clip.clip_id)) {
-    // A new clip: added beside the base's index, sharing its coordinates and kd-trees.
-    auto snapshot = std::make_shared<SpaceSnapshot>();
-    snapshot->record = base.record;
-    snapshot->space = base.space;
-    snapshot->clips = base.clips;
-    snapshot->clips.emplace(clip.clip.clip_id, clip.timing);
+                                                                      IndexedClip clip,
+                                                                      int64_t replaced_clip_id) {
+  const int64_t clip_id = clip.clip.clip_id;
+  if (base.index && !base.clips.contains(clip_id) && !base.clips.contains(replaced_clip_id)) {
+    // Only a new clip: added beside the base's index, sharing its coordinates and kd-trees.
+    std::shared_ptr<SpaceSnapshot> snapshot = CopyOfSnapshot(base);
+    snapshot->clips.emplace(clip_id, clip.timing);
     std::vector<LibraryClip> added;
     added.push_back(std::move(clip.clip));
     MOTIONDB_ASSIGN_OR_RETURN(snapshot->index, base.index->WithClips(std::move(added)));
     return snapshot;
   }
-  std::vector<IndexedClip> clips = ClipsOf(base, clip.clip.clip_id);
+  std::vector<IndexedClip> clips = ClipsOf(base, {clip_id, replaced_clip_id});
   clips.push_back(std::move(clip));
   return BuildSnapshot(base.record, base.space, std::move(clips));
 }
@@ -79,7 +89,18 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithoutClip(const S
   if (!base.clips.contains(clip_id)) {
     return std::shared_ptr<const SpaceSnapshot>(std::make_shared<SpaceSnapshot>(base));
   }
-  return BuildSnapshot(base.record, base.space, ClipsOf(base, clip_id));
+  return BuildSnapshot(base.record, base.space, ClipsOf(base, {clip_id}));
+}
+
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClipInfo(
+    const SpaceSnapshot& base, int64_t clip_id, const std::string& name,
+    const std::vector<std::string>& tags) {
+  if (!base.clips.contains(clip_id)) {
+    return std::shared_ptr<const SpaceSnapshot>(std::make_shared<SpaceSnapshot>(base));
+  }
+  std::shared_ptr<SpaceSnapshot> snapshot = CopyOfSnapshot(base);
+  MOTIONDB_ASSIGN_OR_RETURN(snapshot->index, base.index->WithClipInfo(clip_id, name, tags));
+  return snapshot;
 }
 
 std::shared_ptr<const SpaceSnapshot> IndexRegistry::Find(const std::string& name) const {

@@ -59,9 +59,17 @@ struct SpaceSnapshot {
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> BuildSnapshot(
     storage::SpaceRecord record, std::shared_ptr<const MotionSpace> space,
     std::vector<IndexedClip> clips);
-// `base` with `clip` added (or replaced, when its id is indexed already).
+// `base` with `clip` added (or replaced, when its id is indexed already), and without the clip
+// `replaced_clip_id` when that is indexed (0: none). A new clip alone goes into the index's
+// small second block; dropping one rebuilds the index.
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClip(const SpaceSnapshot& base,
-                                                                      IndexedClip clip);
+                                                                      IndexedClip clip,
+                                                                      int64_t replaced_clip_id = 0);
+// `base` with the clip's name and tags changed, sharing its coordinates and kd-trees; `base`
+// itself when the clip is not indexed.
+absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithClipInfo(
+    const SpaceSnapshot& base, int64_t clip_id, const std::string& name,
+    const std::vector<std::string>& tags);
 // `base` without the clip; `base` itself when the clip is not indexed.
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> SnapshotWithoutClip(const SpaceSnapshot& base,
                                                                          int64_t clip_id);

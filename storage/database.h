@@ -43,17 +43,36 @@ struct DatabaseOptions {
 
 // A clip as stored: its frames, and what the catalogue shows.
 struct ClipRecord {
-  int64_t clip_id = 0;            // assigned by InsertClip
-  std::string name;               // the file name without .bvh
+  int64_t clip_id = 0;  // assigned by InsertClip
+  // Unique. Printable text of 1 to 512 bytes; '/' separates the segments of a relative path
+  // ("session1/take_001"), none empty, "." or "..".
+  std::string name;
   std::string source_file;        // as uploaded
   std::vector<std::string> tags;  // a set: stored sorted and without repeats
   int64_t skeleton_id = 0;        // clips with identical joint names and parents share one
   int64_t created_unix_ms = 0;    // 0 on insert: the time of the insert
   // Filled on read (InsertClip takes them from the clip): what a listing needs without
-  // decoding the frames.
+  // decoding the frames, and the content hash (storage/content_hash.h).
   double frame_time = 0;
   int64_t frame_count = 0;
   int joint_count = 0;
+  std::string content_hash;
+};
+
+struct InsertClipOptions {
+  // A clip that the new one replaces: it is deleted, with its projections and labels, in the
+  // insert's transaction, so that a crash leaves the old clip or the new one, never neither.
+  // 0: none.
+  int64_t replace_clip_id = 0;
+};
+
+// What UpdateClip changes; what is left unset or empty stays.
+struct ClipUpdate {
+  std::optional<std::string> name;
+  std::vector<std::string> add_tags;
+  // Tags the clip lacks are ignored. Only required to be non-empty, so that a tag stored before
+  // the character rules can still be removed.
+  std::vector<std::string> remove_tags;
 };
 
 struct StoredClip {
@@ -99,20 +118,31 @@ class Database {
                                                         const DatabaseOptions& options = {});
   ~Database();
 
-  // Stores a clip, finding or creating its skeleton, together with its projection into every
-  // space of that skeleton (`projections`: one per space, keyed by space id), in one
-  // transaction. Returns the new clip id. ALREADY_EXISTS when a clip of that name exists;
-  // NOT_FOUND for an unknown space; FAILED_PRECONDITION when `projections` misses a space of the
-  // skeleton or names one of another; INVALID_ARGUMENT for a name of 0 or over 512 bytes, a tag
-  // of 0 or over 128 bytes, over 64 tags, values beyond float32, or a projection with
-  // non-finite values or more columns than its space. Projection::clip_id is ignored here.
-  absl::StatusOr<int64_t> InsertClip(
-      const ClipRecord& record, const Clip& clip,
-      const std::vector<std::pair<int64_t, Projection>>& projections);
+  // Stores a clip, finding or creating its skeleton and computing its content hash, together
+  // with its projection into every space of that skeleton (`projections`: one per space, keyed
+  // by space id), in one transaction; first deletes options.replace_clip_id, when given. Returns
+  // the new clip id. ALREADY_EXISTS when another clip of that name exists; NOT_FOUND for an
+  // unknown space or clip to replace; FAILED_PRECONDITION when `projections` misses a space of
+  // the skeleton or names one of another; INVALID_ARGUMENT for a name that breaks
+  // ClipRecord::name's rules, a tag of 0 or over 128 bytes or with a control character, over 64
+  // tags, values beyond float32, or a projection with non-finite values or more columns than
+  // its space. Projection::clip_id is ignored here.
+  absl::StatusOr<int64_t> InsertClip(const ClipRecord& record, const Clip& clip,
+                                     const std::vector<std::pair<int64_t, Projection>>& projections,
+                                     const InsertClipOptions& options = {});
   // The skeleton id a clip of this topology has or would get (-1 when none is stored yet).
   absl::StatusOr<int64_t> FindSkeleton(const Skeleton& skeleton);
   absl::StatusOr<StoredClip> GetClip(int64_t clip_id);  // NOT_FOUND
   absl::StatusOr<ClipRecord> GetClipRecord(int64_t clip_id);
+  absl::StatusOr<ClipRecord> GetClipRecordByName(const std::string& name);  // NOT_FOUND
+  // Up to `limit` clips whose content hash is `content_hash`, in id order.
+  absl::StatusOr<std::vector<ClipRecord>> FindClipsByContentHash(const std::string& content_hash,
+                                                                 int limit);
+  // Renames and re-tags a clip in one transaction, and returns its record as updated. NOT_FOUND
+  // for an unknown clip; ALREADY_EXISTS when another clip has the name; INVALID_ARGUMENT naming
+  // the field for a name or added tag that InsertClip would refuse, an empty removed tag, a tag
+  // both added and removed, or more than 64 tags in the end. Nothing changes on error.
+  absl::StatusOr<ClipRecord> UpdateClip(int64_t clip_id, const ClipUpdate& update);
   // Clips in id order; optionally only those carrying `tag`. page_size 0 means 100; outside
   // 0-1000, or a malformed page_token: INVALID_ARGUMENT.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const std::string& tag = "");

@@ -5,9 +5,11 @@
 #include "absl/container/flat_hash_map.h"
 #include "absl/container/flat_hash_set.h"
 #include "absl/strings/ascii.h"
+#include "absl/strings/escaping.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "storage/blob_codec.h"
+#include "storage/content_hash.h"
 #include "storage/database.h"
 #include "storage/internal/database_impl.h"
 #include "storage/internal/record_checks.h"
@@ -35,15 +37,78 @@ absl::StatusOr<int64_t> PageStart(const std::string& page_token) {
   return after;
 }
 
+// Adds `tags` to the clip; those it carries already stay as they are.
 absl::Status InsertTags(SqliteConnection& db, int64_t clip_id,
                         const std::vector<std::string>& tags) {
-  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement insert_tag,
-                            db.Prepare("INSERT INTO clip_tags (clip_id, tag) VALUES (?, ?)"));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement insert_tag,
+      db.Prepare("INSERT OR IGNORE INTO clip_tags (clip_id, tag) VALUES (?, ?)"));
   for (const std::string& tag : tags) {
     insert_tag.Reset();
     MOTIONDB_RETURN_IF_ERROR(insert_tag.BindInt64(1, clip_id).BindText(2, tag).Run());
   }
   return absl::OkStatus();
+}
+
+// The records, tags included, of the rows `query` returns: bound, and selecting
+// kClipRecordColumns of clips as `c`.
+absl::StatusOr<std::vector<ClipRecord>> ReadClipRecords(SqliteConnection& db,
+                                                        SqliteStatement& query) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
+  std::vector<ClipRecord> records;
+  while (true) {
+    MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
+    if (!row) return records;
+    ClipRecord record = ReadClipRecord(query);
+    MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, record.clip_id));
+    records.push_back(std::move(record));
+  }
+}
+
+// "SELECT <record columns> FROM clips c <rest>".
+absl::StatusOr<SqliteStatement> PrepareClipRecordQuery(SqliteConnection& db,
+                                                       absl::string_view rest) {
+  return db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, " FROM clips c ", rest));
+}
+
+// The one record `query` (bound) selects; NOT_FOUND with `missing` when there is none.
+absl::StatusOr<ClipRecord> ReadOneClipRecord(SqliteConnection& db, SqliteStatement& query,
+                                             absl::string_view missing) {
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<ClipRecord> records, ReadClipRecords(db, query));
+  if (records.empty()) return absl::NotFoundError(missing);
+  return std::move(records.front());
+}
+
+absl::StatusOr<ClipRecord> ClipRecordById(SqliteConnection& db, int64_t clip_id) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
+                            PrepareClipRecordQuery(db, "WHERE c.clip_id = ?"));
+  query.BindInt64(1, clip_id);
+  return ReadOneClipRecord(db, query, absl::StrCat("clip ", clip_id, " not found"));
+}
+
+// Deletes the clip's row; its tags, projections and labels cascade.
+absl::Status DeleteClipRow(SqliteConnection& db, int64_t clip_id, absl::string_view missing) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement erase,
+                            db.Prepare("DELETE FROM clips WHERE clip_id = ?"));
+  return DeleteRow(db, erase.BindInt64(1, clip_id), missing);
+}
+
+// Checks an update before its transaction; returns the tags to add, canonical.
+absl::StatusOr<std::vector<std::string>> CheckClipUpdate(const ClipUpdate& update) {
+  if (update.name) MOTIONDB_RETURN_IF_ERROR(CheckClipName(*update.name));
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<std::string> add_tags,
+                            CanonicalTags(update.add_tags, "add_tags"));
+  for (size_t i = 0; i < update.remove_tags.size(); ++i) {
+    const std::string& tag = update.remove_tags[i];
+    if (tag.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat("remove_tags[", i, "] must not be empty"));
+    }
+    if (std::binary_search(add_tags.begin(), add_tags.end(), tag)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "remove_tags[", i, "] '", absl::CHexEscape(tag), "' is in add_tags too; give it once"));
+    }
+  }
+  return add_tags;
 }
 
 // Inserts the new clip's projections, which must be one into every space of its skeleton.
@@ -90,8 +155,9 @@ absl::Status InsertProjectionsOfClip(
 
 absl::StatusOr<int64_t> Database::InsertClip(
     const ClipRecord& record, const Clip& clip,
-    const std::vector<std::pair<int64_t, Projection>>& projections) {
-  MOTIONDB_RETURN_IF_ERROR(CheckName("clip name", record.name, kMaxNameBytes));
+    const std::vector<std::pair<int64_t, Projection>>& projections,
+    const InsertClipOptions& options) {
+  MOTIONDB_RETURN_IF_ERROR(CheckClipName(record.name));
   MOTIONDB_RETURN_IF_ERROR(
       CheckName("source file name", record.source_file, kMaxNameBytes, /*may_be_empty=*/true));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> tags, CanonicalTags(record.tags));
@@ -111,10 +177,17 @@ absl::StatusOr<int64_t> Database::InsertClip(
   const std::string layout = SkeletonLayoutBlob(clip.skeleton());
   const std::string rotations = Float32Blob(clip.rotations());
   const std::string positions = Float32Blob(clip.positions());
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string content_hash,
+                            ContentHashOfBlobs(clip.frame_time(), layout, rotations, positions));
   const int64_t now = CreationTime(record.created_unix_ms);
 
   int64_t clip_id = 0;
   MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+    if (options.replace_clip_id != 0) {
+      MOTIONDB_RETURN_IF_ERROR(
+          DeleteClipRow(db, options.replace_clip_id,
+                        absl::StrCat("clip ", options.replace_clip_id, " to replace not found")));
+    }
     MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "clips", "clip", record.name));
     MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id,
                               FindOrCreateSkeleton(db, clip.skeleton(), key, now));
@@ -122,7 +195,7 @@ absl::StatusOr<int64_t> Database::InsertClip(
         SqliteStatement insert,
         db.Prepare("INSERT INTO clips (name, source_file, skeleton_id, frame_time, frame_count, "
                    "joint_count, position_joint_count, layout, rotations, positions, "
-                   "created_unix_ms) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+                   "created_unix_ms, content_hash) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
     MOTIONDB_RETURN_IF_ERROR(insert.BindText(1, record.name)
                                  .BindText(2, record.source_file)
                                  .BindInt64(3, skeleton_id)
@@ -134,6 +207,7 @@ absl::StatusOr<int64_t> Database::InsertClip(
                                  .BindBlob(9, rotations)
                                  .BindBlob(10, positions)
                                  .BindInt64(11, now)
+                                 .BindText(12, content_hash)
                                  .Run());
     clip_id = db.last_insert_rowid();
     MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, tags));
@@ -199,17 +273,68 @@ absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id) {
 absl::StatusOr<ClipRecord> Database::GetClipRecord(int64_t clip_id) {
   ClipRecord record;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
-                              db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns,
-                                                      " FROM clips c WHERE c.clip_id = ?")));
-    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindInt64(1, clip_id).Step());
-    if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
-    record = ReadClipRecord(query);
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
-    MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
+    MOTIONDB_ASSIGN_OR_RETURN(record, ClipRecordById(db, clip_id));
     return absl::OkStatus();
   }));
   return record;
+}
+
+absl::StatusOr<ClipRecord> Database::GetClipRecordByName(const std::string& name) {
+  ClipRecord record;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
+                              PrepareClipRecordQuery(db, "WHERE c.name = ?"));
+    query.BindText(1, name);
+    MOTIONDB_ASSIGN_OR_RETURN(
+        record, ReadOneClipRecord(db, query,
+                                  absl::StrCat("no clip is named '", absl::CHexEscape(name), "'")));
+    return absl::OkStatus();
+  }));
+  return record;
+}
+
+absl::StatusOr<std::vector<ClipRecord>> Database::FindClipsByContentHash(
+    const std::string& content_hash, int limit) {
+  std::vector<ClipRecord> records;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement query,
+        PrepareClipRecordQuery(db, "WHERE c.content_hash = ? ORDER BY c.clip_id LIMIT ?"));
+    query.BindText(1, content_hash).BindInt64(2, limit);
+    MOTIONDB_ASSIGN_OR_RETURN(records, ReadClipRecords(db, query));
+    return absl::OkStatus();
+  }));
+  return records;
+}
+
+absl::StatusOr<ClipRecord> Database::UpdateClip(int64_t clip_id, const ClipUpdate& update) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> add_tags, CheckClipUpdate(update));
+  ClipRecord updated;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const ClipRecord current, ClipRecordById(db, clip_id));
+    if (update.name && *update.name != current.name) {
+      MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "clips", "clip", *update.name));
+      MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement rename,
+                                db.Prepare("UPDATE clips SET name = ? WHERE clip_id = ?"));
+      MOTIONDB_RETURN_IF_ERROR(rename.BindText(1, *update.name).BindInt64(2, clip_id).Run());
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement remove_tag,
+                              db.Prepare("DELETE FROM clip_tags WHERE clip_id = ? AND tag = ?"));
+    for (const std::string& tag : update.remove_tags) {
+      remove_tag.Reset();
+      MOTIONDB_RETURN_IF_ERROR(remove_tag.BindInt64(1, clip_id).BindText(2, tag).Run());
+    }
+    MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, add_tags));
+    MOTIONDB_ASSIGN_OR_RETURN(updated, ClipRecordById(db, clip_id));
+    // Counted after the change: tags already carried do not count twice.
+    if (updated.tags.size() > kMaxTags) {
+      return absl::InvalidArgumentError(absl::StrCat("add_tags: a clip has at most ", kMaxTags,
+                                                     " tags; this one would have ",
+                                                     updated.tags.size()));
+    }
+    return absl::OkStatus();
+  }));
+  return updated;
 }
 
 absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string& tag) {
@@ -235,17 +360,10 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string
     // One row more than the page says whether another page follows.
     query.BindInt64(1, after).BindInt64(2, page_size + 1);
     if (!tag.empty()) query.BindText(3, tag);
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
-    while (true) {
-      MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
-      if (!row) break;
-      if (static_cast<int>(result.clips.size()) == page_size) {
-        result.next_page_token = absl::StrCat(result.clips.back().clip_id);
-        break;
-      }
-      ClipRecord record = ReadClipRecord(query);
-      MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, record.clip_id));
-      result.clips.push_back(std::move(record));
+    MOTIONDB_ASSIGN_OR_RETURN(result.clips, ReadClipRecords(db, query));
+    if (static_cast<int>(result.clips.size()) > page_size) {
+      result.clips.pop_back();
+      result.next_page_token = absl::StrCat(result.clips.back().clip_id);
     }
     return absl::OkStatus();
   }));
@@ -254,9 +372,7 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string
 
 absl::Status Database::DeleteClip(int64_t clip_id) {
   return impl_->Write([&](SqliteConnection& db) -> absl::Status {
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement erase,
-                              db.Prepare("DELETE FROM clips WHERE clip_id = ?"));
-    return DeleteRow(db, erase.BindInt64(1, clip_id), absl::StrCat("clip ", clip_id, " not found"));
+    return DeleteClipRow(db, clip_id, absl::StrCat("clip ", clip_id, " not found"));
   });
 }
 

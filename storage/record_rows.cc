@@ -21,14 +21,18 @@ ClipRecord ReadClipRecord(const SqliteStatement& row) {
   record.frame_time = row.ColumnDouble(5);
   record.frame_count = row.ColumnInt64(6);
   record.joint_count = static_cast<int>(row.ColumnInt64(7));
+  record.content_hash = row.ColumnText(8);
   return record;
 }
 
 absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record) {
   const int64_t frames = record.frame_count;
   const int64_t joints = record.joint_count;
-  const int64_t position_joints = row.ColumnInt64(8);
-  absl::StatusOr<std::shared_ptr<const Skeleton>> skeleton = ParseSkeletonLayout(row.ColumnBlob(9));
+  // kClipFrameColumns follow the record's.
+  constexpr int kFirst = kClipRecordColumnCount;
+  const int64_t position_joints = row.ColumnInt64(kFirst);
+  absl::StatusOr<std::shared_ptr<const Skeleton>> skeleton =
+      ParseSkeletonLayout(row.ColumnBlob(kFirst + 1));
   // Bytes this code wrote that no longer parse are damage, whatever the parser calls it.
   if (!skeleton.ok()) return absl::DataLossError(skeleton.status().message());
   if ((*skeleton)->joint_count() != joints ||
@@ -36,10 +40,10 @@ absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& reco
     return absl::DataLossError("its layout does not match its row");
   }
   MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXd rotations,
-                            ParseRotationBlob(row.ColumnBlob(10), frames, joints));
+                            ParseRotationBlob(row.ColumnBlob(kFirst + 2), frames, joints));
   MOTIONDB_ASSIGN_OR_RETURN(
       const RowMatrixXf positions,
-      ParseFloat32Blob(row.ColumnBlob(11), frames, 3 * position_joints, "positions"));
+      ParseFloat32Blob(row.ColumnBlob(kFirst + 3), frames, 3 * position_joints, "positions"));
   absl::StatusOr<Clip> clip = Clip::Create(*std::move(skeleton), record.frame_time,
                                            std::move(rotations), positions.cast<double>());
   if (!clip.ok()) return absl::DataLossError(clip.status().message());

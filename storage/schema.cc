@@ -1,8 +1,10 @@
 #include "storage/schema.h"
 
 #include <array>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "storage/content_hash.h"
 #include "storage/sqlite_transaction.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -100,8 +102,58 @@ CREATE INDEX labels_by_space ON labels (space_id);
 CREATE INDEX labels_by_job ON labels (job_id);
 )sql";
 
+// Each clip's content hash (storage/content_hash.h), by which an ingest recognises a file it
+// has stored before. '' is only ever seen by the backfill below, which runs in the migration's
+// transaction.
+constexpr const char* kMigration2 = R"sql(
+ALTER TABLE clips ADD COLUMN content_hash TEXT NOT NULL DEFAULT '';
+CREATE INDEX clips_by_content_hash ON clips (content_hash);
+)sql";
+
+// Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
+// blobs are in memory at a time.
+absl::Status BackfillContentHashes(SqliteConnection& connection) {
+  std::vector<int64_t> clip_ids;
+  {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement unhashed,
+        connection.Prepare("SELECT clip_id FROM clips WHERE content_hash = '' ORDER BY clip_id"));
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, unhashed.Step());
+      if (!row) break;
+      clip_ids.push_back(unhashed.ColumnInt64(0));
+    }
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement read,
+      connection.Prepare(
+          "SELECT frame_time, layout, rotations, positions FROM clips WHERE clip_id = ?"));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement update,
+      connection.Prepare("UPDATE clips SET content_hash = ? WHERE clip_id = ?"));
+  for (const int64_t clip_id : clip_ids) {
+    read.Reset();
+    MOTIONDB_RETURN_IF_ERROR(read.BindInt64(1, clip_id).Step().status());
+    MOTIONDB_ASSIGN_OR_RETURN(const std::string hash,
+                              ContentHashOfBlobs(read.ColumnDouble(0), read.ColumnBlob(1),
+                                                 read.ColumnBlob(2), read.ColumnBlob(3)));
+    update.Reset();
+    MOTIONDB_RETURN_IF_ERROR(update.BindText(1, hash).BindInt64(2, clip_id).Run());
+  }
+  return absl::OkStatus();
+}
+
+// A schema step: its SQL, then the C++ that fills what SQL cannot (or null).
+struct Migration {
+  const char* sql;
+  absl::Status (*backfill)(SqliteConnection& connection);
+};
+
 // Append only: a file at version i has run exactly the first i entries.
-constexpr std::array kMigrations = {kMigration1};
+constexpr std::array kMigrations = {
+    Migration{kMigration1, nullptr},
+    Migration{kMigration2, BackfillContentHashes},
+};
 
 }  // namespace
 
@@ -132,21 +184,28 @@ absl::Status CheckSchemaVersion(SqliteConnection& connection) {
   return absl::OkStatus();
 }
 
-absl::Status MigrateSchema(SqliteConnection& connection) {
+absl::Status MigrateSchema(SqliteConnection& connection, int target_version) {
+  if (target_version < 1 || target_version > LatestSchemaVersion()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "target_version must be 1 to ", LatestSchemaVersion(), ", got ", target_version));
+  }
   MOTIONDB_ASSIGN_OR_RETURN(SqliteTransaction transaction,
                             SqliteTransaction::Begin(connection, SqliteTransaction::Kind::kWrite));
   // Checked again under the write lock: another process may have migrated meanwhile.
   MOTIONDB_RETURN_IF_ERROR(CheckSchemaVersion(connection));
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t version, connection.QueryInt64("PRAGMA user_version"));
-  if (version == LatestSchemaVersion()) return absl::OkStatus();
-  for (int next = static_cast<int>(version) + 1; next <= LatestSchemaVersion(); ++next) {
-    MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("schema migration ", next),
-                                      connection.Execute(kMigrations[next - 1])));
+  if (version >= target_version) return absl::OkStatus();
+  for (int next = static_cast<int>(version) + 1; next <= target_version; ++next) {
+    const Migration& migration = kMigrations[next - 1];
+    const std::string step = absl::StrCat("schema migration ", next);
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(step, connection.Execute(migration.sql)));
+    if (migration.backfill != nullptr) {
+      MOTIONDB_RETURN_IF_ERROR(Prefixed(step, migration.backfill(connection)));
+    }
   }
   // PRAGMAs take no parameters; both values are numbers of ours.
-  MOTIONDB_RETURN_IF_ERROR(
-      connection.Execute(absl::StrCat("PRAGMA application_id = ", kApplicationId,
-                                      "; PRAGMA user_version = ", LatestSchemaVersion())));
+  MOTIONDB_RETURN_IF_ERROR(connection.Execute(absl::StrCat(
+      "PRAGMA application_id = ", kApplicationId, "; PRAGMA user_version = ", target_version)));
   return transaction.Commit();
 }
 

@@ -23,9 +23,13 @@ int LatestSchemaVersion();
 // file that already holds tables (another application's database).
 absl::Status CheckSchemaVersion(SqliteConnection& connection);
 
-// Applies the missing migrations, and stamps the version and application id, in one write
-// transaction.
-absl::Status MigrateSchema(SqliteConnection& connection);
+// Applies the missing migrations up to `target_version`, with the C++ backfills some of them
+// need, and stamps the version and application id, all in one write transaction: a crash leaves
+// the file at its old version, to be migrated again on the next open. A file at or past
+// `target_version` is left as it is. Open() migrates to the latest version; tests make the
+// files of older builds with a lower one.
+absl::Status MigrateSchema(SqliteConnection& connection,
+                           int target_version = LatestSchemaVersion());
 
 }  // namespace motiondb::storage
 

@@ -349,6 +349,242 @@ TEST_F(ServerTest, IngestsRealBvhFilesStreamedInChunks) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Clip names that fit a studio's folders: names with '/', conflicts, content hashes, updates.
+
+v1::IngestClipRequest Upload(const std::string& name, const std::string& bvh,
+                             v1::OnConflict on_conflict = v1::ON_CONFLICT_UNSPECIFIED,
+                             std::vector<std::string> tags = {}) {
+  v1::IngestClipRequest request;
+  request.set_file_name(name.substr(name.find_last_of('/') + 1) + ".bvh");
+  request.set_name(name);
+  request.set_bvh(bvh);
+  request.set_on_conflict(on_conflict);
+  for (const std::string& tag : tags) request.add_tags(tag);
+  return request;
+}
+
+// The first `frames` frames of a humanoid clip, as BVH: new content on the humanoid skeleton.
+std::string HumanoidTake(size_t clip, int frames) {
+  absl::StatusOr<Clip> take = Humanoid().clips[clip].Slice({0, frames - 1});
+  EXPECT_TRUE(take.ok()) << take.status();
+  return take.ok() ? BvhText(*take) : "";
+}
+
+TEST_F(ServerTest, ClipNamesConflictsHashesAndUpdates) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  ASSERT_GE(ids.size(), 3u);
+  CreateHumanoidSpace(client);
+  const std::string take_a = HumanoidTake(0, 400);
+  const std::string take_b = HumanoidTake(1, 400);
+  const std::string take_c = HumanoidTake(2, 400);
+  auto ingest = [&](const v1::IngestClipRequest& request, v1::IngestClipResponse* response) {
+    response->Clear();
+    return client.clips().IngestClip(client.Context().get(), request, response);
+  };
+  auto space_clips = [&] {
+    v1::GetSpaceRequest get;
+    get.set_name("body");
+    v1::Space space;
+    EXPECT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &space).ok());
+    return space.index().clips();
+  };
+
+  // The same take name in two session folders: two clips.
+  v1::IngestClipResponse first;
+  ASSERT_TRUE(ingest(Upload("session1/take_001", take_a), &first).ok());
+  EXPECT_EQ(first.result(), v1::INGEST_RESULT_STORED);
+  EXPECT_EQ(first.clip().name(), "session1/take_001");
+  EXPECT_EQ(first.clip().source_file(), "take_001.bvh");
+  EXPECT_THAT(first.clip().content_hash(), ::testing::MatchesRegex("[0-9a-f]{64}"));
+  EXPECT_THAT(first.projected_spaces(), ::testing::ElementsAre("body"));
+  EXPECT_TRUE(first.duplicate_of().empty());
+  v1::IngestClipResponse second;
+  ASSERT_TRUE(
+      ingest(Upload("session2/take_001", take_b, v1::ON_CONFLICT_UNSPECIFIED, {"s2"}), &second)
+          .ok());
+  EXPECT_EQ(second.result(), v1::INGEST_RESULT_STORED);
+  EXPECT_NE(second.clip().clip_id(), first.clip().clip_id());
+  EXPECT_NE(second.clip().content_hash(), first.clip().content_hash());
+  const int64_t indexed = static_cast<int64_t>(ids.size()) + 2;
+  EXPECT_EQ(space_clips(), indexed);
+
+  // Re-ingesting the same file is skipped by default: a batch ingest run again is idempotent.
+  v1::IngestClipResponse again;
+  ASSERT_TRUE(ingest(Upload("session1/take_001", take_a), &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_SKIPPED);
+  EXPECT_EQ(again.clip().clip_id(), first.clip().clip_id());
+  EXPECT_TRUE(again.projected_spaces().empty());
+  // Other content under a taken name is refused by default, saying how to choose.
+  grpc::Status status = ingest(Upload("session1/take_001", take_c), &again);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::ALREADY_EXISTS);
+  EXPECT_THAT(status.error_message(), HasSubstr("session1/take_001"));
+  EXPECT_THAT(status.error_message(), HasSubstr("on_conflict skip"));
+  EXPECT_THAT(status.error_message(), HasSubstr("replace"));
+  // ERROR refuses even the identical file.
+  EXPECT_EQ(ingest(Upload("session1/take_001", take_a, v1::ON_CONFLICT_ERROR), &again).error_code(),
+            grpc::StatusCode::ALREADY_EXISTS);
+  // SKIP keeps the existing clip, whatever the upload holds; so does a stream's first message.
+  ASSERT_TRUE(ingest(Upload("session1/take_001", take_c, v1::ON_CONFLICT_SKIP), &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_SKIPPED);
+  EXPECT_EQ(again.clip().clip_id(), first.clip().clip_id());
+  EXPECT_EQ(again.clip().content_hash(), first.clip().content_hash());
+  {
+    auto context = client.Context();
+    v1::IngestClipResponse streamed;
+    auto writer = client.clips().IngestClipStream(context.get(), &streamed);
+    v1::IngestClipStreamRequest header;
+    header.set_file_name("take_001.bvh");
+    header.set_name("session1/take_001");
+    header.set_on_conflict(v1::ON_CONFLICT_SKIP);
+    header.set_chunk(take_c);
+    ASSERT_TRUE(writer->Write(header));
+    ASSERT_TRUE(writer->WritesDone());
+    status = writer->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(streamed.result(), v1::INGEST_RESULT_SKIPPED);
+    EXPECT_EQ(streamed.clip().clip_id(), first.clip().clip_id());
+  }
+  EXPECT_EQ(space_clips(), indexed);
+
+  // REPLACE stores the new content under a new id; the old clip is gone from storage and index.
+  v1::IngestClipResponse replaced;
+  ASSERT_TRUE(
+      ingest(Upload("session1/take_001", take_c, v1::ON_CONFLICT_REPLACE, {"s1"}), &replaced).ok());
+  EXPECT_EQ(replaced.result(), v1::INGEST_RESULT_REPLACED);
+  EXPECT_EQ(replaced.replaced_clip_id(), first.clip().clip_id());
+  const int64_t replacement = replaced.clip().clip_id();
+  EXPECT_GT(replacement, second.clip().clip_id());
+  EXPECT_EQ(replaced.clip().name(), "session1/take_001");
+  EXPECT_NE(replaced.clip().content_hash(), first.clip().content_hash());
+  EXPECT_THAT(replaced.projected_spaces(), ::testing::ElementsAre("body"));
+  v1::GetClipRequest get;
+  get.set_clip_id(first.clip().clip_id());
+  v1::Clip clip;
+  EXPECT_EQ(client.clips().GetClip(client.Context().get(), get, &clip).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(space_clips(), indexed);
+  // A search over the clips tagged s1 finds the new clip, and only it.
+  v1::SearchRequest query = ClipQuery("body", replacement, 0, 150);
+  query.add_tags("s1");
+  v1::SearchResponse found;
+  status = client.Search(query, &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(found.results_size(), 1);
+  for (const v1::SearchResult& result : found.results()) {
+    EXPECT_EQ(result.clip_id(), replacement);
+    EXPECT_EQ(result.clip_name(), "session1/take_001");
+  }
+  EXPECT_EQ(client.Search(ClipQuery("body", first.clip().clip_id(), 0, 150), &found).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  // Identical content under another name is stored, and reported.
+  v1::IngestClipResponse duplicate;
+  ASSERT_TRUE(ingest(Upload("session3/take_007", take_c), &duplicate).ok());
+  EXPECT_EQ(duplicate.result(), v1::INGEST_RESULT_STORED);
+  EXPECT_EQ(duplicate.clip().content_hash(), replaced.clip().content_hash());
+  ASSERT_EQ(duplicate.duplicate_of_size(), 1);
+  EXPECT_EQ(duplicate.duplicate_of(0).clip_id(), replacement);
+  EXPECT_EQ(duplicate.duplicate_of(0).name(), "session1/take_001");
+  EXPECT_THAT(duplicate.warnings(),
+              ::testing::Contains("identical content to clip " + std::to_string(replacement) +
+                                  " 'session1/take_001'"));
+
+  // UpdateClip renames and re-tags, and the index sees it at once.
+  v1::UpdateClipRequest update;
+  update.set_clip_id(second.clip().clip_id());
+  update.set_name("session2/take_001_best");
+  update.add_add_tags("best");
+  update.add_remove_tags("s2");
+  v1::Clip updated;
+  status = client.clips().UpdateClip(client.Context().get(), update, &updated);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(updated.clip_id(), second.clip().clip_id());
+  EXPECT_EQ(updated.name(), "session2/take_001_best");
+  EXPECT_THAT(updated.tags(), ::testing::ElementsAre("best"));
+  EXPECT_EQ(updated.content_hash(), second.clip().content_hash());
+  query = ClipQuery("body", second.clip().clip_id(), 0, 150);
+  query.add_tags("best");
+  status = client.Search(query, &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(found.results_size(), 1);
+  for (const v1::SearchResult& result : found.results()) {
+    EXPECT_EQ(result.clip_id(), second.clip().clip_id());
+    EXPECT_EQ(result.clip_name(), "session2/take_001_best");
+  }
+  query.clear_tags();
+  query.add_tags("s2");
+  ASSERT_TRUE(client.Search(query, &found).ok());
+  EXPECT_EQ(found.results_size(), 0);
+  // The old name is free.
+  ASSERT_TRUE(ingest(Upload("session2/take_001", take_b), &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_STORED);
+
+  // Refused updates name the field and change nothing.
+  struct BadUpdate {
+    std::function<void(v1::UpdateClipRequest*)> change;
+    grpc::StatusCode code;
+    std::string words;
+  };
+  const std::vector<BadUpdate> bad_updates = {
+      {[](v1::UpdateClipRequest* r) { r->set_name("session1/take_001"); },
+       grpc::StatusCode::ALREADY_EXISTS, "session1/take_001"},
+      {[](v1::UpdateClipRequest* r) { r->set_name("session1//take"); },
+       grpc::StatusCode::INVALID_ARGUMENT, "name"},
+      {[](v1::UpdateClipRequest* r) { r->add_add_tags("two\nlines"); },
+       grpc::StatusCode::INVALID_ARGUMENT, "add_tags[0]"},
+      {[](v1::UpdateClipRequest* r) { r->set_clip_id(999999); }, grpc::StatusCode::NOT_FOUND,
+       "999999"},
+  };
+  for (const BadUpdate& bad : bad_updates) {
+    v1::UpdateClipRequest request;
+    request.set_clip_id(second.clip().clip_id());
+    bad.change(&request);
+    status = client.clips().UpdateClip(client.Context().get(), request, &updated);
+    EXPECT_EQ(status.error_code(), bad.code) << bad.words << ": " << status.error_message();
+    EXPECT_THAT(status.error_message(), HasSubstr(bad.words));
+  }
+  get.set_clip_id(second.clip().clip_id());
+  ASSERT_TRUE(client.clips().GetClip(client.Context().get(), get, &clip).ok());
+  EXPECT_EQ(clip.name(), "session2/take_001_best");
+  EXPECT_THAT(clip.tags(), ::testing::ElementsAre("best"));
+
+  // Names that are no relative path, and unknown conflict modes.
+  for (const std::string name : {"/session1/take", "session1/", "session1/../take", "./take"}) {
+    status = ingest(Upload(name, take_a), &again);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << name;
+    EXPECT_THAT(status.error_message(), HasSubstr("clip name")) << name;
+  }
+  status = ingest(Upload("fresh", take_a, static_cast<v1::OnConflict>(9)), &again);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("on_conflict"));
+
+  // A replacement of another skeleton leaves the old skeleton's space as well.
+  ASSERT_TRUE(ingest(Upload("session4/take_001", HumanoidTake(0, 300)), &again).ok());
+  const int64_t with_take = space_clips();
+  ASSERT_TRUE(
+      ingest(Upload("session4/take_001", BvhText(ChainClip()), v1::ON_CONFLICT_REPLACE), &replaced)
+          .ok());
+  EXPECT_EQ(replaced.result(), v1::INGEST_RESULT_REPLACED);
+  EXPECT_EQ(replaced.replaced_clip_id(), again.clip().clip_id());
+  EXPECT_TRUE(replaced.projected_spaces().empty());
+  EXPECT_EQ(space_clips(), with_take - 1);
+
+  // The export's suggested file name stays one file name.
+  v1::ExportClipRequest export_request;
+  export_request.mutable_clip()->set_clip_id(replacement);
+  v1::ExportClipResponse exported;
+  ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), export_request, &exported).ok());
+  EXPECT_EQ(exported.file_name(), "session1_take_001.bvh");
+  export_request.mutable_clip()->set_first_frame(10);
+  export_request.mutable_clip()->set_last_frame(19);
+  ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), export_request, &exported).ok());
+  EXPECT_EQ(exported.file_name(), "session1_take_001_10-19.bvh");
+}
+
+// ---------------------------------------------------------------------------------------------
 // Spaces and search.
 
 TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
@@ -643,9 +879,11 @@ TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
     EXPECT_THAT(status.error_message(), HasSubstr("file_name"));
   }
-  // A name taken: ALREADY_EXISTS.
-  EXPECT_EQ(client.Ingest("humanoid_0.bvh", BvhText(Humanoid().clips[0]), &ingested).error_code(),
-            grpc::StatusCode::ALREADY_EXISTS);
+  // A name taken by other content: ALREADY_EXISTS (the same content is skipped; see
+  // ClipNamesConflictsHashesAndUpdates).
+  status = client.Ingest("humanoid_0.bvh", BvhText(Humanoid().clips[1]), &ingested);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::ALREADY_EXISTS);
+  EXPECT_THAT(status.error_message(), HasSubstr("on_conflict"));
 
   // Unknown ids and names: NOT_FOUND.
   v1::GetClipRequest get;

@@ -1,6 +1,7 @@
 // The SQLite storage layer on real files: round trips, pagination, skeleton sharing, spaces and
-// projections, cascades, atomic failures, damaged and foreign files, concurrency, and a writer
-// killed mid-stream.
+// projections, cascades, atomic failures, clip names and content hashes, replacing and updating
+// clips, schema migration, damaged and foreign files, concurrency, and a writer killed
+// mid-stream.
 #include "storage/database.h"
 
 #include <signal.h>
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -22,7 +24,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "absl/strings/escaping.h"
 #include "core/space/space_serialization.h"
+#include "storage/content_hash.h"
 #include "storage/schema.h"
 #include "storage/sqlite_connection.h"
 #include "tests/clip_builder.h"
@@ -524,6 +528,236 @@ TEST_F(StorageSpaceTest, RejectedWritesChangeNothing) {
   EXPECT_EQ(testing::ReadFileOrDie(path_), file_before);
 }
 
+TEST_F(StorageTest, ClipNamesMayBeRelativePaths) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 4);
+  const int64_t first = Insert(Named("session1/take_001"), clip);
+  const int64_t second = Insert(Named("session2/take_001"), Motion(testing::ChainSkeleton(), 4, 1));
+  ASSERT_GT(first, 0);
+  ASSERT_GT(second, 0);
+  EXPECT_EQ(Db().GetClipRecord(first)->name, "session1/take_001");
+  const absl::StatusOr<ClipRecord> by_name = Db().GetClipRecordByName("session2/take_001");
+  ASSERT_TRUE(by_name.ok()) << by_name.status();
+  EXPECT_EQ(by_name->clip_id, second);
+  EXPECT_EQ(Db().GetClipRecordByName("take_001").status().code(), absl::StatusCode::kNotFound);
+  // 512 bytes, with segments, dots inside segments and non-ASCII text, is a name.
+  const std::string longest = std::string(250, 'a') + "/.hidden/" + std::string(251, 'b') + "é";
+  ASSERT_EQ(longest.size(), 512u);
+  ClipRecord longest_record = Named(longest);
+  longest_record.source_file = "long.bvh";
+  EXPECT_GT(Insert(longest_record, clip), 0);
+  EXPECT_GT(Insert(Named("a..b/c.d/...x"), clip), 0);
+  const absl::StatusOr<int64_t> taken = Db().InsertClip(Named("session1/take_001"), clip, {});
+  EXPECT_EQ(taken.status().code(), absl::StatusCode::kAlreadyExists);
+}
+
+TEST_F(StorageTest, MalformedNamesAndTagsAreRefused) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 4);
+  Insert(Named("kept", {"tag"}), clip);
+  const Counts before = CountsNow();
+  const std::vector<std::string> bad_names = {
+      "",
+      std::string(513, 'n'),
+      std::string("take\0one", 8),
+      "take\none",
+      "take\tone",
+      "take\x7f",
+      "take\xc2\x85one",  // NEL, a C1 control character in UTF-8
+      "/session1/take_001",
+      "session1/take_001/",
+      "/",
+      "session1//take_001",
+      "./take_001",
+      "session1/.",
+      "session1/../take_001",
+      "..",
+      "."};
+  for (const std::string& name : bad_names) {
+    const absl::StatusOr<int64_t> id = Db().InsertClip(Named(name), clip, {});
+    EXPECT_EQ(id.status().code(), absl::StatusCode::kInvalidArgument) << absl::CHexEscape(name);
+    EXPECT_THAT(id.status().message(), HasSubstr("clip name")) << absl::CHexEscape(name);
+    // The message holds no control character of the name.
+    EXPECT_EQ(id.status().message().find_first_of(std::string("\0\n\t\x7f", 4)),
+              absl::string_view::npos);
+  }
+  const std::vector<std::string> bad_tags = {std::string("a\0b", 3), "a\nb", "\x1b[31m", ""};
+  for (const std::string& tag : bad_tags) {
+    const absl::StatusOr<int64_t> id = Db().InsertClip(Named("fresh", {"good", tag}), clip, {});
+    EXPECT_EQ(id.status().code(), absl::StatusCode::kInvalidArgument) << absl::CHexEscape(tag);
+    EXPECT_THAT(id.status().message(), HasSubstr("tags[1]")) << absl::CHexEscape(tag);
+  }
+  EXPECT_EQ(Db().ListClips({}, "a\nb").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+}
+
+TEST_F(StorageTest, ContentHashIsOfTheStoredMotion) {
+  const std::shared_ptr<const Skeleton> chain = testing::ChainSkeleton();
+  const Clip walk = Motion(chain, 40, 1);
+  const int64_t a = Insert(Named("walk"), walk);
+  const int64_t b = Insert(Named("session2/walk"), walk);
+  const std::string hash = Db().GetClipRecord(a)->content_hash;
+  EXPECT_THAT(hash, ::testing::MatchesRegex("[0-9a-f]{64}"));
+  EXPECT_EQ(Db().GetClipRecord(b)->content_hash, hash);
+  EXPECT_EQ(Db().GetClip(a)->record.content_hash, hash);
+  EXPECT_EQ(Db().ListClips({})->clips[1].content_hash, hash);
+  // What the catalogue computes before an insert, to recognise a file stored before.
+  EXPECT_EQ(*ContentHash(walk), hash);
+
+  // Digits beyond float32 are formatting, not motion.
+  RowMatrixXd nudged = walk.positions();
+  nudged(3, 1) += 1e-12;
+  EXPECT_EQ(*ContentHash(
+                *Clip::Create(walk.shared_skeleton(), walk.frame_time(), walk.rotations(), nudged)),
+            hash);
+  // Any other frame, rate or skeleton layout is another content.
+  RowMatrixXd moved = walk.positions();
+  moved(3, 1) += 0.5;
+  const Clip one_frame_moved =
+      *Clip::Create(walk.shared_skeleton(), walk.frame_time(), walk.rotations(), moved);
+  const Clip other_rate =
+      *Clip::Create(walk.shared_skeleton(), 1.0 / 60, walk.rotations(), walk.positions());
+  const Clip other_actor =
+      *Clip::Create(Rescaled(*chain, 1.2), walk.frame_time(), walk.rotations(), walk.positions());
+  std::set<std::string> hashes = {hash};
+  for (const Clip& other :
+       {one_frame_moved, other_rate, other_actor, Motion(chain, 40, 2), Motion(chain, 39, 1)}) {
+    const int64_t id = Insert(Named(absl::StrCat("other_", hashes.size())), other);
+    const std::string other_hash = Db().GetClipRecord(id)->content_hash;
+    EXPECT_EQ(*ContentHash(other), other_hash);
+    EXPECT_TRUE(hashes.insert(other_hash).second) << "clip " << id << " hashes as another";
+  }
+
+  const absl::StatusOr<std::vector<ClipRecord>> same = Db().FindClipsByContentHash(hash, 10);
+  ASSERT_TRUE(same.ok()) << same.status();
+  ASSERT_EQ(same->size(), 2u);
+  EXPECT_EQ((*same)[0].clip_id, a);
+  EXPECT_EQ((*same)[1].name, "session2/walk");
+  EXPECT_EQ(Db().FindClipsByContentHash(hash, 1)->size(), 1u);
+  EXPECT_TRUE(Db().FindClipsByContentHash(std::string(64, '0'), 10)->empty());
+}
+
+TEST_F(StorageSpaceTest, ReplaceSwapsTheClipInOneTransaction) {
+  const int64_t walk = Insert(Named("take_001", {"old"}), walk_);
+  const int64_t other = Insert(Named("take_002"), wave_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  const int64_t space_id =
+      *Db().InsertSpace(SpaceNamed("body", skeleton), space_,
+                        {ProjectionOf(walk, walk_), ProjectionOf(other, wave_)});
+  ASSERT_TRUE(Raw()
+                  ->Execute(absl::StrCat("INSERT INTO labels (clip_id, first_frame, last_frame, "
+                                         "descriptor, value, origin, created_unix_ms) VALUES (",
+                                         walk, ", 0, 10, 'kick', 1.0, 'manual', 0)"))
+                  .ok());
+  const Counts before = CountsNow();
+  const std::string old_hash = Db().GetClipRecord(walk)->content_hash;
+  const Clip run = testing::SyntheticClip(skeleton_, {.frames = 50, .seed = 5});
+
+  // A replace whose insert fails after the delete leaves the old clip, its label and projection.
+  Projection projection;
+  projection.coordinates = RowMatrixXf::Ones(3, 2);
+  EXPECT_EQ(Db().InsertClip(Named("take_001"), run, {{999, projection}}, {.replace_clip_id = walk})
+                .status()
+                .code(),
+            absl::StatusCode::kNotFound);
+  // So does one whose name belongs to a clip other than the replaced one.
+  EXPECT_EQ(Db().InsertClip(Named("take_002"), run, {{space_id, ProjectionOf(0, run)}},
+                            {.replace_clip_id = walk})
+                .status()
+                .code(),
+            absl::StatusCode::kAlreadyExists);
+  const absl::StatusOr<int64_t> unknown = Db().InsertClip(
+      Named("take_009"), run, {{space_id, ProjectionOf(0, run)}}, {.replace_clip_id = 4242});
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(unknown.status().message(), HasSubstr("4242"));
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  EXPECT_EQ(Db().GetClipRecord(walk)->content_hash, old_hash);
+
+  const Projection run_projection = ProjectionOf(0, run);
+  const absl::StatusOr<int64_t> replaced = Db().InsertClip(
+      Named("take_001", {"new"}), run, {{space_id, run_projection}}, {.replace_clip_id = walk});
+  ASSERT_TRUE(replaced.ok()) << replaced.status();
+  EXPECT_GT(*replaced, other);
+  EXPECT_EQ(Db().GetClip(walk).status().code(), absl::StatusCode::kNotFound);
+  const absl::StatusOr<ClipRecord> now = Db().GetClipRecordByName("take_001");
+  ASSERT_TRUE(now.ok()) << now.status();
+  EXPECT_EQ(now->clip_id, *replaced);
+  EXPECT_EQ(now->frame_count, 50);
+  EXPECT_THAT(now->tags, ::testing::ElementsAre("new"));
+  EXPECT_NE(now->content_hash, old_hash);
+  EXPECT_TRUE(Db().FindClipsByContentHash(old_hash, 10)->empty());
+  const Counts after = CountsNow();
+  EXPECT_EQ(after.clips, before.clips);
+  EXPECT_EQ(after.projections, before.projections);
+  EXPECT_EQ(after.labels, 0);  // the old clip's label went with it
+  const std::vector<Projection> loaded = *Db().LoadProjections(space_id);
+  ASSERT_EQ(loaded.size(), 2u);
+  EXPECT_EQ(loaded[0].clip_id, other);
+  EXPECT_EQ(loaded[1].clip_id, *replaced);
+  EXPECT_EQ(loaded[1].coordinates, run_projection.coordinates);
+}
+
+ClipUpdate Update(std::optional<std::string> name, std::vector<std::string> add_tags = {},
+                  std::vector<std::string> remove_tags = {}) {
+  ClipUpdate update;
+  update.name = std::move(name);
+  update.add_tags = std::move(add_tags);
+  update.remove_tags = std::move(remove_tags);
+  return update;
+}
+
+TEST_F(StorageTest, UpdateClipRenamesAndRetagsAtomically) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 4);
+  const int64_t walk = Insert(Named("take_001", {"draft", "walk"}), clip);
+  Insert(Named("session2/take_001"), clip);
+
+  const ClipUpdate update =
+      Update("session1/take_001", {"session1", "walk", "final", "final"}, {"draft", "never-there"});
+  const absl::StatusOr<ClipRecord> updated = Db().UpdateClip(walk, update);
+  ASSERT_TRUE(updated.ok()) << updated.status();
+  EXPECT_EQ(updated->clip_id, walk);
+  EXPECT_EQ(updated->name, "session1/take_001");
+  EXPECT_THAT(updated->tags, ::testing::ElementsAre("final", "session1", "walk"));
+  const ClipRecord stored = *Db().GetClipRecord(walk);
+  EXPECT_EQ(stored.name, "session1/take_001");
+  EXPECT_EQ(stored.tags, updated->tags);
+  EXPECT_EQ(stored.content_hash, updated->content_hash);
+  EXPECT_EQ(Db().ListClips({}, "draft")->clips.size(), 0u);
+  EXPECT_EQ(Db().ListClips({}, "final")->clips.size(), 1u);
+  EXPECT_EQ(Db().GetClipRecordByName("take_001").status().code(), absl::StatusCode::kNotFound);
+  // The old name is free again; its own name is no conflict; nothing set changes nothing.
+  EXPECT_GT(Insert(Named("take_001"), clip), 0);
+  EXPECT_TRUE(Db().UpdateClip(walk, Update("session1/take_001")).ok());
+  EXPECT_EQ(Db().UpdateClip(walk, Update(std::nullopt))->tags, updated->tags);
+
+  const Counts counts = CountsNow();
+  struct Bad {
+    ClipUpdate update;
+    absl::StatusCode code;
+    std::string words;
+  };
+  std::vector<std::string> many;  // 62 new tags beside the 3 carried: over 64 only in the end
+  for (int i = 0; i < 62; ++i) many.push_back(absl::StrCat("t", i));
+  const std::vector<Bad> bad = {
+      {Update("session2/take_001"), absl::StatusCode::kAlreadyExists, "session2/take_001"},
+      {Update("a//b"), absl::StatusCode::kInvalidArgument, "clip name"},
+      {Update(""), absl::StatusCode::kInvalidArgument, "clip name"},
+      {Update("x", {"ok", "bad\n"}), absl::StatusCode::kInvalidArgument, "add_tags[1]"},
+      {Update(std::nullopt, {"ok"}, {""}), absl::StatusCode::kInvalidArgument, "remove_tags[0]"},
+      {Update(std::nullopt, {"ok"}, {"ok"}), absl::StatusCode::kInvalidArgument, "add_tags"},
+      // Refused after the rename has run, which rolls back with it.
+      {Update("renamed", many), absl::StatusCode::kInvalidArgument, "at most 64"},
+  };
+  for (const Bad& b : bad) {
+    const absl::StatusOr<ClipRecord> refused = Db().UpdateClip(walk, b.update);
+    EXPECT_EQ(refused.status().code(), b.code) << b.words << ": " << refused.status();
+    EXPECT_THAT(refused.status().message(), HasSubstr(b.words));
+  }
+  EXPECT_EQ(Db().UpdateClip(4242, Update("x")).status().code(), absl::StatusCode::kNotFound);
+  const ClipRecord unchanged = *Db().GetClipRecord(walk);
+  EXPECT_EQ(unchanged.name, "session1/take_001");
+  EXPECT_EQ(unchanged.tags, updated->tags);
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(counts));
+}
+
 TEST_F(StorageTest, FailureMidTransactionLeavesNoRow) {
   const Counts before = CountsNow();
   Projection projection;
@@ -567,6 +801,61 @@ TEST_F(StorageTest, NewerSchemaVersionIsRefused) {
   const absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_);
   EXPECT_EQ(db.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(db.status().message(), HasSubstr("newer"));
+}
+
+// A file of schema version 1, as builds before the content hash wrote it, gets every clip's hash
+// when opened: the hash a clip stored now would have.
+TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
+  const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
+  const int64_t a = Insert(Named("walk", {"x"}), walk);
+  const int64_t b = Insert(Named("session1/run"), Motion(testing::ChainSkeleton(), 30, 2));
+  const int64_t c = Insert(Named("walk_again"), walk);
+  std::map<int64_t, std::string> expected;
+  for (const int64_t id : {a, b, c}) expected[id] = Db().GetClipRecord(id)->content_hash;
+  Close();
+
+  // Version 1's schema, made by its own migration, holding the same rows.
+  const std::string old_path = (dir_ / "schema1.db").string();
+  {
+    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
+        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
+    ASSERT_TRUE(old.ok()) << old.status();
+    ASSERT_TRUE(MigrateSchema(**old, 1).ok());
+    const absl::Status copied = (*old)->Execute(absl::StrCat(
+        "ATTACH DATABASE '", path_, "' AS current;",
+        "INSERT INTO skeletons SELECT * FROM current.skeletons;"
+        "INSERT INTO clips SELECT clip_id, name, source_file, skeleton_id, frame_time, "
+        "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
+        "created_unix_ms FROM current.clips;"
+        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;"
+        "DETACH DATABASE current"));
+    ASSERT_TRUE(copied.ok()) << copied;
+    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), 1);
+    EXPECT_EQ(*(*old)->QueryInt64(
+                  "SELECT count(*) FROM pragma_table_info('clips') WHERE name = 'content_hash'"),
+              0);
+  }
+  path_ = old_path;
+
+  for (const int64_t id : {a, b, c}) {
+    const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->content_hash, expected[id]) << id;
+  }
+  EXPECT_THAT(Db().GetClipRecord(a)->tags, ::testing::ElementsAre("x"));
+  const absl::StatusOr<std::vector<ClipRecord>> same = Db().FindClipsByContentHash(expected[a], 10);
+  ASSERT_TRUE(same.ok()) << same.status();
+  ASSERT_EQ(same->size(), 2u);
+  EXPECT_EQ((*same)[1].clip_id, c);
+  std::unique_ptr<SqliteConnection> raw = Raw();
+  EXPECT_EQ(*raw->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  EXPECT_EQ(*raw->QueryInt64("SELECT count(*) FROM clips WHERE content_hash = ''"), 0);
+  EXPECT_EQ(
+      *raw->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'clips_by_content_hash'"),
+      1);
+  raw.reset();
+  // New clips go on after the copied ids.
+  EXPECT_GT(Insert(Named("new"), walk), c);
 }
 
 TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {

@@ -56,7 +56,13 @@ def main():
             print(f"{path}: {error.code().name}: {error.details()}", file=sys.stderr)
             continue
         ids.append(reply.clip.clip_id)
-        print(f"{path} -> clip {reply.clip.clip_id}, {reply.clip.frame_count} frames")
+        # Run again on the same files, the example stores nothing twice: an unchanged file is
+        # skipped (on_conflict unset), and a changed one under a stored name is refused.
+        skipped = reply.result == clip_service_pb2.INGEST_RESULT_SKIPPED
+        print(f"{path} -> clip {reply.clip.clip_id}, {reply.clip.frame_count} frames"
+              + (" (stored before; skipped)" if skipped else ""))
+        for warning in reply.warnings:  # e.g. identical content to another clip
+            print(f"  warning: {warning}")
     if not ids:
         return 1
 

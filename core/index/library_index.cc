@@ -164,6 +164,21 @@ absl::StatusOr<std::unique_ptr<LibraryIndex>> LibraryIndex::WithClips(
   return index;
 }
 
+absl::StatusOr<std::unique_ptr<LibraryIndex>> LibraryIndex::WithClipInfo(
+    int64_t clip_id, std::string name, std::vector<std::string> tags) const {
+  const int c = FindClip(clip_id);
+  if (c < 0) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " is not in the library"));
+  std::unique_ptr<LibraryIndex> index(new LibraryIndex(rate_, options_, dims_));
+  index->total_frames_ = total_frames_;
+  index->blocks_ = blocks_;
+  index->clips_ = clips_;
+  index->clip_block_ = clip_block_;
+  index->index_of_id_ = index_of_id_;
+  index->clips_[c].name = std::move(name);
+  index->clips_[c].tags = std::move(tags);
+  return index;
+}
+
 void LibraryIndex::AddBlock(std::vector<LibraryClip> clips, int64_t first_frame) {
   auto block = std::make_shared<Block>();
   block->first_frame = first_frame;

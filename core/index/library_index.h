@@ -71,6 +71,11 @@ class LibraryIndex {
   // be new). Shares this index's first block and kd-tree; the second is built anew from the
   // clips added since the last full build and these.
   absl::StatusOr<std::unique_ptr<LibraryIndex>> WithClips(std::vector<LibraryClip> clips) const;
+  // This library with one clip's name and tags changed (a rename or re-tag). Shares every
+  // coordinate block and kd-tree, copying only the clip entries. NOT_FOUND when the clip is not
+  // in the library.
+  absl::StatusOr<std::unique_ptr<LibraryIndex>> WithClipInfo(int64_t clip_id, std::string name,
+                                                             std::vector<std::string> tags) const;
 
   double rate() const { return rate_; }
   int dims() const { return dims_; }

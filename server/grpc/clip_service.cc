@@ -11,22 +11,15 @@
 #include "util/status_macros.h"
 
 namespace motiondb::server {
-namespace {
-
-IngestRequest IngestRequestOf(const std::string& file_name, const std::string& name,
-                              const google::protobuf::RepeatedPtrField<std::string>& tags) {
-  return {file_name, name, std::vector<std::string>(tags.begin(), tags.end())};
-}
-
-}  // namespace
 
 grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
                                          const v1::IngestClipRequest* request,
                                          v1::IngestClipResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<IngestOutcome> outcome = IngestUpload(
-        catalog_, IngestRequestOf(request->file_name(), request->name(), request->tags()),
-        request->bvh(), limits_);
+    const absl::StatusOr<IngestRequest> ingest = FromProto(*request);
+    if (!ingest.ok()) return ToGrpcStatus(ingest.status());
+    const absl::StatusOr<IngestOutcome> outcome =
+        IngestUpload(catalog_, *ingest, request->bvh(), limits_);
     if (!outcome.ok()) return ToGrpcStatus(outcome.status());
     ToProto(*outcome, response);
     return grpc::Status::OK;
@@ -39,8 +32,7 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStream
   if (!reader->Read(&message)) {
     return absl::InvalidArgumentError("the stream is empty: the first message needs file_name");
   }
-  const IngestRequest request =
-      IngestRequestOf(message.file_name(), message.name(), message.tags());
+  MOTIONDB_ASSIGN_OR_RETURN(const IngestRequest request, FromProto(message));
   // Refused before the upload is read: a stream without a file name would be read in vain.
   MOTIONDB_RETURN_IF_ERROR(ClipName(request).status());
   std::string bvh;
@@ -92,6 +84,17 @@ grpc::Status ClipServiceImpl::DeleteClip(grpc::ServerContext* context,
                                          v1::DeleteClipResponse* /*response*/) {
   return gate_.Run(context, [&]() -> grpc::Status {
     return ToGrpcStatus(catalog_.DeleteClip(request->clip_id()));
+  });
+}
+
+grpc::Status ClipServiceImpl::UpdateClip(grpc::ServerContext* context,
+                                         const v1::UpdateClipRequest* request, v1::Clip* response) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<storage::ClipRecord> updated =
+        catalog_.UpdateClip(request->clip_id(), FromProto(*request));
+    if (!updated.ok()) return ToGrpcStatus(updated.status());
+    ToProto(*updated, response);
+    return grpc::Status::OK;
   });
 }
 

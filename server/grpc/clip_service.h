@@ -1,4 +1,4 @@
-// motiondb.v1.ClipService: ingest, list, get, delete and export clips.
+// motiondb.v1.ClipService: ingest, list, get, update, delete and export clips.
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
@@ -28,6 +28,8 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                        v1::Clip* response) override;
   grpc::Status DeleteClip(grpc::ServerContext* context, const v1::DeleteClipRequest* request,
                           v1::DeleteClipResponse* response) override;
+  grpc::Status UpdateClip(grpc::ServerContext* context, const v1::UpdateClipRequest* request,
+                          v1::Clip* response) override;
   grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
                           v1::ExportClipResponse* response) override;
 

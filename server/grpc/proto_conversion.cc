@@ -57,6 +57,44 @@ v1::WeightPreset ToProto(WeightPreset preset) {
   return preset == WeightPreset::kMass ? v1::WEIGHT_PRESET_MASS : v1::WEIGHT_PRESET_UNIFORM;
 }
 
+absl::StatusOr<OnConflict> FromProto(v1::OnConflict on_conflict) {
+  switch (on_conflict) {
+    case v1::ON_CONFLICT_UNSPECIFIED:
+      return OnConflict::kSkipIdentical;
+    case v1::ON_CONFLICT_ERROR:
+      return OnConflict::kError;
+    case v1::ON_CONFLICT_SKIP:
+      return OnConflict::kSkip;
+    case v1::ON_CONFLICT_REPLACE:
+      return OnConflict::kReplace;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("on_conflict: unknown value ", on_conflict));
+  }
+}
+
+v1::IngestResult ToProto(IngestResult result) {
+  switch (result) {
+    case IngestResult::kStored:
+      return v1::INGEST_RESULT_STORED;
+    case IngestResult::kSkipped:
+      return v1::INGEST_RESULT_SKIPPED;
+    case IngestResult::kReplaced:
+      return v1::INGEST_RESULT_REPLACED;
+  }
+  return v1::INGEST_RESULT_UNSPECIFIED;
+}
+
+// IngestClipRequest and the first IngestClipStreamRequest carry the same fields.
+template <typename Message>
+absl::StatusOr<IngestRequest> IngestRequestOf(const Message& message) {
+  IngestRequest request;
+  request.file_name = message.file_name();
+  request.name = message.name();
+  request.tags.assign(message.tags().begin(), message.tags().end());
+  MOTIONDB_ASSIGN_OR_RETURN(request.on_conflict, FromProto(message.on_conflict()));
+  return request;
+}
+
 template <typename T>
 std::optional<T> Optional(bool has, T value) {
   return has ? std::optional<T>(value) : std::nullopt;
@@ -84,6 +122,22 @@ absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
 ClipSelection FromProto(const v1::ClipRange& range) {
   return {range.clip_id(), Optional(range.has_first_frame(), range.first_frame()),
           Optional(range.has_last_frame(), range.last_frame())};
+}
+
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipRequest& request) {
+  return IngestRequestOf(request);
+}
+
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipStreamRequest& first) {
+  return IngestRequestOf(first);
+}
+
+storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request) {
+  storage::ClipUpdate update;
+  if (request.has_name()) update.name = request.name();
+  update.add_tags.assign(request.add_tags().begin(), request.add_tags().end());
+  update.remove_tags.assign(request.remove_tags().begin(), request.remove_tags().end());
+  return update;
 }
 
 absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
@@ -155,12 +209,20 @@ void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
   clip->set_fps(fps);
   clip->set_duration_s(fps > 0 ? record.frame_count / fps : 0.0);
   clip->set_joint_count(record.joint_count);
+  clip->set_content_hash(record.content_hash);
 }
 
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
   ToProto(outcome.clip, response->mutable_clip());
   for (const std::string& warning : outcome.warnings) response->add_warnings(warning);
   for (const std::string& space : outcome.spaces) response->add_projected_spaces(space);
+  response->set_result(ToProto(outcome.result));
+  response->set_replaced_clip_id(outcome.replaced_clip_id);
+  for (const storage::ClipRecord& duplicate : outcome.duplicates) {
+    v1::ClipRef* same = response->add_duplicate_of();
+    same->set_clip_id(duplicate.clip_id);
+    same->set_name(duplicate.name);
+  }
 }
 
 void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response) {

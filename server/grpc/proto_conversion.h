@@ -23,6 +23,10 @@ namespace motiondb::server {
 
 // Requests.
 ClipSelection FromProto(const v1::ClipRange& range);
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipRequest& request);
+// The first message of the stream (the one that carries the request's fields).
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipStreamRequest& first);
+storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request);
 absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request);
 absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request);
 CurveRequest FromProto(const v1::GetCurveRequest& request);

@@ -20,13 +20,23 @@ inline constexpr size_t kMaxNameBytes = 512;  // clip, source file and space nam
 inline constexpr size_t kMaxTagBytes = 128;
 inline constexpr size_t kMaxTags = 64;  // a clip's
 
-// INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`) or one longer than
-// `max_bytes`.
+// INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`), one longer than
+// `max_bytes`, or one holding a control character (NUL, the rest of C0, DEL, or C1 encoded as
+// UTF-8). Names and tags are printed in listings, logs and terminals, where a control character
+// would hide or rewrite what follows it, and NUL would cut the name short in C strings.
 absl::Status CheckName(absl::string_view what, absl::string_view name, size_t max_bytes,
                        bool may_be_empty = false);
 
+// CheckName's rules for a clip name, and those of a relative path: '/' separates segments
+// (studios name takes "session1/take_001"), none of which may be empty, "." or "..", so no
+// leading, trailing or doubled '/'. A clip name then maps to a path under an export folder that
+// cannot leave it, and one clip has one spelling ("a//b" and "a/./b" are not a second "a/b").
+absl::Status CheckClipName(absl::string_view name);
+
 // Tags are a set: checked, sorted and without repeats, as ListClips and GetClip return them.
-absl::StatusOr<std::vector<std::string>> CanonicalTags(std::vector<std::string> tags);
+// Errors name the tag as `field`[i].
+absl::StatusOr<std::vector<std::string>> CanonicalTags(std::vector<std::string> tags,
+                                                       absl::string_view field = "tags");
 
 // INVALID_ARGUMENT naming `what` for a projection without columns, with more columns than
 // `space_dims` (the dimensions of the stored space, when known yet), or with non-finite values.

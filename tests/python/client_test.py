@@ -145,6 +145,37 @@ class ServerTest(unittest.TestCase):
         self.assertTrue(info.version)
         self.assertGreaterEqual(info.counts.clips, 5)
 
+    def test_5_names_conflicts_and_updates(self):
+        def upload(bvh, on_conflict=clip_service_pb2.ON_CONFLICT_UNSPECIFIED):
+            return self.clips.IngestClip(clip_service_pb2.IngestClipRequest(
+                file_name="take_001.bvh", name="py_session/take_001", bvh=bvh.encode(),
+                on_conflict=on_conflict), timeout=30)
+
+        take, retake = arm_raise_bvh(60, 0.5), arm_raise_bvh(60, 0.6)
+        first = upload(take)
+        self.assertEqual(first.result, clip_service_pb2.INGEST_RESULT_STORED)
+        self.assertEqual(first.clip.name, "py_session/take_001")
+        self.assertEqual(len(first.clip.content_hash), 64)
+        again = upload(take)  # the same file again: skipped by default
+        self.assertEqual(again.result, clip_service_pb2.INGEST_RESULT_SKIPPED)
+        self.assertEqual(again.clip.clip_id, first.clip.clip_id)
+        with self.assertRaises(grpc.RpcError) as raised:
+            upload(retake)  # other content under the name: refused by default
+        self.assertEqual(raised.exception.code(), grpc.StatusCode.ALREADY_EXISTS)
+        self.assertIn("on_conflict", raised.exception.details())
+        replaced = upload(retake, clip_service_pb2.ON_CONFLICT_REPLACE)
+        self.assertEqual(replaced.result, clip_service_pb2.INGEST_RESULT_REPLACED)
+        self.assertEqual(replaced.replaced_clip_id, first.clip.clip_id)
+
+        updated = self.clips.UpdateClip(clip_service_pb2.UpdateClipRequest(
+            clip_id=replaced.clip.clip_id, name="py_session/take_001_best", add_tags=["best"]),
+            timeout=10)
+        self.assertEqual(updated.name, "py_session/take_001_best")
+        self.assertEqual(list(updated.tags), ["best"])
+        exported = self.clips.ExportClip(clip_service_pb2.ExportClipRequest(
+            clip=common_pb2.ClipRange(clip_id=updated.clip_id)), timeout=10)
+        self.assertEqual(exported.file_name, "py_session_take_001_best.bvh")
+
 
 if __name__ == "__main__":
     SERVER, EXAMPLE = sys.argv[1], sys.argv[2]
