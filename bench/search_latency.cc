@@ -15,12 +15,12 @@
 #include <string>
 
 #include "bench/measure.h"
+#include "util/cli_conventions.h"
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
 #include "core/space/search_coordinates.h"
 #include "testing/synthetic_library.h"
-#include "util/command_line.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -220,11 +220,7 @@ absl::Status Sweeps(int queries) {
   return absl::OkStatus();
 }
 
-absl::Status Main(const cli::CommandLine& line) {
-  const std::string scenario = line.value("scenario").value_or("all");
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> queries, line.integer("queries"));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> exact, line.integer("exact-queries"));
-  const int q = queries.value_or(20), e = exact.value_or(5);
+absl::Status Main(const std::string& scenario, int q, int e) {
   const auto wants = [&](const char* name) { return scenario == "all" || scenario == name; };
   if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e));
   if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e));
@@ -238,10 +234,26 @@ absl::Status Main(const cli::CommandLine& line) {
 }  // namespace motiondb
 
 int main(int argc, char** argv) {
-  const absl::StatusOr<motiondb::cli::CommandLine> line =
-      motiondb::cli::CommandLine::Parse(std::vector<std::string>(argv + 1, argv + argc),
-                                        {"scenario", "queries", "exact-queries"}, {});
-  const absl::Status status = line.ok() ? motiondb::Main(*line) : line.status();
+  CLI::App app("Search latency, index build time and memory on synthetic libraries.",
+               "search_latency");
+  std::string scenario = "all";
+  int queries = 20, exact_queries = 5;
+  motiondb::cli::OneOf(
+      app.add_option("--scenario", scenario, "the library to measure, or the sweeps, or all"),
+      {"70s120", "1h30", "10h30", "10h120", "sweeps", "all"})
+      ->capture_default_str();
+  app.add_option("--queries", queries, "fast-search queries per scenario")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--exact-queries", exact_queries, "exact-search queries per scenario")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(motiondb::cli::WholeAtLeast(0));
+  if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
+    return *exit_code;
+  }
+  const absl::Status status = motiondb::Main(scenario, queries, exact_queries);
   if (!status.ok()) {
     std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());
     return 1;

@@ -10,50 +10,85 @@
 //          [--no-refine]
 #include <chrono>
 #include <cstdio>
+#include <string>
+#include <tuple>
 
 #include "bench/measure.h"
+#include "util/cli_conventions.h"
 #include "testing/labelled_library.h"
 #include "testing/retrieval_evaluation.h"
-#include "util/command_line.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
 namespace {
 
-absl::Status Run(const cli::CommandLine& line) {
-  const std::filesystem::path mocap = bench::MocapRoot();
-  const std::filesystem::path folder =
-      line.value("folder").value_or((mocap / "bandai2-normal").string());
+// The flags, with the defaults of the space and the search.
+struct QualityFlags {
+  std::string folder = (bench::MocapRoot() / "bandai2-normal").string();
+  std::string metric = "unit";
+  std::string weights = "mass";
+  std::string neutral = "mean";
+  bool keep_heading = false, no_refine = false;
+  SpaceOptions space;
+  RetrievalOptions retrieval;
+};
+
+void AddFlags(CLI::App& app, QualityFlags* flags) {
+  app.add_option("--folder", flags->folder, "labelled BVH folder")
+      ->type_name("DIR")
+      ->capture_default_str();
+  cli::OneOf(app.add_option("--metric", flags->metric, "the space's metric"), {"unit", "eigen"})
+      ->capture_default_str();
+  cli::OneOf(app.add_option("--weights", flags->weights, "the joint-weight preset"),
+             {"mass", "uniform"})
+      ->capture_default_str();
+  app.add_option("--rate", flags->space.sample_rate, "the space's sample rate")
+      ->type_name("HZ")
+      ->capture_default_str()
+      ->check(cli::NumberAbove(0));
+  app.add_option("--yaw-weight", flags->space.yaw_rate_weight, "the yaw-rate dimension's weight")
+      ->type_name("W")
+      ->capture_default_str()
+      ->check(cli::NumberAbove(0));
+  app.add_flag("--keep-heading", flags->keep_heading, "keep the body's facing in the pose");
+  SearchParams& params = flags->retrieval.params;
+  for (auto [name, field, what, min] :
+       {std::tuple{"--neighbours", &params.neighbours, "seeds", 1},
+        {"--ann-dims", &params.ann_dims, "seed search dimensions", 1},
+        {"--dtw-dims", &params.dtw_dims, "time-warp dimensions", 1},
+        {"--slope", &params.slope_limit, "the warp's slope limit", 1},
+        {"--exact-every", &flags->retrieval.exact_every,
+         "run the exact search on every N-th query (0: never)", 0}}) {
+    app.add_option(name, *field, what)
+        ->type_name("N")
+        ->capture_default_str()
+        ->check(cli::WholeAtLeast(min));
+  }
+  cli::OneOf(app.add_option("--neutral", flags->neutral, "the characteristic pose's neutral pose"),
+             {"mean", "boundary", "origin"})
+      ->capture_default_str();
+  app.add_flag("--no-refine", flags->no_refine, "the thesis's search as is");
+}
+
+absl::Status Run(QualityFlags& flags) {
+  const std::filesystem::path folder = flags.folder;
   if (!std::filesystem::is_directory(folder)) {
     std::printf("search_quality: %s is absent; nothing measured\n", folder.c_str());
     return absl::OkStatus();
   }
-  SpaceOptions space_options;
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> rate, line.number("rate"));
-  space_options.sample_rate = rate.value_or(space_options.sample_rate);
-  const std::string metric = line.value("metric").value_or("unit");
+  SpaceOptions& space_options = flags.space;
+  const std::string& metric = flags.metric;
   space_options.metric = metric == "eigen" ? SpaceMetric::kEigenvalueScaled : SpaceMetric::kUnit;
-  MOTIONDB_ASSIGN_OR_RETURN(space_options.weights.preset,
-                            ParseWeightPreset(line.value("weights").value_or("mass")));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> yaw, line.number("yaw-weight"));
-  space_options.yaw_rate_weight = yaw.value_or(space_options.yaw_rate_weight);
-  space_options.pose.remove_heading = !line.flag("keep-heading");
+  MOTIONDB_ASSIGN_OR_RETURN(space_options.weights.preset, ParseWeightPreset(flags.weights));
+  space_options.pose.remove_heading = !flags.keep_heading;
 
-  RetrievalOptions options;
-  SearchParams& params = options.params;
-  for (auto [name, field] : {std::pair{"neighbours", &params.neighbours},
-                             {"ann-dims", &params.ann_dims},
-                             {"dtw-dims", &params.dtw_dims},
-                             {"slope", &params.slope_limit},
-                             {"exact-every", &options.exact_every}}) {
-    MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> value, line.integer(name));
-    *field = value.value_or(*field);
-  }
-  const std::string neutral = line.value("neutral").value_or("mean");
+  const RetrievalOptions& options = flags.retrieval;
+  SearchParams& params = flags.retrieval.params;
+  const std::string& neutral = flags.neutral;
   params.neutral = neutral == "origin"     ? NeutralPose::kOrigin
                    : neutral == "boundary" ? NeutralPose::kBoundaryMean
                                            : NeutralPose::kQueryMean;
-  params.refine = !line.flag("no-refine");
+  params.refine = !flags.no_refine;
 
   const bench::Clock::time_point start = bench::Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledLibrary library,
@@ -96,12 +131,13 @@ absl::Status Run(const cli::CommandLine& line) {
 }  // namespace motiondb
 
 int main(int argc, char** argv) {
-  const absl::StatusOr<motiondb::cli::CommandLine> line = motiondb::cli::CommandLine::Parse(
-      std::vector<std::string>(argv + 1, argv + argc),
-      {"folder", "metric", "weights", "rate", "neighbours", "ann-dims", "dtw-dims", "slope",
-       "neutral", "exact-every", "yaw-weight"},
-      {"keep-heading", "no-refine"});
-  const absl::Status status = line.ok() ? motiondb::Run(*line) : line.status();
+  CLI::App app("Retrieval quality of the search on real labelled data.", "search_quality");
+  motiondb::QualityFlags flags;
+  motiondb::AddFlags(app, &flags);
+  if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
+    return *exit_code;
+  }
+  const absl::Status status = motiondb::Run(flags);
   if (!status.ok()) {
     std::fprintf(stderr, "search_quality: %s\n", std::string(status.message()).c_str());
     return 1;

@@ -33,6 +33,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "bench/measure.h"
+#include "util/cli_conventions.h"
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
@@ -43,7 +44,6 @@
 #include "storage/database.h"
 #include "testing/server_process.h"
 #include "testing/synthetic_library.h"
-#include "util/command_line.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
@@ -443,22 +443,24 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   return absl::OkStatus();
 }
 
-absl::Status Run(const cli::CommandLine& line) {
-  const std::filesystem::path mocap = MocapRoot();
-  const std::filesystem::path folder =
-      line.value("folder").value_or((mocap / "bandai2-normal").string());
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> seconds, line.number("seconds"));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> hours, line.number("hours"));
+struct BenchFlags {
+  std::string folder = (MocapRoot() / "bandai2-normal").string();
+  double seconds = 5.0;  // of each served-search measurement
+  double hours = 10.0;   // of the start-up library (0: skip)
+};
+
+absl::Status Run(const BenchFlags& flags) {
+  const std::filesystem::path folder = flags.folder;
   const std::filesystem::path work = std::filesystem::temp_directory_path() /
                                      ("motiondb_server_bench_" + std::to_string(getpid()));
   std::filesystem::create_directories(work);
   absl::Status status = absl::OkStatus();
   if (std::filesystem::is_directory(folder)) {
-    status = ServedSearches(folder, seconds.value_or(5.0), work);
+    status = ServedSearches(folder, flags.seconds, work);
   } else {
     std::printf("%s is absent; the ingest and search measurements are skipped\n", folder.c_str());
   }
-  if (status.ok() && hours.value_or(10.0) > 0) status = StartToServing(hours.value_or(10.0), work);
+  if (status.ok() && flags.hours > 0) status = StartToServing(flags.hours, work);
   std::filesystem::remove_all(work);
   return status;
 }
@@ -467,9 +469,23 @@ absl::Status Run(const cli::CommandLine& line) {
 }  // namespace motiondb
 
 int main(int argc, char** argv) {
-  const absl::StatusOr<motiondb::cli::CommandLine> line = motiondb::cli::CommandLine::Parse(
-      std::vector<std::string>(argv + 1, argv + argc), {"folder", "seconds", "hours"}, {});
-  const absl::Status status = line.ok() ? motiondb::Run(*line) : line.status();
+  CLI::App app("The server's throughput, ingest rate, start-up time and memory.", "server_bench");
+  motiondb::BenchFlags flags;
+  app.add_option("--folder", flags.folder, "labelled BVH folder to ingest and search")
+      ->type_name("DIR")
+      ->capture_default_str();
+  app.add_option("--seconds", flags.seconds, "length of each served-search measurement")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(motiondb::cli::NumberAbove(0));
+  app.add_option("--hours", flags.hours, "hours of capture in the start-up library (0: skip)")
+      ->type_name("H")
+      ->capture_default_str()
+      ->check(motiondb::cli::NumberAtLeast(0));
+  if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
+    return *exit_code;
+  }
+  const absl::Status status = motiondb::Run(flags);
   if (!status.ok()) {
     std::fprintf(stderr, "server_bench: %s\n", std::string(status.message()).c_str());
     return 1;

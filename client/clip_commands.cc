@@ -1,6 +1,6 @@
 // motiondb clips [--tag T] | clip show ID | clip delete ID | export ID [--from F --to T] -o OUT
-#include <charconv>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +10,7 @@
 #include "client/commands.h"
 #include "client/server_connection.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
@@ -33,25 +34,11 @@ nlohmann::json ClipJson(const v1::Clip& clip) {
   return json;
 }
 
-absl::StatusOr<int64_t> ParseClipId(const CommandLine& line, size_t index) {
-  if (line.positionals().size() != index + 1) {
-    return absl::InvalidArgumentError("expected one clip id");
-  }
-  const std::string& text = line.positionals()[index];
-  int64_t id = 0;
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), id);
-  if (ec != std::errc() || ptr != text.data() + text.size() || id <= 0) {
-    return absl::InvalidArgumentError(absl::StrCat("'", text, "' is not a clip id"));
-  }
-  return id;
-}
-
-absl::Status ListClips(const CommandLine& line, const ServerConnection& connection) {
-  if (!line.positionals().empty()) return absl::InvalidArgumentError("unexpected arguments");
+absl::Status ListClips(const std::string& tag, bool json, const ServerConnection& connection) {
   const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::ListClipsRequest request;
   request.set_page_size(1000);
-  request.set_tag(line.value("tag").value_or(""));
+  request.set_tag(tag);
   nlohmann::json clips = nlohmann::json::array();
   bool first_page = true;
   do {
@@ -59,13 +46,13 @@ absl::Status ListClips(const CommandLine& line, const ServerConnection& connecti
     MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
       return stub->ListClips(context, request, &response);
     }));
-    if (first_page && !line.flag("json")) {
+    if (first_page && !json) {
       absl::PrintF("%8s  %-40s %8s %8s %9s  %s\n", "ID", "NAME", "FRAMES", "FPS", "SECONDS",
                    "TAGS");
     }
     first_page = false;
     for (const v1::Clip& clip : response.clips()) {
-      if (line.flag("json")) {
+      if (json) {
         clips.push_back(ClipJson(clip));
       } else {
         absl::PrintF("%8d  %-40s %8d %8.2f %9.2f  %s\n", clip.clip_id(), clip.name(),
@@ -75,38 +62,19 @@ absl::Status ListClips(const CommandLine& line, const ServerConnection& connecti
     }
     request.set_page_token(response.next_page_token());
   } while (!request.page_token().empty());
-  if (line.flag("json")) std::cout << nlohmann::json{{"clips", clips}}.dump() << "\n";
+  if (json) std::cout << nlohmann::json{{"clips", clips}}.dump() << "\n";
   return absl::OkStatus();
 }
 
-absl::Status ClipSubcommand(const CommandLine& line, const ServerConnection& connection) {
-  const std::string subcommand = line.positionals().empty() ? "" : line.positionals()[0];
-  if (subcommand != "show" && subcommand != "delete") {
-    return absl::InvalidArgumentError("expected 'clip show ID' or 'clip delete ID'");
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t id, ParseClipId(line, 1));
+absl::Status ShowClip(int64_t id, bool json, const ServerConnection& connection) {
   const auto stub = v1::ClipService::NewStub(connection.channel());
-  if (subcommand == "delete") {
-    v1::DeleteClipRequest request;
-    request.set_clip_id(id);
-    v1::DeleteClipResponse response;
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->DeleteClip(context, request, &response);
-    }));
-    if (line.flag("json")) {
-      std::cout << nlohmann::json{{"deleted", id}}.dump() << "\n";
-    } else {
-      absl::PrintF("deleted clip %d\n", id);
-    }
-    return absl::OkStatus();
-  }
   v1::GetClipRequest request;
   request.set_clip_id(id);
   v1::Clip clip;
   MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
     return stub->GetClip(context, request, &clip);
   }));
-  if (line.flag("json")) {
+  if (json) {
     std::cout << ClipJson(clip).dump() << "\n";
   } else {
     absl::PrintF("clip %d: %s (from %s)\n  frames:   %d at %.4f fps, %.3f s\n", clip.clip_id(),
@@ -119,53 +87,99 @@ absl::Status ClipSubcommand(const CommandLine& line, const ServerConnection& con
   return absl::OkStatus();
 }
 
-absl::Status Export(const CommandLine& line, const ServerConnection& connection) {
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t id, ParseClipId(line, 0));
-  const std::optional<std::string> out = line.value("out");
-  if (!out) return absl::InvalidArgumentError("no output file given (-o OUT.bvh)");
+absl::Status DeleteClip(int64_t id, bool json, const ServerConnection& connection) {
+  const auto stub = v1::ClipService::NewStub(connection.channel());
+  v1::DeleteClipRequest request;
+  request.set_clip_id(id);
+  v1::DeleteClipResponse response;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->DeleteClip(context, request, &response);
+  }));
+  if (json) {
+    std::cout << nlohmann::json{{"deleted", id}}.dump() << "\n";
+  } else {
+    absl::PrintF("deleted clip %d\n", id);
+  }
+  return absl::OkStatus();
+}
+
+struct ExportFlags {
+  int64_t id = 0;
+  FrameRangeFlags range;
+  std::string out;
+};
+
+absl::Status Export(const ExportFlags& flags, bool json, const ServerConnection& connection) {
   v1::ExportClipRequest request;
-  request.mutable_clip()->set_clip_id(id);
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> from, line.integer("from"));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> to, line.integer("to"));
-  if (from) request.mutable_clip()->set_first_frame(*from);
-  if (to) request.mutable_clip()->set_last_frame(*to);
+  request.mutable_clip()->set_clip_id(flags.id);
+  if (flags.range.from) request.mutable_clip()->set_first_frame(*flags.range.from);
+  if (flags.range.to) request.mutable_clip()->set_last_frame(*flags.range.to);
   const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::ExportClipResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->ExportClip(context, request, &response);
-  }));
-  MOTIONDB_RETURN_IF_ERROR(WriteFileAtomically(*out, response.bvh()));
-  if (line.flag("json")) {
-    std::cout << nlohmann::json{{"file", *out},
-                                {"clip_id", id},
+  MOTIONDB_RETURN_IF_ERROR(Call(
+      connection,
+      [&](grpc::ClientContext* context) { return stub->ExportClip(context, request, &response); },
+      {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"}}));
+  MOTIONDB_RETURN_IF_ERROR(WriteFileAtomically(flags.out, response.bvh()));
+  if (json) {
+    std::cout << nlohmann::json{{"file", flags.out},
+                                {"clip_id", flags.id},
                                 {"first_frame", response.first_frame()},
                                 {"last_frame", response.last_frame()},
                                 {"bytes", response.bvh().size()}}
                      .dump()
               << "\n";
   } else {
-    absl::PrintF("wrote %s: clip %d, frames %d-%d\n", *out, id, response.first_frame(),
+    absl::PrintF("wrote %s: clip %d, frames %d-%d\n", flags.out, flags.id, response.first_frame(),
                  response.last_frame());
   }
   return absl::OkStatus();
 }
 
+// A stored clip's id, the positional argument of `clip show`, `clip delete` and `export`.
+void AddClipId(CLI::App* command, int64_t* id) {
+  command->add_option("ID", *id, "the clip's id (see 'motiondb clips')")
+      ->required()
+      ->check(WholeAtLeast(1));
+}
+
 }  // namespace
 
-int RunClips(const std::vector<std::string>& args) {
-  return RunServerCommand("clips", "motiondb clips [--tag T] [--json] [--server ADDR]", args,
-                          {"tag"}, {"json"}, ListClips);
-}
+void AddClipCommands(Commands& commands) {
+  const GlobalOptions& global = commands.global();
+  auto tag = std::make_shared<std::string>();
+  commands
+      .AddServer(commands.root(), "clips", "list the stored clips",
+                 [tag, &global](const ServerConnection& connection) {
+                   return ListClips(*tag, global.json, connection);
+                 })
+      ->add_option("--tag", *tag, "only clips tagged T")
+      ->type_name("T");
 
-int RunClip(const std::vector<std::string>& args) {
-  return RunServerCommand("clip", "motiondb clip show|delete ID [--json] [--server ADDR]", args, {},
-                          {"json"}, ClipSubcommand);
-}
+  CLI::App* clip = commands.AddGroup(commands.root(), "clip", "one stored clip: show, delete");
+  auto id = std::make_shared<int64_t>(0);  // `show` and `delete` take the same ID; one runs
+  AddClipId(commands.AddServer(clip, "show", "a clip's frames, rate, skeleton and tags",
+                               [id, &global](const ServerConnection& connection) {
+                                 return ShowClip(*id, global.json, connection);
+                               }),
+            id.get());
+  AddClipId(commands.AddServer(clip, "delete", "delete a clip and its projections",
+                               [id, &global](const ServerConnection& connection) {
+                                 return DeleteClip(*id, global.json, connection);
+                               }),
+            id.get());
 
-int RunExport(const std::vector<std::string>& args) {
-  return RunServerCommand("export",
-                          "motiondb export ID [--from F --to T] -o OUT.bvh [--server ADDR]", args,
-                          {"from", "to", "out"}, {"json"}, Export);
+  auto flags = std::make_shared<ExportFlags>();
+  CLI::App* exporter = commands.AddServer(commands.root(), "export",
+                                          "download a clip, or a range of it, as a BVH file",
+                                          [flags, &global](const ServerConnection& connection) {
+                                            return Export(*flags, global.json, connection);
+                                          });
+  AddClipId(exporter, &flags->id);
+  AddFrameRangeFlags(exporter, "the clip", &flags->range);
+  exporter->add_option("-o,--out", flags->out, "the BVH file to write")
+      ->type_name("OUT.bvh")
+      ->required();
 }
 
 }  // namespace motiondb::cli

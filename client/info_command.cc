@@ -13,15 +13,14 @@
 namespace motiondb::cli {
 namespace {
 
-absl::Status Info(const CommandLine& line, const ServerConnection& connection) {
-  if (!line.positionals().empty()) return absl::InvalidArgumentError("unexpected arguments");
+absl::Status Info(bool json, const ServerConnection& connection) {
   const auto stub = v1::ServerService::NewStub(connection.channel());
   v1::ServerInfo info;
   MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
     return stub->GetServerInfo(context, v1::GetServerInfoRequest(), &info);
   }));
   const v1::DatabaseCounts& c = info.counts();
-  if (line.flag("json")) {
+  if (json) {
     nlohmann::json indices = nlohmann::json::array();
     for (const v1::SpaceIndexInfo& index : info.indices()) indices.push_back(index.space());
     std::cout << nlohmann::json{{"version", info.version()},
@@ -50,9 +49,11 @@ absl::Status Info(const CommandLine& line, const ServerConnection& connection) {
 
 }  // namespace
 
-int RunInfo(const std::vector<std::string>& args) {
-  return RunServerCommand("info", "motiondb info [--json] [--server ADDR] [--token T]", args, {},
-                          {"json"}, Info);
+void AddInfo(Commands& commands) {
+  const GlobalOptions& global = commands.global();
+  commands.AddServer(
+      commands.root(), "info", "the server's version, contents and indices (a health probe)",
+      [&global](const ServerConnection& connection) { return Info(global.json, connection); });
 }
 
 }  // namespace motiondb::cli

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -82,27 +83,17 @@ grpc::Status Upload(const ServerConnection& connection, v1::ClipService::Stub& s
   return writer->Finish();
 }
 
-}  // namespace
+struct IngestFlags {
+  std::vector<std::string> paths;
+  std::vector<std::string> tags;
+  bool recursive = false;
+};
 
-int RunIngest(const std::vector<std::string>& args) {
-  std::set<std::string> options = ConnectionOptions();
-  options.insert("tag");
-  const absl::StatusOr<CommandLine> line = CommandLine::Parse(args, options, {"recursive", "json"});
-  if (!line.ok() || line->positionals().empty()) {
-    std::cerr << "motiondb ingest: " << (line.ok() ? "no files given" : line.status().message())
-              << "\nusage: motiondb ingest PATH... [--tag T]... [--recursive] [--json] "
-                 "[--server ADDR] [--token T]\n";
-    return 2;
-  }
-  const absl::StatusOr<ServerConnection> connection = ServerConnection::Connect(*line);
-  if (!connection.ok()) {
-    std::cerr << "motiondb ingest: " << connection.status().message() << "\n";
-    return 2;
-  }
+absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection& connection) {
   const std::unique_ptr<v1::ClipService::Stub> stub =
-      v1::ClipService::NewStub(connection->channel());
-  const std::vector<fs::path> files = ExpandPaths(line->positionals(), line->flag("recursive"));
-  const bool progress_bar = ::isatty(STDERR_FILENO) && !line->flag("json");
+      v1::ClipService::NewStub(connection.channel());
+  const std::vector<fs::path> files = ExpandPaths(flags.paths, flags.recursive);
+  const bool progress_bar = ::isatty(STDERR_FILENO) && !json;
   nlohmann::json ingested = nlohmann::json::array(), failed = nlohmann::json::array();
   for (size_t i = 0; i < files.size(); ++i) {
     const fs::path& path = files[i];
@@ -112,9 +103,9 @@ int RunIngest(const std::vector<std::string>& args) {
         !bytes.ok()) {
       error = std::string(bytes.status().message());
     } else if (const grpc::Status status =
-                   Upload(*connection, *stub, path, *bytes, line->values("tag"), &response);
+                   Upload(connection, *stub, path, *bytes, flags.tags, &response);
                !status.ok()) {
-      error = DescribeError(status, connection->address());
+      error = DescribeError(status, connection.address());
     }
     if (progress_bar) std::cerr << "\r\033[K";
     if (!error.empty()) {
@@ -139,20 +130,37 @@ int RunIngest(const std::vector<std::string>& args) {
                                    std::string(width - done, ' '), i + 1, files.size(),
                                    path.filename().string())
                 << std::flush;
-    } else if (!line->flag("json") && error.empty()) {
+    } else if (!json && error.empty()) {
       std::cout << absl::StrFormat("[%zu/%zu] %s -> clip %d (%d frames)\n", i + 1, files.size(),
                                    path.string(), response.clip().clip_id(),
                                    response.clip().frame_count());
     }
   }
   if (progress_bar) std::cerr << "\n";
-  if (line->flag("json")) {
+  if (json) {
     std::cout << nlohmann::json{{"ingested", ingested}, {"failed", failed}}.dump() << "\n";
   } else {
     std::cout << absl::StrFormat("ingested %zu of %zu files", ingested.size(), files.size())
               << (failed.empty() ? "" : absl::StrFormat(", %zu failed", failed.size())) << "\n";
   }
-  return failed.empty() ? 0 : 1;
+  return failed.empty() ? absl::OkStatus() : ReportedFailure();
+}
+
+}  // namespace
+
+void AddIngest(Commands& commands) {
+  auto flags = std::make_shared<IngestFlags>();
+  const GlobalOptions& global = commands.global();
+  CLI::App* ingest = commands.AddServer(commands.root(), "ingest",
+                                        "upload BVH files, or the .bvh files of folders",
+                                        [flags, &global](const ServerConnection& connection) {
+                                          return Ingest(*flags, global.json, connection);
+                                        });
+  ingest->add_option("PATH", flags->paths, "BVH files or folders")->required();
+  ingest->add_option("--tag", flags->tags, "tag every clip with T; repeat for more")
+      ->type_name("T")
+      ->allow_extra_args(false);
+  ingest->add_flag("--recursive", flags->recursive, "the folders' subfolders too");
 }
 
 }  // namespace motiondb::cli

@@ -1,6 +1,7 @@
 // motiondb inspect FILE... [--json]
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -8,7 +9,6 @@
 #include "absl/strings/str_join.h"
 #include "client/commands.h"
 #include "core/bvh/bvh_reader.h"
-#include "util/command_line.h"
 
 namespace motiondb::cli {
 namespace {
@@ -46,29 +46,27 @@ void PrintText(const std::string& path, const BvhReadResult& result) {
 
 }  // namespace
 
-int RunInspect(const std::vector<std::string>& args) {
-  const absl::StatusOr<CommandLine> line = CommandLine::Parse(args, {}, {"json"});
-  if (!line.ok() || line->positionals().empty()) {
-    std::cerr << "motiondb inspect: "
-              << (line.ok() ? "no files given" : std::string(line.status().message()))
-              << "\nusage: motiondb inspect FILE... [--json]\n";
-    return 2;
-  }
-  int failures = 0;
-  for (const std::string& path : line->positionals()) {
-    const absl::StatusOr<BvhReadResult> result = ReadBvhFile(path);
-    if (!result.ok()) {
-      std::cerr << "motiondb inspect: " << result.status().message() << "\n";
-      ++failures;
-      continue;
-    }
-    if (line->flag("json")) {
-      std::cout << Describe(path, *result).dump() << "\n";
-    } else {
-      PrintText(path, *result);
-    }
-  }
-  return failures == 0 ? 0 : 1;
+void AddInspect(Commands& commands) {
+  auto files = std::make_shared<std::vector<std::string>>();
+  const GlobalOptions& global = commands.global();
+  CLI::App* inspect = commands.AddOffline(
+      commands.root(), "inspect", "describe BVH files: joints, channels, frames, fps, warnings",
+      /*json=*/true, [files, &global]() -> absl::Status {
+        int failures = 0;
+        for (const std::string& path : *files) {
+          const absl::StatusOr<BvhReadResult> result = ReadBvhFile(path);
+          if (!result.ok()) {
+            std::cerr << "motiondb inspect: " << result.status().message() << "\n";
+            ++failures;
+          } else if (global.json) {
+            std::cout << Describe(path, *result).dump() << "\n";
+          } else {
+            PrintText(path, *result);
+          }
+        }
+        return failures == 0 ? absl::OkStatus() : ReportedFailure();
+      });
+  inspect->add_option("FILE", *files, "BVH files")->required();
 }
 
 }  // namespace motiondb::cli

@@ -1,6 +1,7 @@
 // motiondb space create NAME [--train CLIP[:FROM-TO]]... [options] | list | show NAME |
 // delete NAME: Motion Curve spaces on the server (`space build` is the offline command).
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -10,27 +11,30 @@
 #include "absl/strings/str_split.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
+#include "client/space_flags.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {
 
-constexpr char kUsage[] =
-    "motiondb space create NAME [--train CLIP_ID[:FROM-TO]]... [--rate R]\n"
-    "        [--weights mass|uniform|FILE.json] [--keep-heading] [--yaw-rate-weight W]\n"
-    "        [--metric unit|eigen] [--skeleton ID]\n"
-    "    | motiondb space list | space show NAME | space delete NAME   [--json] [--server ADDR]";
+struct CreateFlags {
+  std::string name;
+  std::vector<std::string> train;  // CLIP_ID[:FROM-TO]
+  std::optional<int64_t> skeleton;
+  SpaceFlags space;
+};
 
-// "12" or "12:30-90" (frames at the clip's own rate, inclusive).
+// "12" or "12:30-90" (frames at the clip's own rate, inclusive); also --train's check.
 absl::StatusOr<v1::ClipRange> ParseTraining(const std::string& spec) {
   v1::ClipRange range;
   const std::vector<std::string> parts = absl::StrSplit(spec, ':');
   int64_t id = 0;
   if (parts.size() > 2 || !absl::SimpleAtoi(parts[0], &id)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("--train expects CLIP_ID or CLIP_ID:FROM-TO, got '", spec, "'"));
+        absl::StrCat("expected CLIP_ID or CLIP_ID:FROM-TO, got '", spec, "'"));
   }
   range.set_clip_id(id);
   if (parts.size() == 2) {
@@ -38,8 +42,7 @@ absl::StatusOr<v1::ClipRange> ParseTraining(const std::string& spec) {
     int first = 0, last = 0;
     if (bounds.size() != 2 || !absl::SimpleAtoi(bounds[0], &first) ||
         !absl::SimpleAtoi(bounds[1], &last)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--train expects CLIP_ID:FROM-TO, got '", spec, "'"));
+      return absl::InvalidArgumentError(absl::StrCat("expected CLIP_ID:FROM-TO, got '", spec, "'"));
     }
     range.set_first_frame(first);
     range.set_last_frame(last);
@@ -47,33 +50,45 @@ absl::StatusOr<v1::ClipRange> ParseTraining(const std::string& spec) {
   return range;
 }
 
-absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CommandLine& line) {
+absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
   v1::CreateSpaceRequest request;
-  request.set_name(line.positionals()[1]);
-  for (const std::string& spec : line.values("train")) {
+  request.set_name(flags.name);
+  for (const std::string& spec : flags.train) {
     MOTIONDB_ASSIGN_OR_RETURN(*request.add_training(), ParseTraining(spec));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> rate, line.number("rate"));
-  if (rate) request.set_sample_rate(*rate);
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> yaw, line.number("yaw-rate-weight"));
-  if (yaw) request.set_yaw_rate_weight(*yaw);
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> skeleton, line.integer("skeleton"));
-  if (skeleton) request.set_skeleton_id(*skeleton);
-  request.set_keep_heading(line.flag("keep-heading"));
-  const std::string weights = line.value("weights").value_or("mass");
-  if (weights == "mass") {
-    request.set_weight_preset(v1::WEIGHT_PRESET_MASS);
-  } else if (weights == "uniform") {
-    request.set_weight_preset(v1::WEIGHT_PRESET_UNIFORM);
+  const SpaceFlags& space = flags.space;
+  if (space.rate) request.set_sample_rate(*space.rate);
+  if (space.yaw_rate_weight) request.set_yaw_rate_weight(*space.yaw_rate_weight);
+  if (flags.skeleton) request.set_skeleton_id(*flags.skeleton);
+  request.set_keep_heading(space.keep_heading);
+  if (!IsWeightPreset(space.weights)) {
+    MOTIONDB_ASSIGN_OR_RETURN(*request.mutable_weights_json(),
+                              ReadFileBytes(space.weights, 1 << 20));
   } else {
-    MOTIONDB_ASSIGN_OR_RETURN(*request.mutable_weights_json(), ReadFileBytes(weights, 1 << 20));
+    request.set_weight_preset(space.weights == "mass" ? v1::WEIGHT_PRESET_MASS
+                                                      : v1::WEIGHT_PRESET_UNIFORM);
   }
-  const std::string metric = line.value("metric").value_or("unit");
-  if (metric != "unit" && metric != "eigen") {
-    return absl::InvalidArgumentError("--metric must be unit or eigen");
-  }
-  request.set_metric(metric == "unit" ? v1::SPACE_METRIC_UNIT : v1::SPACE_METRIC_EIGENVALUE_SCALED);
+  request.set_metric(space.metric == "unit" ? v1::SPACE_METRIC_UNIT
+                                            : v1::SPACE_METRIC_EIGENVALUE_SCALED);
   return request;
+}
+
+// The flags that set CreateSpaceRequest's fields, for the server's errors.
+FlagNames CreateFlagNames(const CreateFlags& flags) {
+  FlagNames names = {{"skeleton_id", "--skeleton"},
+                     {"sample_rate", "--rate"},
+                     {"yaw_rate_weight", "--yaw-rate-weight"},
+                     {"weights_json", "--weights"},
+                     {"weight_preset", "--weights"},
+                     {"metric", "--metric"}};
+  for (size_t i = 0; i < flags.train.size(); ++i) {
+    const std::string field = absl::StrCat("training[", i, "]");
+    const std::string flag = absl::StrCat("--train ", flags.train[i]);
+    names.insert(names.end(), {{field, flag},
+                               {field + ".first_frame", flag + ": frame"},
+                               {field + ".last_frame", flag + ": frame"}});
+  }
+  return names;
 }
 
 nlohmann::json SpaceJson(const v1::Space& space) {
@@ -116,73 +131,118 @@ void PrintSpace(const v1::Space& space) {
   absl::PrintF("(mean/max)\n");
 }
 
-absl::Status Space(const CommandLine& line, const ServerConnection& connection) {
-  const std::vector<std::string>& args = line.positionals();
-  const std::string sub = args.empty() ? "" : args[0];
-  const size_t wanted = sub == "list" ? 1 : 2;
-  if ((sub != "create" && sub != "list" && sub != "show" && sub != "delete") ||
-      args.size() != wanted) {
-    return absl::InvalidArgumentError(absl::StrCat("usage: ", kUsage));
-  }
-  const auto stub = v1::SpaceService::NewStub(connection.channel());
-  const bool json = line.flag("json");
-  if (sub == "list") {
-    v1::ListSpacesResponse response;
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->ListSpaces(context, v1::ListSpacesRequest(), &response);
-    }));
-    nlohmann::json spaces = nlohmann::json::array();
-    for (const v1::Space& space : response.spaces()) {
-      if (json) {
-        spaces.push_back(SpaceJson(space));
-      } else {
-        absl::PrintF("%-24s skeleton %d, %d dims at %g Hz, %d clips\n", space.name(),
-                     space.skeleton_id(), space.report().dims(), space.report().sample_rate(),
-                     space.report().projected_clips());
-      }
-    }
-    if (json) std::cout << nlohmann::json{{"spaces", spaces}}.dump() << "\n";
-    return absl::OkStatus();
-  }
-  if (sub == "delete") {
-    v1::DeleteSpaceRequest request;
-    request.set_name(args[1]);
-    v1::DeleteSpaceResponse response;
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->DeleteSpace(context, request, &response);
-    }));
-    std::cout << (json ? nlohmann::json{{"deleted", args[1]}}.dump()
-                       : absl::StrCat("deleted space ", args[1]))
-              << "\n";
-    return absl::OkStatus();
-  }
-  v1::Space space;
-  if (sub == "show") {
-    v1::GetSpaceRequest request;
-    request.set_name(args[1]);
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->GetSpace(context, request, &space);
-    }));
-  } else {
-    MOTIONDB_ASSIGN_OR_RETURN(const v1::CreateSpaceRequest request, CreateRequest(line));
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->CreateSpace(context, request, &space);
-    }));
-  }
+void PrintSpaceOrJson(const v1::Space& space, bool json) {
   if (json) {
     std::cout << SpaceJson(space).dump() << "\n";
   } else {
     PrintSpace(space);
   }
+}
+
+absl::Status Create(const CreateFlags& flags, bool json, const ServerConnection& connection) {
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::CreateSpaceRequest request, CreateRequest(flags));
+  const auto stub = v1::SpaceService::NewStub(connection.channel());
+  v1::Space space;
+  MOTIONDB_RETURN_IF_ERROR(Call(
+      connection,
+      [&](grpc::ClientContext* context) { return stub->CreateSpace(context, request, &space); },
+      CreateFlagNames(flags)));
+  PrintSpaceOrJson(space, json);
+  return absl::OkStatus();
+}
+
+absl::Status List(bool json, const ServerConnection& connection) {
+  const auto stub = v1::SpaceService::NewStub(connection.channel());
+  v1::ListSpacesResponse response;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->ListSpaces(context, v1::ListSpacesRequest(), &response);
+  }));
+  nlohmann::json spaces = nlohmann::json::array();
+  for (const v1::Space& space : response.spaces()) {
+    if (json) {
+      spaces.push_back(SpaceJson(space));
+    } else {
+      absl::PrintF("%-24s skeleton %d, %d dims at %g Hz, %d clips\n", space.name(),
+                   space.skeleton_id(), space.report().dims(), space.report().sample_rate(),
+                   space.report().projected_clips());
+    }
+  }
+  if (json) std::cout << nlohmann::json{{"spaces", spaces}}.dump() << "\n";
+  return absl::OkStatus();
+}
+
+absl::Status Show(const std::string& name, bool json, const ServerConnection& connection) {
+  const auto stub = v1::SpaceService::NewStub(connection.channel());
+  v1::GetSpaceRequest request;
+  request.set_name(name);
+  v1::Space space;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->GetSpace(context, request, &space);
+  }));
+  PrintSpaceOrJson(space, json);
+  return absl::OkStatus();
+}
+
+absl::Status Delete(const std::string& name, bool json, const ServerConnection& connection) {
+  const auto stub = v1::SpaceService::NewStub(connection.channel());
+  v1::DeleteSpaceRequest request;
+  request.set_name(name);
+  v1::DeleteSpaceResponse response;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->DeleteSpace(context, request, &response);
+  }));
+  std::cout << (json ? nlohmann::json{{"deleted", name}}.dump()
+                     : absl::StrCat("deleted space ", name))
+            << "\n";
   return absl::OkStatus();
 }
 
 }  // namespace
 
-int RunRemoteSpace(const std::vector<std::string>& args) {
-  return RunServerCommand("space", kUsage, args,
-                          {"train", "rate", "weights", "yaw-rate-weight", "metric", "skeleton"},
-                          {"keep-heading", "json"}, Space);
+void AddRemoteSpace(Commands& commands, CLI::App* space) {
+  const GlobalOptions& global = commands.global();
+  auto create = std::make_shared<CreateFlags>();
+  CLI::App* create_command =
+      commands.AddServer(space, "create", "build a space from stored clips; index every clip in it",
+                         [create, &global](const ServerConnection& connection) {
+                           return Create(*create, global.json, connection);
+                         });
+  create_command->add_option("NAME", create->name, "the new space (letters, digits, '.', '_', '-')")
+      ->required();
+  create_command
+      ->add_option("--train", create->train,
+                   "a clip to learn from (default: all), or frames FROM..TO of it")
+      ->type_name("CLIP_ID[:FROM-TO]")
+      ->allow_extra_args(false)
+      ->check(CLI::Validator(
+          [](const std::string& spec) {
+            return std::string(ParseTraining(spec).status().message());
+          },
+          ""));
+  create_command->add_option("--skeleton", create->skeleton, "the skeleton (default: --train's)")
+      ->type_name("ID")
+      ->check(WholeAtLeast(1));
+  AddSpaceFlags(create_command, &create->space);
+
+  commands.AddServer(
+      space, "list", "list the server's spaces",
+      [&global](const ServerConnection& connection) { return List(global.json, connection); });
+  // `show` and `delete` take the same NAME; one of them runs.
+  auto name = std::make_shared<std::string>();
+  commands
+      .AddServer(space, "show", "a space's build report",
+                 [name, &global](const ServerConnection& connection) {
+                   return Show(*name, global.json, connection);
+                 })
+      ->add_option("NAME", *name, "the space")
+      ->required();
+  commands
+      .AddServer(space, "delete", "delete a space and its projections",
+                 [name, &global](const ServerConnection& connection) {
+                   return Delete(*name, global.json, connection);
+                 })
+      ->add_option("NAME", *name, "the space")
+      ->required();
 }
 
 }  // namespace motiondb::cli

@@ -1,87 +1,99 @@
 // motiondb search --space NAME (--clip ID [--from F --to T] | --bvh FILE) [parameters] [--json]
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
+#include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
 namespace motiondb::cli {
 namespace {
 
-constexpr char kUsage[] =
-    "motiondb search --space NAME (--clip ID [--from F --to T] | --bvh FILE [--from F --to T])\n"
-    "    [--neighbours K] [--ann-dims N] [--dtw-dims N] [--epsilon E] [--slope S]\n"
-    "    [--char-frame F] [--neutral mean|boundary|origin] [--max N] [--exact] [--no-refine]\n"
-    "    [--path] [--in-clip ID]... [--tag T]... [--json] [--server ADDR] [--token T]";
-
 // Larger than any query a studio will send; the server has its own limit.
 constexpr int64_t kMaxQueryBytes = int64_t{1} << 30;
 
-absl::StatusOr<v1::SearchRequest> BuildRequest(const CommandLine& line) {
+struct SearchFlags {
+  std::string space;
+  std::optional<int64_t> clip;
+  std::string bvh;
+  FrameRangeFlags range;
+  std::optional<int> neighbours, ann_dims, dtw_dims, slope, max, char_frame;
+  std::optional<double> epsilon;
+  std::string neutral = "mean";
+  bool exact = false, path = false, no_refine = false;
+  std::vector<int64_t> in_clips;
+  std::vector<std::string> tags;
+};
+
+// The whole-number search parameters: their flags, the request fields they set (whose names the
+// server's errors use) and the defaults the server fills in when they are unset (thesis Table
+// 6.2, as proto/motiondb/v1/search_service.proto documents them).
+struct Parameter {
+  const char* flag;
+  const char* field;
+  const char* value_name;
+  const char* default_value;
+  const char* description;
+  std::optional<int> SearchFlags::*value;
+  void (v1::SearchRequest::*set)(int32_t);
+};
+constexpr Parameter kParameters[] = {
+    {"--neighbours", "neighbours", "K", "1000", "seeds: library frames nearest the char. pose",
+     &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours},
+    {"--ann-dims", "ann_dims", "N", "10", "dimensions of the seed search", &SearchFlags::ann_dims,
+     &v1::SearchRequest::set_ann_dims},
+    {"--dtw-dims", "dtw_dims", "N", "5", "dimensions of the time warp's pose distance",
+     &SearchFlags::dtw_dims, &v1::SearchRequest::set_dtw_dims},
+    {"--slope", "slope_limit", "S", "2", "the warp runs at most S times faster or slower",
+     &SearchFlags::slope, &v1::SearchRequest::set_slope_limit},
+    {"--max", "max_results", "N", "20", "results returned", &SearchFlags::max,
+     &v1::SearchRequest::set_max_results},
+};
+
+// The flags that set SearchRequest's fields, for the server's errors.
+FlagNames SearchFlagNames(const SearchFlags& flags) {
+  FlagNames names = {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"},
+                     {"bvh.first_frame", "--from"},  {"bvh.last_frame", "--to"},
+                     {"bvh", "--bvh " + flags.bvh},  {"characteristic_frame", "--char-frame"},
+                     {"epsilon", "--epsilon"},       {"neutral", "--neutral"}};
+  for (const Parameter& parameter : kParameters) names.push_back({parameter.field, parameter.flag});
+  return names;
+}
+
+absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   v1::SearchRequest request;
-  const std::optional<std::string> space = line.value("space");
-  if (!space) return absl::InvalidArgumentError("--space NAME is required");
-  request.set_space(*space);
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> from, line.integer("from"));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> to, line.integer("to"));
-  const std::optional<std::string> clip = line.value("clip"), bvh = line.value("bvh");
-  if (clip.has_value() == bvh.has_value()) {
-    return absl::InvalidArgumentError("give exactly one of --clip ID and --bvh FILE");
-  }
-  if (clip) {
-    MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> id, line.integer("clip"));
-    request.mutable_clip()->set_clip_id(*id);
-    if (from) request.mutable_clip()->set_first_frame(*from);
-    if (to) request.mutable_clip()->set_last_frame(*to);
+  request.set_space(flags.space);
+  const FrameRangeFlags& range = flags.range;
+  if (flags.clip) {
+    request.mutable_clip()->set_clip_id(*flags.clip);
+    if (range.from) request.mutable_clip()->set_first_frame(*range.from);
+    if (range.to) request.mutable_clip()->set_last_frame(*range.to);
   } else {
     MOTIONDB_ASSIGN_OR_RETURN(*request.mutable_bvh()->mutable_bvh(),
-                              ReadFileBytes(*bvh, kMaxQueryBytes));
-    if (from) request.mutable_bvh()->set_first_frame(*from);
-    if (to) request.mutable_bvh()->set_last_frame(*to);
+                              ReadFileBytes(flags.bvh, kMaxQueryBytes));
+    if (range.from) request.mutable_bvh()->set_first_frame(*range.from);
+    if (range.to) request.mutable_bvh()->set_last_frame(*range.to);
   }
-  for (auto [name, set] :
-       std::initializer_list<std::pair<const char*, void (v1::SearchRequest::*)(int32_t)>>{
-           {"neighbours", &v1::SearchRequest::set_neighbours},
-           {"ann-dims", &v1::SearchRequest::set_ann_dims},
-           {"dtw-dims", &v1::SearchRequest::set_dtw_dims},
-           {"slope", &v1::SearchRequest::set_slope_limit},
-           {"char-frame", &v1::SearchRequest::set_characteristic_frame},
-           {"max", &v1::SearchRequest::set_max_results}}) {
-    MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int> value, line.integer(name));
-    if (value) (request.*set)(*value);
+  for (const Parameter& parameter : kParameters) {
+    if (const std::optional<int>& value = flags.*parameter.value) (request.*parameter.set)(*value);
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> epsilon, line.number("epsilon"));
-  if (epsilon) request.set_epsilon(static_cast<float>(*epsilon));
-  if (const std::optional<std::string> neutral = line.value("neutral")) {
-    if (*neutral == "mean") {
-      request.set_neutral(v1::NEUTRAL_POSE_QUERY_MEAN);
-    } else if (*neutral == "boundary") {
-      request.set_neutral(v1::NEUTRAL_POSE_BOUNDARY_MEAN);
-    } else if (*neutral == "origin") {
-      request.set_neutral(v1::NEUTRAL_POSE_ORIGIN);
-    } else {
-      return absl::InvalidArgumentError("--neutral must be mean, boundary or origin");
-    }
-  }
-  for (const std::string& tag : line.values("tag")) request.add_tags(tag);
-  for (const std::string& id : line.values("in-clip")) {
-    int64_t value = 0;
-    if (!absl::SimpleAtoi(id, &value)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--in-clip expects a clip id, got '", id, "'"));
-    }
-    request.add_clip_ids(value);
-  }
-  request.set_exact(line.flag("exact"));
-  request.set_return_path(line.flag("path"));
-  if (line.flag("no-refine")) request.set_refine(false);
+  if (flags.char_frame) request.set_characteristic_frame(*flags.char_frame);
+  if (flags.epsilon) request.set_epsilon(static_cast<float>(*flags.epsilon));
+  request.set_neutral(flags.neutral == "boundary" ? v1::NEUTRAL_POSE_BOUNDARY_MEAN
+                      : flags.neutral == "origin" ? v1::NEUTRAL_POSE_ORIGIN
+                                                  : v1::NEUTRAL_POSE_QUERY_MEAN);
+  for (const std::string& tag : flags.tags) request.add_tags(tag);
+  for (const int64_t id : flags.in_clips) request.add_clip_ids(id);
+  request.set_exact(flags.exact);
+  request.set_return_path(flags.path);
+  if (flags.no_refine) request.set_refine(false);
   return request;
 }
 
@@ -117,24 +129,24 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
             {"library_frames", c.library_frames()}}}};
 }
 
-absl::Status Search(const CommandLine& line, const ServerConnection& connection) {
-  if (!line.positionals().empty()) return absl::InvalidArgumentError("unexpected arguments");
-  MOTIONDB_ASSIGN_OR_RETURN(const v1::SearchRequest request, BuildRequest(line));
+absl::Status Search(const SearchFlags& flags, bool json, const ServerConnection& connection) {
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::SearchRequest request, BuildRequest(flags));
   const auto stub = v1::SearchService::NewStub(connection.channel());
   v1::SearchResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->Search(context, request, &response);
-  }));
-  if (line.flag("json")) {
+  MOTIONDB_RETURN_IF_ERROR(Call(
+      connection,
+      [&](grpc::ClientContext* context) { return stub->Search(context, request, &response); },
+      SearchFlagNames(flags)));
+  if (json) {
     std::cout << ResponseJson(response).dump() << "\n";
     return absl::OkStatus();
   }
-  absl::PrintF("%4s  %-40s %9s %9s %13s %10s\n", "RANK", "CLIP", "START (s)", "END (s)", "FRAMES",
-               "SCORE");
+  absl::PrintF("%4s %8s  %-40s %9s %9s %13s %10s\n", "RANK", "CLIP", "NAME", "START (s)", "END (s)",
+               "FRAMES", "SCORE");
   int rank = 0;
   for (const v1::SearchResult& r : response.results()) {
-    absl::PrintF("%4d  %-40s %9.3f %9.3f %6d-%-6d %10.5f\n", ++rank, r.clip_name(), r.start_s(),
-                 r.end_s(), r.start_frame(), r.end_frame(), r.score());
+    absl::PrintF("%4d %8d  %-40s %9.3f %9.3f %6d-%-6d %10.5f\n", ++rank, r.clip_id(), r.clip_name(),
+                 r.start_s(), r.end_s(), r.start_frame(), r.end_frame(), r.score());
   }
   const v1::SearchTimings& t = response.timings();
   absl::PrintF(
@@ -148,12 +160,64 @@ absl::Status Search(const CommandLine& line, const ServerConnection& connection)
 
 }  // namespace
 
-int RunSearch(const std::vector<std::string>& args) {
-  return RunServerCommand(
-      "search", kUsage, args,
-      {"space", "clip", "bvh", "from", "to", "neighbours", "ann-dims", "dtw-dims", "epsilon",
-       "slope", "char-frame", "neutral", "max", "tag", "in-clip"},
-      {"exact", "path", "no-refine", "json"}, Search);
+void AddSearch(Commands& commands) {
+  auto flags = std::make_shared<SearchFlags>();
+  const GlobalOptions& global = commands.global();
+  CLI::App* search = commands.AddServer(
+      commands.root(), "search", "query by example: ranges of clips that move like the query",
+      [flags, &global](const ServerConnection& connection) {
+        return Search(*flags, global.json, connection);
+      });
+  search->add_option("--space", flags->space, "the space to search in")
+      ->type_name("NAME")
+      ->required();
+  const CLI::Option* clip = search->add_option("--clip", flags->clip, "the query: a stored clip")
+                                ->type_name("ID")
+                                ->check(WholeAtLeast(1));
+  const CLI::Option* bvh = search->add_option("--bvh", flags->bvh, "... or a BVH file")
+                               ->type_name("FILE")
+                               ->check(ExistingFile());
+  search->final_callback([clip, bvh] {
+    if (clip->count() + bvh->count() != 1) {
+      throw CLI::ValidationError("give exactly one of --clip ID and --bvh FILE");
+    }
+  });
+  AddFrameRangeFlags(search, "the query", &flags->range);
+  for (const Parameter& parameter : kParameters) {
+    search->add_option(parameter.flag, flags.get()->*parameter.value, parameter.description)
+        ->type_name(parameter.value_name)
+        ->default_str(parameter.default_value)
+        ->check(WholeAtLeast(1));
+  }
+  search->add_option("--epsilon", flags->epsilon, "approximation bound of the seed search")
+      ->type_name("E")
+      ->default_str("0")
+      ->check(NumberAtLeast(0));
+  search->add_option("--char-frame", flags->char_frame, "the query frame every warp goes through")
+      ->type_name("F")
+      ->default_str("auto")
+      ->check(WholeAtLeast(-1));  // -1: automatic, as the server reads it
+  OneOf(search->add_option("--neutral", flags->neutral,
+                           "auto --char-frame: the pose farthest from this"),
+        {"mean", "boundary", "origin"})
+      ->capture_default_str();
+  search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
+  search->add_flag("--no-refine", flags->no_refine,
+                   "the thesis's search as is (faster, lower recall)");
+  search->add_flag("--path", flags->path, "each result's warp path (with --json)");
+  search->add_option("--in-clip", flags->in_clips, "only in this clip; repeat for more")
+      ->type_name("ID")
+      ->allow_extra_args(false)
+      ->check(WholeAtLeast(1));
+  search->add_option("--tag", flags->tags, "only in clips tagged T; repeat for more")
+      ->type_name("T")
+      ->allow_extra_args(false);
+  search->footer(
+      "Unset parameters take the server's defaults, the thesis's (Table 6.2), shown here.\n"
+      "--ann-dims and --dtw-dims are at most the space's dimensions. --neutral: the query's\n"
+      "mean pose, the mean of its first and last poses, or the space's origin. --no-refine\n"
+      "skips re-warping each candidate free of its seed. --exact ignores the seed parameters.\n"
+      "Frames count from 0 at the query's own rate; ranges are inclusive.");
 }
 
 }  // namespace motiondb::cli

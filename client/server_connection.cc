@@ -1,42 +1,74 @@
 #include "client/server_connection.h"
 
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
-#include <iostream>
+#include <regex>
 
+#include "absl/strings/ascii.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/strip.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
+#include "util/token_file.h"
 
 namespace motiondb::cli {
 namespace {
 
 // A CA bundle is small; anything larger is a wrong path.
-constexpr int64_t kMaxCaBytes = int64_t{1} << 20;
+constexpr int64_t kMaxSecretFileBytes = int64_t{1} << 20;
+
+absl::StatusOr<std::string> ResolveToken(const ConnectionOptions& options) {
+  if (!options.token.empty()) return options.token;
+  if (!options.token_file.empty()) return ReadTokenFile(options.token_file);
+  if (const char* token = std::getenv("MOTIONDB_TOKEN"); token != nullptr && *token != '\0') {
+    return std::string(token);
+  }
+  if (const char* file = std::getenv("MOTIONDB_TOKEN_FILE"); file != nullptr && *file != '\0') {
+    return Prefixed("$MOTIONDB_TOKEN_FILE", ReadTokenFile(file));
+  }
+  return std::string();
+}
+
+// Field names are words of these characters: "training[0].last_frame".
+bool IsFieldCharacter(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '[' ||
+         c == ']';
+}
+
+const std::string* FlagOf(const std::string& field, const FlagNames& flags) {
+  for (const auto& [name, flag] : flags) {
+    if (name == field) return &flag;
+  }
+  return nullptr;
+}
+
+// "F is outside frames A..B" (the server's wording of a range check) with F past B.
+std::string SayPastTheEnd(const std::string& message) {
+  static const std::regex outside(R"((-?\d+) is outside (the clip's )?frames (-?\d+)\.\.(-?\d+))");
+  std::smatch match;
+  int64_t frame = 0, last = 0;
+  if (!std::regex_search(message, match, outside) || !absl::SimpleAtoi(match.str(1), &frame) ||
+      !absl::SimpleAtoi(match.str(4), &last) || frame <= last) {
+    return message;
+  }
+  return absl::StrCat(match.prefix().str(), frame, " is past the clip's last frame ", last,
+                      match.suffix().str());
+}
 
 }  // namespace
 
-const std::set<std::string>& ConnectionOptions() {
-  static const std::set<std::string> options = {"server", "token", "tls-ca", "timeout"};
-  return options;
-}
-
-absl::StatusOr<ServerConnection> ServerConnection::Connect(const CommandLine& line) {
+absl::StatusOr<ServerConnection> ServerConnection::Connect(const ConnectionOptions& options) {
   ServerConnection connection;
-  connection.address_ = line.value("server").value_or("127.0.0.1:50051");
-  if (const std::optional<std::string> token = line.value("token")) {
-    connection.token_ = *token;
-  } else if (const char* env = std::getenv("MOTIONDB_TOKEN"); env != nullptr) {
-    connection.token_ = env;
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> timeout, line.number("timeout"));
-  if (timeout && *timeout <= 0) return absl::InvalidArgumentError("--timeout must be positive");
-  connection.timeout_s_ = timeout.value_or(connection.timeout_s_);
+  connection.address_ = options.server;
+  MOTIONDB_ASSIGN_OR_RETURN(connection.token_, ResolveToken(options));
+  connection.timeout_s_ = options.timeout_s;
   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
-  if (const std::optional<std::string> ca = line.value("tls-ca")) {
+  if (!options.tls_ca.empty()) {
     grpc::SslCredentialsOptions ssl;
-    MOTIONDB_ASSIGN_OR_RETURN(ssl.pem_root_certs, ReadFileBytes(*ca, kMaxCaBytes));
+    MOTIONDB_ASSIGN_OR_RETURN(ssl.pem_root_certs,
+                              ReadFileBytes(options.tls_ca, kMaxSecretFileBytes));
     credentials = grpc::SslCredentials(ssl);
   }
   grpc::ChannelArguments arguments;
@@ -66,34 +98,40 @@ std::string DescribeError(const grpc::Status& status, const std::string& address
   return absl::StrCat(name, ": ", status.error_message());
 }
 
+std::string SpeakFlags(const std::string& message, const FlagNames& flags) {
+  std::string spoken;
+  for (size_t at = 0; at < message.size();) {
+    size_t end = at;
+    while (end < message.size() && IsFieldCharacter(message[end])) ++end;
+    if (end == at) {
+      spoken += message[at++];
+      continue;
+    }
+    size_t word_end = end;  // a sentence's full stop is not part of the field
+    while (word_end > at && message[word_end - 1] == '.') --word_end;
+    const std::string word = message.substr(at, word_end - at);
+    const std::string* flag = word.empty() ? nullptr : FlagOf(word, flags);
+    if (flag == nullptr) {
+      spoken.append(message, at, end - at);
+      at = end;
+      continue;
+    }
+    spoken += *flag;
+    at = word_end;
+    if (message.compare(at, 3, " = ") == 0) at += 2;  // "--max 0", not "--max = 0"
+  }
+  return SayPastTheEnd(spoken);
+}
+
 absl::Status Call(const ServerConnection& connection,
-                  const std::function<grpc::Status(grpc::ClientContext*)>& rpc) {
+                  const std::function<grpc::Status(grpc::ClientContext*)>& rpc,
+                  const FlagNames& flags) {
   const std::unique_ptr<grpc::ClientContext> context = connection.NewContext();
   const grpc::Status status = rpc(context.get());
   if (status.ok()) return absl::OkStatus();
+  const grpc::Status spoken(status.error_code(), SpeakFlags(status.error_message(), flags));
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
-                      DescribeError(status, connection.address()));
-}
-
-int RunServerCommand(
-    const std::string& name, const std::string& usage, const std::vector<std::string>& args,
-    std::set<std::string> value_options, const std::set<std::string>& flags,
-    const std::function<absl::Status(const CommandLine&, const ServerConnection&)>& body) {
-  value_options.insert(ConnectionOptions().begin(), ConnectionOptions().end());
-  const absl::StatusOr<CommandLine> line = CommandLine::Parse(args, value_options, flags);
-  absl::StatusOr<ServerConnection> connection =
-      line.ok() ? ServerConnection::Connect(*line) : line.status();
-  if (!connection.ok()) {
-    std::cerr << "motiondb " << name << ": " << connection.status().message() << "\n"
-              << "usage: " << usage << "\n";
-    return 2;
-  }
-  const absl::Status status = body(*line, *connection);
-  if (!status.ok()) {
-    std::cerr << "motiondb " << name << ": " << status.message() << "\n";
-    return 1;
-  }
-  return 0;
+                      DescribeError(spoken, connection.address()));
 }
 
 }  // namespace motiondb::cli

@@ -1,27 +1,36 @@
-// How the CLI reaches a motiondb server: --server ADDR (default 127.0.0.1:50051), --token T or
-// the MOTIONDB_TOKEN environment variable (sent as "authorization: Bearer T"), --tls-ca FILE
-// (TLS, verifying the server against that CA certificate), --timeout SECONDS per call.
+// How the CLI reaches a motiondb server: --server ADDR (default 127.0.0.1:50051), a bearer token
+// (sent as "authorization: Bearer T"), --tls-ca FILE (TLS, verifying the server against that CA
+// certificate), --timeout SECONDS per call; and how the server's errors are told in the CLI's
+// words.
 #ifndef MOTIONDB_CLIENT_SERVER_CONNECTION_H_
 #define MOTIONDB_CLIENT_SERVER_CONNECTION_H_
 
 #include <functional>
 #include <memory>
-#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <grpcpp/grpcpp.h>
 
 #include "absl/status/statusor.h"
-#include "util/command_line.h"
 
 namespace motiondb::cli {
 
-// The value options every server command accepts.
-const std::set<std::string>& ConnectionOptions();
+// What the connection flags say (client/commands.cc registers them).
+struct ConnectionOptions {
+  std::string server = "127.0.0.1:50051";
+  // The token is --token; else the contents of --token-file; else $MOTIONDB_TOKEN; else the
+  // contents of the file $MOTIONDB_TOKEN_FILE names (a file's surrounding whitespace ignored).
+  std::string token;
+  std::string token_file;
+  std::string tls_ca;  // empty: no TLS
+  double timeout_s = 600;
+};
 
 class ServerConnection {
  public:
-  static absl::StatusOr<ServerConnection> Connect(const CommandLine& line);
+  static absl::StatusOr<ServerConnection> Connect(const ConnectionOptions& options);
 
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
   const std::string& address() const { return address_; }
@@ -39,19 +48,19 @@ class ServerConnection {
 // it cannot be reached.
 std::string DescribeError(const grpc::Status& status, const std::string& address);
 
-// Runs one RPC with a fresh context; a failure becomes an absl::Status carrying the gRPC code
-// and DescribeError's text.
-absl::Status Call(const ServerConnection& connection,
-                  const std::function<grpc::Status(grpc::ClientContext*)>& rpc);
+// The command-line words that set a request's fields, for the server's errors, which name the
+// fields: {"clip.last_frame", "--to"}, {"training[0]", "--train 12:0-400"}.
+using FlagNames = std::vector<std::pair<std::string, std::string>>;
+// `message` with each field of `flags` (a whole word) replaced by its words, "FIELD = V" said
+// as "FLAG V", and a frame "F is outside frames A..B" past the end said as "F is past the
+// clip's last frame B".
+std::string SpeakFlags(const std::string& message, const FlagNames& flags);
 
-// The shape every server command shares: parse `args` (with the connection options added to
-// `value_options`), connect, run `body`; errors print as "motiondb NAME: message" (plus the
-// usage when the command line cannot be parsed). Returns the process exit code: 0, 1 for a
-// failed command, 2 for a bad command line.
-int RunServerCommand(
-    const std::string& name, const std::string& usage, const std::vector<std::string>& args,
-    std::set<std::string> value_options, const std::set<std::string>& flags,
-    const std::function<absl::Status(const CommandLine&, const ServerConnection&)>& body);
+// Runs one RPC with a fresh context; a failure becomes an absl::Status carrying the gRPC code
+// and DescribeError's text, told in `flags`' words.
+absl::Status Call(const ServerConnection& connection,
+                  const std::function<grpc::Status(grpc::ClientContext*)>& rpc,
+                  const FlagNames& flags = {});
 
 }  // namespace motiondb::cli
 

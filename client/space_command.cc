@@ -1,20 +1,20 @@
 // motiondb space build --train FILE[:FROM-TO]... --out SPACE.mcs [--rate 30]
 //     [--weights mass|uniform|FILE.json] [--yaw-rate-weight W] [--metric unit|eigen]
-//     [--keep-heading] [--json]
+//     [--keep-heading] [--json]: a space file built offline.
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
-#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.h"
+#include "client/space_flags.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/space/heading.h"
 #include "core/space/motion_space.h"
 #include "core/space/space_serialization.h"
-#include "util/command_line.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -22,14 +22,11 @@
 namespace motiondb::cli {
 namespace {
 
-constexpr char kUsage[] =
-    "usage: motiondb space build --train FILE[:FROM-TO]... --out SPACE.mcs [--rate 30]\n"
-    "           [--weights mass|uniform|FILE.json] [--yaw-rate-weight 0.5]\n"
-    "           [--metric unit|eigen] [--keep-heading] [--json]\n"
-    "  --train   BVH files to learn the space from, each optionally cut to frames FROM..TO\n"
-    "            (inclusive, counted from 0 at the file's rate); repeat or list several\n"
-    "  --weights a preset, or a JSON object {\"Joint\": weight} overriding the mass preset\n"
-    "  --keep-heading  keep the body's facing in the pose (no yaw-rate dimension)\n";
+struct BuildFlags {
+  std::vector<std::string> train;
+  std::string out;
+  SpaceFlags space;
+};
 
 // Joint-weights files larger than this are refused: a few hundred joints fit in kilobytes.
 constexpr int64_t kMaxWeightsFileBytes = int64_t{1} << 20;
@@ -62,7 +59,7 @@ absl::StatusOr<TrainingClip> LoadTrainingRange(const std::string& spec) {
 }
 
 absl::Status ApplyWeights(const std::string& weights, SpaceOptions* options) {
-  if (!absl::EndsWith(weights, ".json")) {
+  if (IsWeightPreset(weights)) {
     MOTIONDB_ASSIGN_OR_RETURN(options->weights.preset, ParseWeightPreset(weights));
     return absl::OkStatus();
   }
@@ -72,23 +69,13 @@ absl::Status ApplyWeights(const std::string& weights, SpaceOptions* options) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<SpaceOptions> ParseOptions(const CommandLine& line) {
+absl::StatusOr<SpaceOptions> ParseOptions(const SpaceFlags& flags) {
   SpaceOptions options;
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> rate, line.number("rate"));
-  options.sample_rate = rate.value_or(options.sample_rate);
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<double> yaw, line.number("yaw-rate-weight"));
-  options.yaw_rate_weight = yaw.value_or(options.yaw_rate_weight);
-  options.pose.remove_heading = !line.flag("keep-heading");
-  if (const std::optional<std::string> weights = line.value("weights")) {
-    MOTIONDB_RETURN_IF_ERROR(ApplyWeights(*weights, &options));
-  }
-  // The same names as the server's `space create`.
-  const std::string metric = line.value("metric").value_or("unit");
-  if (metric != "unit" && metric != "eigen") {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--metric expects unit or eigen, got '", metric, "'"));
-  }
-  if (metric == "eigen") options.metric = SpaceMetric::kEigenvalueScaled;
+  options.sample_rate = flags.rate.value_or(options.sample_rate);
+  options.yaw_rate_weight = flags.yaw_rate_weight.value_or(options.yaw_rate_weight);
+  options.pose.remove_heading = !flags.keep_heading;
+  MOTIONDB_RETURN_IF_ERROR(ApplyWeights(flags.weights, &options));
+  if (flags.metric == "eigen") options.metric = SpaceMetric::kEigenvalueScaled;
   return options;
 }
 
@@ -148,55 +135,46 @@ void PrintText(const std::string& out, const MotionSpace& space,
   }
 }
 
-absl::Status Build(const CommandLine& line) {
-  // "--train A B --train C": the option repeats, and the files after its first value are
-  // positionals.
-  std::vector<std::string> specs = line.values("train");
-  specs.insert(specs.end(), line.positionals().begin() + 1, line.positionals().end());
-  if (specs.empty()) return absl::InvalidArgumentError("no --train files given");
-  const std::optional<std::string> out = line.value("out");
-  if (!out) return absl::InvalidArgumentError("no --out file given");
-  MOTIONDB_ASSIGN_OR_RETURN(const SpaceOptions options, ParseOptions(line));
+absl::Status Build(const BuildFlags& flags, bool json) {
+  MOTIONDB_ASSIGN_OR_RETURN(const SpaceOptions options, ParseOptions(flags.space));
   std::vector<TrainingClip> training;
-  for (const std::string& spec : specs) {
+  for (const std::string& spec : flags.train) {
     MOTIONDB_ASSIGN_OR_RETURN(TrainingClip range, LoadTrainingRange(spec));
     training.push_back(std::move(range));
   }
-  if (const std::optional<std::string> weights = line.value("weights");
-      weights && !options.weights.overrides.empty()) {
+  if (!options.weights.overrides.empty()) {
     // Name the weights file when one of its joints is not in the training skeleton.
-    MOTIONDB_RETURN_IF_ERROR(Prefixed(
-        *weights, ComputeJointWeights(training.front().clip.skeleton(), options.weights).status()));
+    MOTIONDB_RETURN_IF_ERROR(
+        Prefixed(flags.space.weights,
+                 ComputeJointWeights(training.front().clip.skeleton(), options.weights).status()));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const MotionSpace space, MotionSpace::Build(training, options));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
                             space.RepresentationalError(training));
-  MOTIONDB_RETURN_IF_ERROR(WriteSpaceFile(*out, space));
-  if (line.flag("json")) {
-    std::cout << Report(*out, space, errors).dump() << "\n";
+  MOTIONDB_RETURN_IF_ERROR(WriteSpaceFile(flags.out, space));
+  if (json) {
+    std::cout << Report(flags.out, space, errors).dump() << "\n";
   } else {
-    PrintText(*out, space, errors);
+    PrintText(flags.out, space, errors);
   }
   return absl::OkStatus();
 }
 
 }  // namespace
 
-int RunSpace(const std::vector<std::string>& args) {
-  if (args.empty() || args[0] != "build") return RunRemoteSpace(args);
-  const absl::StatusOr<CommandLine> line =
-      CommandLine::Parse(args, {"train", "out", "rate", "weights", "yaw-rate-weight", "metric"},
-                         {"keep-heading", "json"});
-  if (!line.ok()) {
-    std::cerr << "motiondb space build: " << line.status().message() << "\n" << kUsage;
-    return 2;
-  }
-  const absl::Status status = Build(*line);
-  if (!status.ok()) {
-    std::cerr << "motiondb space build: " << status.message() << "\n";
-    return 1;
-  }
-  return 0;
+void AddSpaceBuild(Commands& commands, CLI::App* space) {
+  auto flags = std::make_shared<BuildFlags>();
+  const GlobalOptions& global = commands.global();
+  CLI::App* build =
+      commands.AddOffline(space, "build", "build a Motion Curve space file from BVH files",
+                          /*json=*/true, [flags, &global] { return Build(*flags, global.json); });
+  build->add_option("--train", flags->train, "BVH files to learn from, or frames FROM..TO of them")
+      ->type_name("FILE[:FROM-TO]...")
+      ->required();
+  build->add_option("--out", flags->out, "the space file to write")
+      ->type_name("SPACE.mcs")
+      ->required();
+  AddSpaceFlags(build, &flags->space);
 }
 
 }  // namespace motiondb::cli

@@ -1,4 +1,7 @@
-// The motiondb CLI's offline commands, run as a user would run them.
+// The motiondb CLI, run as a user would run it: the offline commands, the command-line
+// conventions (help, version, usage errors), and the server commands against a real server.
+#include <stdlib.h>
+
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -9,13 +12,16 @@
 
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
+#include "testing/server_process.h"
 #include "tests/clip_builder.h"
+#include "tests/synthetic_motion.h"
 #include "tests/test_data.h"
 
 namespace motiondb {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::RunCli;
 
 class CliTest : public ::testing::Test {
@@ -134,10 +140,242 @@ TEST_F(CliTest, ConvertRejectsBadArgumentsAndWritesNothing) {
 }
 
 TEST_F(CliTest, UnknownCommandAndHelp) {
-  EXPECT_EQ(RunCli({"frobnicate"}).exit_code, 2);
+  const testing::CommandResult unknown = RunCli({"frobnicate"});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.err, HasSubstr("unknown command 'frobnicate'"));
+  EXPECT_EQ(RunCli({}).exit_code, 2);
   const testing::CommandResult help = RunCli({"help"});
   EXPECT_EQ(help.exit_code, 0);
-  EXPECT_THAT(help.out, HasSubstr("inspect"));
+  for (const char* command : {"inspect", "convert", "project", "ingest", "clips", "clip", "export",
+                              "space", "search", "info", "help"}) {
+    EXPECT_THAT(help.out, HasSubstr(std::string("\n  ") + command + " ")) << command;
+  }
+  EXPECT_EQ(RunCli({"--help"}).out, help.out);
+  EXPECT_EQ(RunCli({"help", "frobnicate"}).exit_code, 2);
+}
+
+TEST_F(CliTest, VersionIsTheProjectVersion) {
+  const testing::CommandResult r = RunCli({"--version"});
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_TRUE(std::regex_match(r.out, std::regex("motiondb [0-9]+\\.[0-9]+\\.[0-9]+\n"))) << r.out;
+}
+
+TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
+  const testing::CommandResult help = RunCli({"help", "search"});
+  const testing::CommandResult flag = RunCli({"search", "--help"});
+  ASSERT_EQ(help.exit_code, 0) << help.err;
+  ASSERT_EQ(flag.exit_code, 0) << flag.err;
+  EXPECT_EQ(help.out, flag.out);
+  EXPECT_THAT(help.out, HasSubstr("Usage: motiondb search [OPTIONS]"));
+  for (const char* listed : {"--space NAME",
+                             "--clip ID",
+                             "--bvh FILE",
+                             "--from F=0",
+                             "--to T=last",
+                             "--neighbours K=1000",
+                             "--ann-dims N=10",
+                             "--dtw-dims N=5",
+                             "--slope S=2",
+                             "--max N=20",
+                             "--epsilon E=0",
+                             "--char-frame F=auto",
+                             "--neutral mean|boundary|origin=mean",
+                             "--exact",
+                             "--no-refine",
+                             "--path",
+                             "--in-clip ID",
+                             "--tag T",
+                             "--server ADDR=127.0.0.1:50051",
+                             "--token T",
+                             "--token-file FILE",
+                             "--tls-ca FILE",
+                             "--timeout S=600",
+                             "--json"}) {
+    EXPECT_THAT(help.out, HasSubstr(listed));
+  }
+  // Two-word commands too, through either door.
+  const testing::CommandResult create = RunCli({"help", "space", "create"});
+  ASSERT_EQ(create.exit_code, 0);
+  EXPECT_EQ(create.out, RunCli({"space", "create", "--help"}).out);
+  for (const char* listed : {"Usage: motiondb space create [OPTIONS] NAME", "--skeleton ID",
+                             "--yaw-rate-weight W=0.5", "--train CLIP_ID[:FROM-TO]"}) {
+    EXPECT_THAT(create.out, HasSubstr(listed));
+  }
+}
+
+TEST_F(CliTest, UsageErrorsAreOneLineAndAHintAndExit2) {
+  const struct {
+    std::vector<std::string> args;
+    std::string command;
+    std::string message;
+  } cases[] = {
+      {{"search", "--space", "s", "--clip", "1", "--bogus"}, "search", "unknown option --bogus"},
+      {{"--bogus", "clips"}, "", "unknown option --bogus"},
+      {{"search", "--space", "s", "--clip", "1", "--max", "0"},
+       "search",
+       "--max: must be at least 1, got 0"},
+      {{"search", "--space", "s", "--clip", "x"}, "search", "--clip: expected a whole number"},
+      {{"search", "--space", "s"}, "search", "give exactly one of --clip ID and --bvh FILE"},
+      {{"search", "--clip", "1"}, "search", "--space is required"},
+      {{"clips", "--timeout", "0"}, "clips", "--timeout: must be greater than 0"},
+      {{"space", "create"}, "space create", "NAME is required"},
+      {{"clip", "show", "1", "2"}, "clip show", "unexpected argument '2'"},
+      {{"info", "--token-file", "/nonexistent/token"}, "info", "--token-file"},
+      {{"inspect", walk_, "--bogus"}, "inspect", "unknown option --bogus"},
+  };
+  for (const auto& c : cases) {
+    const testing::CommandResult r = RunCli(c.args);
+    const std::string command = c.command.empty() ? "motiondb" : "motiondb " + c.command;
+    EXPECT_EQ(r.exit_code, 2) << c.message;
+    EXPECT_THAT(r.err, HasSubstr(command + ": " + c.message));
+    EXPECT_THAT(r.err, HasSubstr("\nrun '" + command + " --help' for usage\n"));
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+// Sets an environment variable for the commands a test runs; restores its absence after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() { ::unsetenv(name_); }
+
+ private:
+  const char* name_;
+};
+
+// The server commands against the real motiondb-server, on a temporary database holding one
+// 54-frame clip (30 fps) and a space "body" over it.
+class CliServerTest : public CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    ::unsetenv("MOTIONDB_TOKEN");
+    ::unsetenv("MOTIONDB_TOKEN_FILE");
+    ASSERT_TRUE(StartServer(&server_, {"--db", (dir_ / "motiondb.sqlite").string()}, ""));
+    Clip clip = testing::SyntheticClip(testing::HumanoidSkeleton(false),
+                                       {.frames = kFrames, .fps = 30, .seed = 3});
+    const std::string path = (dir_ / "walk54.bvh").string();
+    ASSERT_TRUE(WriteBvhFile(path, clip).ok());
+    const testing::CommandResult ingest = Remote({"ingest", path, "--json"});
+    ASSERT_EQ(ingest.exit_code, 0) << ingest.err;
+    clip_id_ =
+        std::to_string(nlohmann::json::parse(ingest.out)["ingested"][0]["clip_id"].get<int>());
+    const testing::CommandResult space = Remote({"space", "create", "body"});
+    ASSERT_EQ(space.exit_code, 0) << space.err;
+  }
+  void TearDown() override {
+    if (HasFailure()) std::cerr << "---- server log ----\n" << server_.Log();
+    CliTest::TearDown();
+  }
+
+  // Starts `server` with `args`, and waits until it serves (`token` authenticating the check).
+  static bool StartServer(testing::ServerProcess* server, const std::vector<std::string>& args,
+                          const std::string& token) {
+    std::string error;
+    if (!server->Start(args, &error)) {
+      ADD_FAILURE() << error;
+      return false;
+    }
+    return testing::WaitUntilServing(testing::InsecureChannel(server->address()), token);
+  }
+  // Runs a server command against this test's server.
+  testing::CommandResult Remote(std::vector<std::string> args) {
+    args.insert(args.end(), {"--server", server_.address()});
+    return RunCli(args);
+  }
+
+  static constexpr int kFrames = 54;
+  testing::ServerProcess server_;
+  std::string clip_id_;
+};
+
+TEST_F(CliServerTest, GlobalOptionsGoBeforeOrAfterTheCommand) {
+  const std::string address = server_.address();
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"--server", address, "clips", "--json"},
+           {"clips", "--server", address, "--json"},
+           {"--json", "--server=" + address, "--timeout", "30", "clips"},
+           {"--timeout", "30", "clips", "--json", "--server", address},
+           // The later of two wins.
+           {"--server", "127.0.0.1:1", "clips", "--server", address, "--json"}}) {
+    const testing::CommandResult r = RunCli(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json listed = nlohmann::json::parse(r.out);
+    ASSERT_EQ(listed["clips"].size(), 1u) << r.out;
+    EXPECT_EQ(std::to_string(listed["clips"][0]["clip_id"].get<int>()), clip_id_);
+  }
+  const testing::CommandResult two_words = RunCli({"--server", address, "space", "list", "--json"});
+  ASSERT_EQ(two_words.exit_code, 0) << two_words.err;
+  EXPECT_EQ(nlohmann::json::parse(two_words.out)["spaces"][0]["name"], "body");
+}
+
+TEST_F(CliServerTest, OutOfRangeFramesAreToldInTheFlagsThatSetThem) {
+  const testing::CommandResult create =
+      Remote({"space", "create", "arms", "--train", clip_id_ + ":0-400"});
+  EXPECT_EQ(create.exit_code, 1);
+  EXPECT_THAT(create.err, HasSubstr("motiondb space create: INVALID_ARGUMENT: --train " + clip_id_ +
+                                    ":0-400: frame 400 is past the clip's last frame 53"));
+  EXPECT_THAT(create.err, Not(HasSubstr("training[")));
+
+  const testing::CommandResult search =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--from", "40", "--to", "999"});
+  EXPECT_EQ(search.exit_code, 1);
+  EXPECT_THAT(search.err, HasSubstr("--to 999 is past the clip's last frame 53"));
+  EXPECT_THAT(search.err, Not(HasSubstr("last_frame")));
+
+  const testing::CommandResult from =
+      Remote({"export", clip_id_, "--from", "60", "-o", (dir_ / "never.bvh").string()});
+  EXPECT_EQ(from.exit_code, 1);
+  EXPECT_THAT(from.err, HasSubstr("--from 60 is past the clip's last frame 53"));
+
+  const testing::CommandResult dims =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--ann-dims", "500"});
+  EXPECT_EQ(dims.exit_code, 1);
+  EXPECT_THAT(dims.err, HasSubstr("--ann-dims 500 is out of range"));
+  EXPECT_THAT(dims.err, Not(HasSubstr("ann_dims")));
+}
+
+TEST_F(CliServerTest, SearchRowsShowTheClipId) {
+  const testing::CommandResult r =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--from", "10", "--to", "40"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("CLIP  NAME"));
+  // The query finds itself first: rank, clip id, name, start and end (s), frames, score.
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex("\n +1 +" + clip_id_ + " +walk54 +[0-9.]+ +[0-9.]+ +[0-9]+-[0-9]+ ")))
+      << r.out;
+}
+
+TEST_F(CliServerTest, TokenFromAFileOrTheEnvironment) {
+  const std::string token_file = WriteText("token", "  s3cret-token\n");
+  testing::ServerProcess secured;
+  ASSERT_TRUE(StartServer(
+      &secured, {"--db", (dir_ / "secured.sqlite").string(), "--auth-token-file", token_file},
+      "s3cret-token"));
+  const std::string address = secured.address();
+  const testing::CommandResult refused = RunCli({"info", "--server", address});
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_THAT(refused.err, HasSubstr("UNAUTHENTICATED"));
+  EXPECT_EQ(RunCli({"info", "--server", address, "--token-file", token_file}).exit_code, 0);
+  EXPECT_EQ(RunCli({"--token-file", token_file, "info", "--server", address}).exit_code, 0);
+  EXPECT_EQ(RunCli({"info", "--server", address, "--token", "s3cret-token"}).exit_code, 0);
+  {
+    const ScopedEnv env("MOTIONDB_TOKEN_FILE", token_file);  // how the Docker healthcheck runs
+    EXPECT_EQ(RunCli({"info", "--server", address}).exit_code, 0);
+    EXPECT_EQ(RunCli({"info", "--server", address, "--token", "wrong"}).exit_code, 1)
+        << "an explicit --token wins";
+  }
+  {
+    const ScopedEnv env("MOTIONDB_TOKEN", "s3cret-token");
+    EXPECT_EQ(RunCli({"info", "--server", address}).exit_code, 0);
+  }
+  const std::string empty = WriteText("empty", " \n");
+  const testing::CommandResult blank = RunCli({"info", "--server", address, "--token-file", empty});
+  EXPECT_EQ(blank.exit_code, 2);
+  EXPECT_THAT(blank.err, HasSubstr("the token is empty"));
 }
 
 TEST(CliAssimp, InspectsDebianTestModels) {

@@ -172,30 +172,59 @@ TEST_F(SpaceCliTest, BadInputIsOneLineNamingTheFile) {
       {{"space", "build", "--train", a_, "--out", space_, "--weights", bad_json}, "bad.json"},
       {{"space", "build", "--train", a_, "--out", space_, "--weights", tail_json},
        "tail.json: weight given for unknown joint 'Tail'"},
-      {{"space", "build", "--train", a_, "--out", space_, "--weights", "heavy"}, "'heavy'"},
-      {{"space", "build", "--train", a_, "--out", space_, "--rate", "0"}, "sample rate"},
-      {{"space", "build", "--train", a_, "--out", space_, "--metric", "cosine"}, "cosine"},
-      {{"space", "build", "--out", space_}, "no --train"},
-      {{"space", "build", "--train", a_}, "no --out"},
-      {{"project", missing, "--space", space_}, "missing.bvh"},
       {{"project", a_, "--space", bad_space}, "bad.mcs"},
-      {{"project", a_, "--space", (dir_ / "none.mcs").string()}, "none.mcs"},
       {{"project", other_, "--space", space_}, "other.bvh"},
       {{"project", a_, "--space", space_, "--dims", "62"}, "--dims must be in 1..61"},
-      {{"project", a_, "--space", space_, "--dims", "0"}, "--dims"},
-      {{"project", a_}, "no --space"},
   };
   for (const auto& c : cases) {
     const testing::CommandResult r = RunCli(c.args);
-    EXPECT_NE(r.exit_code, 0) << c.message;
+    EXPECT_EQ(r.exit_code, 1) << c.message;
     EXPECT_THAT(r.err, HasSubstr(c.message));
     EXPECT_EQ(Lines(r.err).size(), 1u) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
-  // Usage errors print the usage too and exit 2.
-  const testing::CommandResult usage = RunCli({"space", "build", "--train", a_, "--bogus"});
-  EXPECT_EQ(usage.exit_code, 2);
-  EXPECT_THAT(usage.err, HasSubstr("usage: motiondb space build"));
+}
+
+TEST_F(SpaceCliTest, UsageErrorsNameTheFlagAndPointToTheHelp) {
+  ASSERT_EQ(RunCli({"space", "build", "--train", a_, "--out", space_}).exit_code, 0);
+  const struct {
+    std::vector<std::string> args;
+    std::string message;
+  } cases[] = {
+      {{"space", "build", "--train", a_, "--out", space_, "--weights", "heavy"}, "'heavy'"},
+      {{"space", "build", "--train", a_, "--out", space_, "--rate", "0"}, "--rate: must be"},
+      {{"space", "build", "--train", a_, "--out", space_, "--metric", "cosine"}, "cosine"},
+      {{"space", "build", "--out", space_}, "--train is required"},
+      {{"space", "build", "--train", a_}, "--out is required"},
+      {{"space", "build", "--train", a_, "--out", space_, "--bogus"}, "unknown option --bogus"},
+      {{"project", (dir_ / "missing.bvh").string(), "--space", space_}, "missing.bvh"},
+      {{"project", a_, "--space", (dir_ / "none.mcs").string()}, "none.mcs"},
+      {{"project", a_, "--space", space_, "--dims", "0"}, "--dims: must be at least 1"},
+      {{"project", a_}, "--space is required"},
+  };
+  for (const auto& c : cases) {
+    const testing::CommandResult r = RunCli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.message;
+    const std::string command = c.args[0] == "project" ? "project" : "space build";
+    EXPECT_THAT(r.err, HasSubstr("motiondb " + command + ": "));
+    EXPECT_THAT(r.err, HasSubstr(c.message));
+    EXPECT_THAT(r.err, HasSubstr("run 'motiondb " + command + " --help'"));
+    EXPECT_EQ(Lines(r.err).size(), 2u) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+TEST_F(SpaceCliTest, HelpListsEveryFlagWithItsDefault) {
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
+           {"space", "build", "--help"}, {"help", "space", "build"}}) {
+    const testing::CommandResult r = RunCli(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* flag : {"--train FILE[:FROM-TO]", "--out SPACE.mcs", "--rate R=30",
+                             "--weights mass|uniform|FILE.json=mass", "--yaw-rate-weight W=0.5",
+                             "--metric unit|eigen=unit", "--keep-heading", "--json"}) {
+      EXPECT_THAT(r.out, HasSubstr(flag)) << args.back();
+    }
+  }
 }
 
 }  // namespace
