@@ -1,5 +1,6 @@
 #include "client/commands.h"
 
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <utility>
@@ -22,8 +23,12 @@ void AddGlobalFlags(CLI::App* command, GlobalOptions* global, bool connection) {
   std::vector<CLI::Option*> added;
   if (connection) {
     ConnectionOptions& c = global->connection;
+    // The environment sets the default, so that an explicit --server still wins.
+    if (const char* server = std::getenv("MOTIONDB_SERVER"); server != nullptr && *server != '\0') {
+      c.server = server;
+    }
     added = {
-        command->add_option("--server", c.server, "the server's address")
+        command->add_option("--server", c.server, "the server's address (or $MOTIONDB_SERVER)")
             ->type_name("ADDR")
             ->capture_default_str(),
         command->add_option("--token", c.token, "bearer token (or $MOTIONDB_TOKEN)")

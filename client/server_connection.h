@@ -1,4 +1,5 @@
-// How the CLI reaches a motiondb server: --server ADDR (default 127.0.0.1:50051), a bearer token
+// How the CLI reaches a motiondb server: --server ADDR (default $MOTIONDB_SERVER, else
+// 127.0.0.1:50051), a bearer token
 // (sent as "authorization: Bearer T"), --tls-ca FILE (TLS, verifying the server against that CA
 // certificate), --timeout SECONDS per call; and how the server's errors are told in the CLI's
 // words.

@@ -4,12 +4,13 @@
 #
 #   scripts/start.sh           start the server (Ctrl-C stops it gracefully)
 #   scripts/start.sh --demo    ... and load a small demo library into it first: the BVH files of
-#                              Debian's assimp-testmodels, and ../shared/mocap/bandai2-normal
-#                              when it is there, with a space called "demo" to search in
+#                              Debian's assimp-testmodels with a space "demo" on the first one's
+#                              skeleton, and ../shared/mocap/bandai2-normal when it is there
+#                              with a space "bandai"
 # Extra arguments after the options go to motiondb-server (e.g. --listen 0.0.0.0:50051).
-# Only the server and the CLI are built here (scripts/test.sh builds the rest). The server's log
-# (one line per request) goes to $MOTIONDB_LOG, default ./motiondb-server.log, so that this
-# terminal stays free for the CLI.
+# Only the server and the CLI are built here (scripts/test.sh builds the rest), in $BUILD_DIR
+# (default build/). The server's log (one line per request) goes to $MOTIONDB_LOG, default
+# ./motiondb-server.log, so that this terminal stays free for the CLI.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 demo=0
@@ -18,9 +19,10 @@ if [[ "${1:-}" == "--demo" ]]; then
   shift
 fi
 "$root/scripts/install-deps.sh"
-"$root/scripts/build.sh" motiondb-server motiondb
-server="$root/build/server/motiondb-server"
-cli="$root/build/client/motiondb"
+build="${BUILD_DIR:-$root/build}"
+BUILD_DIR="$build" "$root/scripts/build.sh" motiondb-server motiondb
+server="$build/server/motiondb-server"
+cli="$build/client/motiondb"
 # The CLI talks to wherever the server was told to listen (a wildcard host is reached locally).
 listen="127.0.0.1:50051"
 args=("$@")
@@ -41,21 +43,22 @@ for _ in $(seq 100); do
 done
 "$cli" info --server "$address"
 
+# The skeleton id of the first clip carrying `tag`.
+skeleton_of_tag() {
+  "$cli" clips --tag "$1" --json --server "$address" | /usr/bin/python3 -c \
+    'import json,sys; c=json.load(sys.stdin)["clips"]; print(c[0]["skeleton_id"] if c else "")'
+}
 if ((demo)); then
   echo "Loading the demo library..."
-  "$cli" ingest /usr/share/assimp/models/BVH/*.bvh --tag demo --server "$address" || true
+  "$cli" ingest /usr/share/assimp/models/BVH --tag demo --server "$address" || true
+  # The space "demo" is on the skeleton of clip 1, the first CMU file.
+  "$cli" space create demo --skeleton "$(skeleton_of_tag demo)" --server "$address" || true
   bandai="$root/../shared/mocap/bandai2-normal"
   if [[ -d "$bandai" ]]; then
     "$cli" ingest "$bandai" --tag bandai --server "$address" || true
-    first=$("$cli" clips --tag bandai --json --server "$address" | /usr/bin/python3 -c \
-      'import json,sys; c=json.load(sys.stdin)["clips"]; print(c[0]["clip_id"] if c else "")')
-    if [[ -n "$first" ]]; then
-      skeleton=$("$cli" clip show "$first" --json --server "$address" | /usr/bin/python3 -c \
-        'import json,sys; print(json.load(sys.stdin)["skeleton_id"])')
-      "$cli" space create demo --skeleton "$skeleton" --server "$address" || true
-      echo "Try: $cli search --space demo --clip $first --server $address"
-    fi
+    "$cli" space create bandai --skeleton "$(skeleton_of_tag bandai)" --server "$address" || true
   fi
+  echo "Try: $cli search --space demo --clip 1 --server $address"
 fi
 echo
 echo "motiondb-server is running (pid $pid). Use $cli help; Ctrl-C stops the server."

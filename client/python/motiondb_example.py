@@ -10,6 +10,7 @@ It uploads the files, builds a space named "example" if there is none, searches 
 first file as the query and prints the ranked time ranges.
 """
 import argparse
+import os
 import pathlib
 import sys
 
@@ -31,7 +32,7 @@ def connect(address, token=None):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--server", default="127.0.0.1:50051")
+    parser.add_argument("--server", default=os.environ.get("MOTIONDB_SERVER", "127.0.0.1:50051"))
     parser.add_argument("--token", default=None)
     parser.add_argument("--space", default="example")
     parser.add_argument("files", nargs="+", type=pathlib.Path)

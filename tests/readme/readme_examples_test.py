@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Runs every command block of README.md as written, so that the README cannot drift.
+
+    readme_examples_test.py REPO BUILD_DIR
+
+The README's first command starts the server: this test runs scripts/start.sh itself (on a free
+loopback port, a fresh database and log in a temporary folder), then each ```sh block in order
+in a temporary working folder (with build/, client/, scripts/ and proto/ linked to the real
+ones), with the built `motiondb` on PATH and MOTIONDB_SERVER naming the test's server. A block
+preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must say which other
+check runs it. `<!-- readme-test: requires: TOOL -->` runs the block when TOOL is on PATH and
+says so when it is not (npx: Node.js is not among the Debian packages this project installs). Last, `scripts/start.sh --demo` must load its demo library into a fresh database.
+"""
+import os
+import pathlib
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+BLOCK = re.compile(r"(?:<!--\s*readme-test:\s*(?P<directive>.*?)\s*-->\s*\n)?```sh\n(?P<body>.*?)```",
+                   re.S)
+DEFAULT_ADDRESS = "127.0.0.1:50051"
+
+
+def free_port():
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+class StartedServer:
+    """scripts/start.sh [--demo] running in the background until stop()."""
+
+    def __init__(self, repo, build, work, demo):
+        self.port = free_port()
+        self.address = f"127.0.0.1:{self.port}"
+        env = dict(os.environ, BUILD_DIR=str(build), MOTIONDB_DB=str(work / "motiondb.sqlite"),
+                   MOTIONDB_LOG=str(work / "motiondb-server.log"))
+        command = [str(repo / "scripts" / "start.sh")] + (["--demo"] if demo else [])
+        self.output = open(work / "start.out", "w+")
+        self.process = subprocess.Popen(command + ["--listen", self.address], cwd=work, env=env,
+                                        stdout=self.output, stderr=subprocess.STDOUT,
+                                        start_new_session=True)
+        deadline = time.monotonic() + 900
+        while "motiondb-server is running" not in self.text():
+            if self.process.poll() is not None or time.monotonic() > deadline:
+                raise SystemExit(f"start.sh did not serve:\n{self.text()}")
+            time.sleep(0.2)
+
+    def text(self):
+        self.output.flush()
+        self.output.seek(0)
+        return self.output.read()
+
+    def stop(self):
+        os.killpg(self.process.pid, signal.SIGTERM)
+        self.process.wait(timeout=60)
+
+
+def run_block(body, env, work):
+    print(f"$ {body.strip()}", flush=True)
+    result = subprocess.run(["/bin/bash", "-euo", "pipefail", "-c", body], cwd=work, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            timeout=600)
+    print(result.stdout[-3000:], flush=True)
+    return result.returncode
+
+
+def main():
+    repo, build = pathlib.Path(sys.argv[1]).resolve(), pathlib.Path(sys.argv[2]).resolve()
+    blocks = list(BLOCK.finditer((repo / "README.md").read_text()))
+    if not blocks:
+        raise SystemExit("README.md has no ```sh blocks")
+    work = pathlib.Path(tempfile.mkdtemp(prefix="motiondb_readme_"))
+    try:
+        for name in ("client", "scripts", "proto"):
+            (work / name).symlink_to(repo / name)
+        (work / "build").symlink_to(build)
+        (work / "docker").mkdir()
+        server = StartedServer(repo, build, work, demo=False)
+        env = dict(os.environ, MOTIONDB_SERVER=server.address,
+                   PATH=f"{build / 'client'}:{os.environ.get('PATH', '')}")
+        failed, ran, skipped = [], 0, 0
+        try:
+            for match in blocks:
+                directive, body = match.group("directive"), match.group("body")
+                if directive and directive.startswith("requires:"):
+                    tool = directive.split(":", 1)[1].strip()
+                    if shutil.which(tool) is None:
+                        print(f"not run here ({tool} is not installed):\n{body}")
+                        skipped += 1
+                        continue
+                elif directive:
+                    if not directive.startswith("skip:") or len(directive) < 12:
+                        raise SystemExit(f"bad readme-test directive: {directive!r}")
+                    print(f"not run here ({directive}):\n{body}")
+                    skipped += 1
+                    continue
+                ran += 1
+                if run_block(body.replace(DEFAULT_ADDRESS, server.address), env, work) != 0:
+                    failed.append(body.strip().splitlines()[0])
+        finally:
+            server.stop()
+
+        demo_work = work / "demo"
+        demo_work.mkdir()
+        demo = StartedServer(repo, build, demo_work, demo=True)
+        try:
+            demo_env = dict(env, MOTIONDB_SERVER=demo.address)
+            ran += 1
+            if run_block("motiondb clips --tag demo | grep -q 01_01\n"
+                         "motiondb search --space demo --clip 1 --max 3\n", demo_env, work) != 0:
+                failed.append("scripts/start.sh --demo")
+        finally:
+            demo.stop()
+        print(f"README blocks: {ran} run, {skipped} not run here, {len(failed)} failed")
+        for first_line in failed:
+            print(f"FAILED: {first_line}")
+        return 1 if failed else 0
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
