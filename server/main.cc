@@ -48,24 +48,22 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   app.add_option("--listen", options->listen, "address to serve on (port 0 picks one)")
       ->type_name("HOST:PORT")
       ->capture_default_str();
-  app.add_option("--threads", options->threads, "most calls run at once (0: no limit)")
-      ->type_name("N")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1 << 16).description(""));
-  app.add_option("--max-waiting", options->max_waiting_calls,
-                 "with --threads: most calls waiting their turn")
-      ->type_name("N")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1 << 16).description(""));
-  app.add_option("--max-message-mb", options->max_message_mb, "largest request message, in MiB")
-      ->type_name("MB")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 2047).description(""));
+  // A whole-number flag in [min, max] whose help shows its default.
+  const auto number = [&app](const char* name, int& value, const char* help, const char* unit,
+                             int min, int max) {
+    app.add_option(name, value, help)
+        ->type_name(unit)
+        ->capture_default_str()
+        ->check(CLI::Range(min, max).description(""));
+  };
+  number("--threads", options->threads, "most calls run at once (0: no limit)", "N", 0, 1 << 16);
+  number("--max-waiting", options->max_waiting_calls,
+         "with --threads: most calls waiting their turn", "N", 0, 1 << 16);
+  number("--max-message-mb", options->max_message_mb, "largest request message, in MiB", "MB", 1,
+         2047);
   flags->max_bvh_mb = static_cast<int>(options->uploads.max_bvh_bytes >> 20);
-  app.add_option("--max-bvh-mb", flags->max_bvh_mb, "largest BVH upload, streamed or not, in MiB")
-      ->type_name("MB")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 20).description(""));
+  number("--max-bvh-mb", flags->max_bvh_mb, "largest BVH upload, streamed or not, in MiB", "MB", 1,
+         1 << 20);
   app.add_option("--auth-token-file", flags->auth_token_file,
                  "require 'authorization: Bearer <FILE's contents>'")
       ->type_name("FILE")

@@ -29,6 +29,13 @@ class HeldCall {
   std::promise<void> release_;
 };
 
+// A thread running `held` through the gate, returned once the call holds the gate's slot.
+std::thread RunHeld(CallGate& gate, grpc::ServerContext& context, HeldCall& held) {
+  std::thread thread([&] { EXPECT_TRUE(gate.Run(&context, std::ref(held)).ok()); });
+  held.WaitStarted();
+  return thread;
+}
+
 void WaitForWaiting(const CallGate& gate, int waiting) {
   while (gate.waiting() != waiting) std::this_thread::yield();
 }
@@ -50,8 +57,7 @@ TEST(CallGateTest, CallsBeyondTheLimitWaitTheirTurnInOrder) {
   CallGate gate(1, 2);
   grpc::ServerContext first_context, second_context, third_context;
   HeldCall held;
-  std::thread first([&] { EXPECT_TRUE(gate.Run(&first_context, std::ref(held)).ok()); });
-  held.WaitStarted();
+  std::thread first = RunHeld(gate, first_context, held);
 
   std::mutex mutex;
   std::vector<int> order;
@@ -82,8 +88,7 @@ TEST(CallGateTest, AFullLineRefusesWithTheLimit) {
   CallGate gate(1, 1);
   grpc::ServerContext first_context, second_context, third_context;
   HeldCall held;
-  std::thread first([&] { EXPECT_TRUE(gate.Run(&first_context, std::ref(held)).ok()); });
-  held.WaitStarted();
+  std::thread first = RunHeld(gate, first_context, held);
   std::thread second(
       [&] { EXPECT_TRUE(gate.Run(&second_context, [] { return grpc::Status::OK; }).ok()); });
   WaitForWaiting(gate, 1);
