@@ -1,6 +1,10 @@
-// motiondb clips [--tag T] | clip show ID | clip delete ID | export ID [--from F --to T] -o OUT
+// motiondb clips [--tag T ...] | skeletons | clip show ID | clip update ID [--name N] [--tag
+// +T|-T]... | clip delete ID | export ID [--from F --to T] -o OUT
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -34,35 +38,99 @@ nlohmann::json ClipJson(const v1::Clip& clip) {
   return json;
 }
 
-absl::Status ListClips(const std::string& tag, bool json, const ServerConnection& connection) {
+// What `clip show` and `clip update` print. UpdateClip's answer has no joint names, so then
+// they are left out.
+void PrintClip(const v1::Clip& clip, bool json) {
+  if (json) {
+    std::cout << ClipJson(clip).dump() << "\n";
+    return;
+  }
+  absl::PrintF("clip %d: %s (from %s)\n  frames:   %d at %.4f fps, %.3f s\n", clip.clip_id(),
+               clip.name(), clip.source_file(), clip.frame_count(), clip.fps(), clip.duration_s());
+  absl::PrintF(
+      "  skeleton: %d, %d joints%s\n  tags:     %s\n", clip.skeleton_id(), clip.joint_count(),
+      clip.joint_names().empty() ? ""
+                                 : absl::StrCat(" (", absl::StrJoin(clip.joint_names(), ", "), ")"),
+      clip.tags().empty() ? "none" : absl::StrJoin(clip.tags(), ", "));
+}
+
+struct ListFlags {
+  std::string tag;
+  std::string name_contains;
+  std::string sort = "id";
+  std::optional<int> limit;  // set, or a page token: one page
+  std::string page_token;
+};
+
+absl::Status ListClips(const ListFlags& flags, bool json, const ServerConnection& connection) {
   const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::ListClipsRequest request;
-  request.set_page_size(1000);
-  request.set_tag(tag);
+  request.set_page_size(flags.limit.value_or(1000));
+  request.set_page_token(flags.page_token);
+  request.set_tag(flags.tag);
+  request.set_name_contains(flags.name_contains);
+  request.set_sort(flags.sort);
+  const bool one_page = flags.limit.has_value() || !flags.page_token.empty();
   nlohmann::json clips = nlohmann::json::array();
   bool first_page = true;
+  v1::ListClipsResponse response;
   do {
-    v1::ListClipsResponse response;
-    MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-      return stub->ListClips(context, request, &response);
-    }));
+    response.Clear();
+    MOTIONDB_RETURN_IF_ERROR(Call(
+        connection,
+        [&](grpc::ClientContext* context) { return stub->ListClips(context, request, &response); },
+        {{"page_size", "--limit"}, {"page_token", "--page-token"}, {"sort", "--sort"}}));
     if (first_page && !json) {
-      absl::PrintF("%8s  %-40s %8s %8s %9s  %s\n", "ID", "NAME", "FRAMES", "FPS", "SECONDS",
-                   "TAGS");
+      absl::PrintF("%8s  %-40s %8s %8s %8s %9s  %s\n", "ID", "NAME", "SKELETON", "FRAMES", "FPS",
+                   "SECONDS", "TAGS");
     }
     first_page = false;
     for (const v1::Clip& clip : response.clips()) {
       if (json) {
         clips.push_back(ClipJson(clip));
       } else {
-        absl::PrintF("%8d  %-40s %8d %8.2f %9.2f  %s\n", clip.clip_id(), clip.name(),
-                     clip.frame_count(), clip.fps(), clip.duration_s(),
+        absl::PrintF("%8d  %-40s %8d %8d %8.2f %9.2f  %s\n", clip.clip_id(), clip.name(),
+                     clip.skeleton_id(), clip.frame_count(), clip.fps(), clip.duration_s(),
                      absl::StrJoin(clip.tags(), ","));
       }
     }
     request.set_page_token(response.next_page_token());
-  } while (!request.page_token().empty());
-  if (json) std::cout << nlohmann::json{{"clips", clips}}.dump() << "\n";
+  } while (!one_page && !request.page_token().empty());
+  const std::string& next = response.next_page_token();
+  if (json) {
+    nlohmann::json listed = {{"clips", clips}};
+    if (one_page && !next.empty()) listed["next_page_token"] = next;
+    std::cout << listed.dump() << "\n";
+  } else if (one_page && !next.empty()) {
+    // On stderr, so that stdout stays the table.
+    std::cerr << "next page: --page-token " << next << "\n";
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ListSkeletons(bool json, const ServerConnection& connection) {
+  const auto stub = v1::ClipService::NewStub(connection.channel());
+  v1::ListSkeletonsResponse response;
+  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
+    return stub->ListSkeletons(context, v1::ListSkeletonsRequest(), &response);
+  }));
+  if (json) {
+    nlohmann::json skeletons = nlohmann::json::array();
+    for (const v1::Skeleton& skeleton : response.skeletons()) {
+      skeletons.push_back({{"skeleton_id", skeleton.skeleton_id()},
+                           {"name", skeleton.name()},
+                           {"joint_count", skeleton.joint_count()},
+                           {"clip_count", skeleton.clip_count()},
+                           {"root_joint", skeleton.root_joint()}});
+    }
+    std::cout << nlohmann::json{{"skeletons", skeletons}}.dump() << "\n";
+    return absl::OkStatus();
+  }
+  absl::PrintF("%8s  %-40s %6s %8s\n", "ID", "NAME", "JOINTS", "CLIPS");
+  for (const v1::Skeleton& skeleton : response.skeletons()) {
+    absl::PrintF("%8d  %-40s %6d %8d\n", skeleton.skeleton_id(), skeleton.name(),
+                 skeleton.joint_count(), skeleton.clip_count());
+  }
   return absl::OkStatus();
 }
 
@@ -74,16 +142,36 @@ absl::Status ShowClip(int64_t id, bool json, const ServerConnection& connection)
   MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
     return stub->GetClip(context, request, &clip);
   }));
-  if (json) {
-    std::cout << ClipJson(clip).dump() << "\n";
-  } else {
-    absl::PrintF("clip %d: %s (from %s)\n  frames:   %d at %.4f fps, %.3f s\n", clip.clip_id(),
-                 clip.name(), clip.source_file(), clip.frame_count(), clip.fps(),
-                 clip.duration_s());
-    absl::PrintF("  skeleton: %d, %d joints (%s)\n  tags:     %s\n", clip.skeleton_id(),
-                 clip.joint_count(), absl::StrJoin(clip.joint_names(), ", "),
-                 clip.tags().empty() ? "none" : absl::StrJoin(clip.tags(), ", "));
+  PrintClip(clip, json);
+  return absl::OkStatus();
+}
+
+struct UpdateFlags {
+  int64_t id = 0;
+  std::optional<std::string> name;
+  std::vector<std::string> tags;  // each "+T" (add) or "-T" (remove)
+};
+
+absl::Status UpdateClip(const UpdateFlags& flags, bool json, const ServerConnection& connection) {
+  v1::UpdateClipRequest request;
+  request.set_clip_id(flags.id);
+  if (flags.name) request.set_name(*flags.name);
+  FlagNames names = {{"name", "--name"}};
+  for (const std::string& tag : flags.tags) {
+    // The server names the tag by its place in add_tags or remove_tags.
+    const bool add = tag[0] == '+';
+    const int at = add ? request.add_tags_size() : request.remove_tags_size();
+    names.emplace_back(absl::StrCat(add ? "add_tags[" : "remove_tags[", at, "]"),
+                       absl::StrCat("--tag ", tag));
+    *(add ? request.add_add_tags() : request.add_remove_tags()) = tag.substr(1);
   }
+  const auto stub = v1::ClipService::NewStub(connection.channel());
+  v1::Clip clip;
+  MOTIONDB_RETURN_IF_ERROR(Call(
+      connection,
+      [&](grpc::ClientContext* context) { return stub->UpdateClip(context, request, &clip); },
+      names));
+  PrintClip(clip, json);
   return absl::OkStatus();
 }
 
@@ -147,22 +235,57 @@ void AddClipId(CLI::App* command, int64_t* id) {
 
 void AddClipCommands(Commands& commands) {
   const GlobalOptions& global = commands.global();
-  auto tag = std::make_shared<std::string>();
-  commands
-      .AddServer(commands.root(), "clips", "list the stored clips",
-                 [tag, &global](const ServerConnection& connection) {
-                   return ListClips(*tag, global.json, connection);
-                 })
-      ->add_option("--tag", *tag, "only clips tagged T")
+  auto list = std::make_shared<ListFlags>();
+  CLI::App* clips = commands.AddServer(commands.root(), "clips", "list the stored clips",
+                                       [list, &global](const ServerConnection& connection) {
+                                         return ListClips(*list, global.json, connection);
+                                       });
+  clips->add_option("--tag", list->tag, "only clips tagged T")->type_name("T");
+  clips->add_option("--name-contains", list->name_contains, "only clips whose name holds S")
+      ->type_name("S");
+  OneOf(clips->add_option("--sort", list->sort, "the order"), {"id", "name", "created"})
+      ->capture_default_str();
+  clips->add_option("--limit", list->limit, "one page of at most N clips (default: all clips)")
+      ->type_name("N")
+      ->check(WholeAtLeast(1));
+  clips
+      ->add_option("--page-token", list->page_token,
+                   "the page after the one that printed T (with the same --sort)")
       ->type_name("T");
+  clips->footer(
+      "With --limit or --page-token, one page is listed and the next page's token, when there\n"
+      "is one, printed: on stderr, or as next_page_token with --json.");
 
-  CLI::App* clip = commands.AddGroup(commands.root(), "clip", "one stored clip: show, delete");
+  commands.AddServer(commands.root(), "skeletons",
+                     "list the skeletons: joint hierarchies that clips and spaces share",
+                     [&global](const ServerConnection& connection) {
+                       return ListSkeletons(global.json, connection);
+                     });
+
+  CLI::App* clip =
+      commands.AddGroup(commands.root(), "clip", "one stored clip: show, update, delete");
   auto id = std::make_shared<int64_t>(0);  // `show` and `delete` take the same ID; one runs
   AddClipId(commands.AddServer(clip, "show", "a clip's frames, rate, skeleton and tags",
                                [id, &global](const ServerConnection& connection) {
                                  return ShowClip(*id, global.json, connection);
                                }),
             id.get());
+  auto update = std::make_shared<UpdateFlags>();
+  CLI::App* updater = commands.AddServer(clip, "update", "rename a clip, add or remove its tags",
+                                         [update, &global](const ServerConnection& connection) {
+                                           return UpdateClip(*update, global.json, connection);
+                                         });
+  AddClipId(updater, &update->id);
+  updater->add_option("--name", update->name, "the clip's new name")->type_name("N");
+  updater->add_option("--tag", update->tags, "+T adds tag T, -T removes it; repeat for more")
+      ->type_name("+T|-T")
+      ->allow_extra_args(false)
+      ->check(CLI::Validator(
+          [](const std::string& tag) -> std::string {
+            if (tag.size() >= 2 && (tag[0] == '+' || tag[0] == '-')) return "";
+            return "'" + tag + "' is neither +TAG (add) nor -TAG (remove)";
+          },
+          ""));
   AddClipId(commands.AddServer(clip, "delete", "delete a clip and its projections",
                                [id, &global](const ServerConnection& connection) {
                                  return DeleteClip(*id, global.json, connection);

@@ -72,7 +72,7 @@ struct FrameRangeFlags {
 // Adds --from and --to to `command`; `what` is what they cut ("the query", "the clip").
 void AddFrameRangeFlags(CLI::App* command, const std::string& what, FrameRangeFlags* range);
 
-// The commands, each in its own file.
+// The commands, each in its own file (clip_commands.cc has `skeletons` too).
 void AddInspect(Commands& commands);                       // inspect_command.cc
 void AddConvert(Commands& commands);                       // convert_command.cc
 void AddProject(Commands& commands);                       // project_command.cc

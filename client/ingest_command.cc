@@ -1,4 +1,5 @@
-// motiondb ingest PATH... [--tag T]... [--recursive] [--json]
+// motiondb ingest PATH... [--tag T]... [--recursive] [--name N] [--on-conflict error|skip|replace]
+// [--json]
 // Uploads BVH files, or the .bvh files of folders, to the server. Each file's error is listed
 // while the others continue; the exit code is 1 if any failed.
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include "client/commands.h"
 #include "client/server_connection.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "util/cli_conventions.h"
 #include "util/file_io.h"
 
 namespace motiondb::cli {
@@ -32,47 +34,82 @@ bool IsBvh(const fs::path& path) {
   return extension == ".bvh";
 }
 
+// A file to upload, and the clip name to ask for: empty for a file named directly (the server
+// takes its base name), else its path relative to the folder named, without `.bvh`, so that
+// takes of one name in several session folders ("session1/take_001") do not collide.
+struct FileToIngest {
+  fs::path path;
+  std::string name;
+};
+
 // The files named, and the .bvh files of the folders named (their subfolders too with
 // `recursive`), sorted within each folder. Paths that do not exist are kept, to fail later.
-std::vector<fs::path> ExpandPaths(const std::vector<std::string>& paths, bool recursive) {
-  std::vector<fs::path> files;
+std::vector<FileToIngest> ExpandPaths(const std::vector<std::string>& paths, bool recursive) {
+  std::vector<FileToIngest> files;
   for (const std::string& name : paths) {
     std::error_code error;
     if (!fs::is_directory(name, error)) {
-      files.emplace_back(name);
+      files.push_back({fs::path(name), ""});
       continue;
     }
-    std::vector<fs::path> found;
+    std::vector<FileToIngest> found;
     const auto add = [&](const fs::directory_entry& entry) {
-      if (entry.is_regular_file() && IsBvh(entry.path())) found.push_back(entry.path());
+      if (!entry.is_regular_file() || !IsBvh(entry.path())) return;
+      // generic_string: '/' between the segments whatever the platform writes.
+      found.push_back({entry.path(),
+                       entry.path().lexically_relative(name).replace_extension().generic_string()});
     };
     if (recursive) {
       for (const auto& entry : fs::recursive_directory_iterator(name, error)) add(entry);
     } else {
       for (const auto& entry : fs::directory_iterator(name, error)) add(entry);
     }
-    std::sort(found.begin(), found.end());
+    std::sort(found.begin(), found.end(),
+              [](const FileToIngest& a, const FileToIngest& b) { return a.path < b.path; });
     files.insert(files.end(), found.begin(), found.end());
   }
   return files;
 }
 
+struct IngestFlags {
+  std::vector<std::string> paths;
+  std::vector<std::string> tags;
+  bool recursive = false;
+  std::string name;         // overrides the clip name of a single file
+  std::string on_conflict;  // empty: the server's default
+};
+
+v1::OnConflict OnConflictOf(const std::string& flag) {
+  return flag == "error"     ? v1::ON_CONFLICT_ERROR
+         : flag == "skip"    ? v1::ON_CONFLICT_SKIP
+         : flag == "replace" ? v1::ON_CONFLICT_REPLACE
+                             : v1::ON_CONFLICT_UNSPECIFIED;
+}
+
+// What both request messages carry besides the bytes: IngestClipRequest and the first
+// IngestClipStreamRequest have the same fields.
+template <typename Request>
+void FillHeader(const FileToIngest& file, const IngestFlags& flags, Request* request) {
+  request->set_file_name(file.path.filename().string());
+  request->set_name(flags.name.empty() ? file.name : flags.name);
+  for (const std::string& tag : flags.tags) request->add_tags(tag);
+  request->set_on_conflict(OnConflictOf(flags.on_conflict));
+}
+
 grpc::Status Upload(const ServerConnection& connection, v1::ClipService::Stub& stub,
-                    const fs::path& path, const std::string& bytes,
-                    const std::vector<std::string>& tags, v1::IngestClipResponse* response) {
+                    const FileToIngest& file, const std::string& bytes, const IngestFlags& flags,
+                    v1::IngestClipResponse* response) {
   const std::unique_ptr<grpc::ClientContext> context = connection.NewContext();
   if (bytes.size() <= kChunkBytes) {
     v1::IngestClipRequest request;
-    request.set_file_name(path.filename().string());
+    FillHeader(file, flags, &request);
     request.set_bvh(bytes);
-    for (const std::string& tag : tags) request.add_tags(tag);
     return stub.IngestClip(context.get(), request, response);
   }
   std::unique_ptr<grpc::ClientWriter<v1::IngestClipStreamRequest>> writer =
       stub.IngestClipStream(context.get(), response);
   v1::IngestClipStreamRequest header;
-  header.set_file_name(path.filename().string());
-  for (const std::string& tag : tags) header.add_tags(tag);
+  FillHeader(file, flags, &header);
   bool open = writer->Write(header);
   for (size_t at = 0; open && at < bytes.size(); at += kChunkBytes) {
     v1::IngestClipStreamRequest chunk;
@@ -83,27 +120,51 @@ grpc::Status Upload(const ServerConnection& connection, v1::ClipService::Stub& s
   return writer->Finish();
 }
 
-struct IngestFlags {
-  std::vector<std::string> paths;
-  std::vector<std::string> tags;
-  bool recursive = false;
-};
+// "stored", "skipped" or "replaced", as --json gives it.
+std::string ResultName(v1::IngestResult result) {
+  switch (result) {
+    case v1::INGEST_RESULT_SKIPPED:
+      return "skipped";
+    case v1::INGEST_RESULT_REPLACED:
+      return "replaced";
+    default:
+      return "stored";
+  }
+}
+
+// The human line's outcome: "stored", "skipped (identical)", "replaced clip 4". Under the
+// default policy a skip means the stored clip has the same content; under --on-conflict skip it
+// only means the name was taken.
+std::string DescribeResult(const v1::IngestClipResponse& response, const std::string& on_conflict) {
+  switch (response.result()) {
+    case v1::INGEST_RESULT_SKIPPED:
+      return on_conflict.empty() ? "skipped (identical)" : "skipped (name taken)";
+    case v1::INGEST_RESULT_REPLACED:
+      return absl::StrFormat("replaced clip %d", response.replaced_clip_id());
+    default:
+      return "stored";
+  }
+}
 
 absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection& connection) {
   const std::unique_ptr<v1::ClipService::Stub> stub =
       v1::ClipService::NewStub(connection.channel());
-  const std::vector<fs::path> files = ExpandPaths(flags.paths, flags.recursive);
+  const std::vector<FileToIngest> files = ExpandPaths(flags.paths, flags.recursive);
+  if (!flags.name.empty() && files.size() != 1) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--name names one clip, but the paths hold %d files", files.size()));
+  }
   const bool progress_bar = ::isatty(STDERR_FILENO) && !json;
   nlohmann::json ingested = nlohmann::json::array(), failed = nlohmann::json::array();
   for (size_t i = 0; i < files.size(); ++i) {
-    const fs::path& path = files[i];
+    const fs::path& path = files[i].path;
     std::string error;
     v1::IngestClipResponse response;
     if (absl::StatusOr<std::string> bytes = ReadFileBytes(path.string(), kMaxFileBytes);
         !bytes.ok()) {
       error = std::string(bytes.status().message());
     } else if (const grpc::Status status =
-                   Upload(connection, *stub, path, *bytes, flags.tags, &response);
+                   Upload(connection, *stub, files[i], *bytes, flags, &response);
                !status.ok()) {
       error = DescribeError(status, connection.address());
     }
@@ -116,10 +177,14 @@ absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection&
       ingested.push_back({{"file", path.string()},
                           {"clip_id", clip.clip_id()},
                           {"name", clip.name()},
+                          {"result", ResultName(response.result())},
                           {"frames", clip.frame_count()},
                           {"fps", clip.fps()},
                           {"warnings", std::vector<std::string>(response.warnings().begin(),
                                                                 response.warnings().end())}});
+      if (response.result() == v1::INGEST_RESULT_REPLACED) {
+        ingested.back()["replaced_clip_id"] = response.replaced_clip_id();
+      }
       for (const std::string& warning : response.warnings()) {
         std::cerr << "motiondb ingest: " << path.string() << ": warning: " << warning << "\n";
       }
@@ -131,9 +196,10 @@ absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection&
                                    path.filename().string())
                 << std::flush;
     } else if (!json && error.empty()) {
-      std::cout << absl::StrFormat("[%zu/%zu] %s -> clip %d (%d frames)\n", i + 1, files.size(),
-                                   path.string(), response.clip().clip_id(),
-                                   response.clip().frame_count());
+      std::cout << absl::StrFormat("[%zu/%zu] %s -> clip %d '%s' (%d frames): %s\n", i + 1,
+                                   files.size(), path.string(), response.clip().clip_id(),
+                                   response.clip().name(), response.clip().frame_count(),
+                                   DescribeResult(response, flags.on_conflict));
     }
   }
   if (progress_bar) std::cerr << "\n";
@@ -160,7 +226,15 @@ void AddIngest(Commands& commands) {
   ingest->add_option("--tag", flags->tags, "tag every clip with T; repeat for more")
       ->type_name("T")
       ->allow_extra_args(false);
-  ingest->add_flag("--recursive", flags->recursive, "the folders' subfolders too");
+  ingest->add_flag("--recursive", flags->recursive,
+                   "the folders' subfolders too; a clip found in a folder is named by its path "
+                   "relative to the folder, without .bvh (session1/take_001)");
+  ingest->add_option("--name", flags->name, "the clip's name instead of the file's (one file only)")
+      ->type_name("N");
+  OneOf(ingest->add_option("--on-conflict", flags->on_conflict,
+                           "when a clip of the name exists: refuse, keep it, or replace it "
+                           "(default: skip it if its content is identical, refuse otherwise)"),
+        {"error", "skip", "replace"});
 }
 
 }  // namespace motiondb::cli

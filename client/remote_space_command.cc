@@ -105,6 +105,10 @@ nlohmann::json SpaceJson(const v1::Space& space) {
           {"heading_removed", report.heading_removed()},
           {"training_frames", report.training_frames()},
           {"projected_clips", report.projected_clips()},
+          // The resident index, current after later ingests and deletes; the report is the
+          // build's.
+          {"clips", space.index().clips()},
+          {"frames", space.index().frames()},
           {"explained_variance", std::vector<double>(report.explained_variance().begin(),
                                                      report.explained_variance().end())},
           {"reconstruction_error", errors}};
@@ -116,8 +120,9 @@ void PrintSpace(const v1::Space& space) {
                space.name(), space.space_id(), space.skeleton_id(), report.dims(),
                report.sample_rate(), report.heading_removed() ? "removed" : "kept",
                report.pelvis());
-  absl::PrintF("  trained on %d ranges (%d frames); %d clips projected\n", report.training_size(),
-               report.training_frames(), report.projected_clips());
+  absl::PrintF("  trained on %d ranges (%d frames); %d clips projected when built\n",
+               report.training_size(), report.training_frames(), report.projected_clips());
+  absl::PrintF("  index: %d clips, %d frames\n", space.index().clips(), space.index().frames());
   double cumulative = 0;
   absl::PrintF("  explained variance:");
   for (int i = 0; i < report.explained_variance_size() && i < 10; ++i) {
@@ -164,7 +169,7 @@ absl::Status List(bool json, const ServerConnection& connection) {
     } else {
       absl::PrintF("%-24s skeleton %d, %d dims at %g Hz, %d clips\n", space.name(),
                    space.skeleton_id(), space.report().dims(), space.report().sample_rate(),
-                   space.report().projected_clips());
+                   space.index().clips());
     }
   }
   if (json) std::cout << nlohmann::json{{"spaces", spaces}}.dump() << "\n";

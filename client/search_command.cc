@@ -28,6 +28,7 @@ struct SearchFlags {
   std::optional<double> epsilon;
   std::string neutral = "mean";
   bool exact = false, path = false, no_refine = false;
+  bool exclude_query = true;  // a --clip query's own range is not a result
   std::vector<int64_t> in_clips;
   std::vector<std::string> tags;
 };
@@ -94,6 +95,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   request.set_exact(flags.exact);
   request.set_return_path(flags.path);
   if (flags.no_refine) request.set_refine(false);
+  if (flags.clip) request.set_exclude_query(flags.exclude_query);
   return request;
 }
 
@@ -204,6 +206,10 @@ void AddSearch(Commands& commands) {
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
   search->add_flag("--no-refine", flags->no_refine,
                    "the thesis's search as is (faster, lower recall)");
+  search
+      ->add_flag("--exclude-query,!--include-query", flags->exclude_query,
+                 "--clip: leave out (or keep) results overlapping the query's own range")
+      ->default_str("exclude");
   search->add_flag("--path", flags->path, "each result's warp path (with --json)");
   search->add_option("--in-clip", flags->in_clips, "only in this clip; repeat for more")
       ->type_name("ID")

@@ -17,14 +17,29 @@ absl::StatusOr<int> ResolvePageSize(int requested) {
   return requested == 0 ? kDefaultPageSize : std::min(requested, kMaxPageSize);
 }
 
+absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort) {
+  if (sort.empty() || sort == "id") return storage::ClipOrder::kId;
+  if (sort == "name") return storage::ClipOrder::kName;
+  if (sort == "created") return storage::ClipOrder::kCreated;
+  return absl::InvalidArgumentError(
+      absl::StrCat("sort: '", sort.substr(0, 40), "' is not id, name or created"));
+}
+
 }  // namespace
 
 absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
-                                            const std::string& tag) {
+                                            const ClipListRequest& request) {
   storage::Page stored;
   MOTIONDB_ASSIGN_OR_RETURN(stored.page_size, ResolvePageSize(page.page_size));
   stored.page_token = page.page_token;
-  return database.ListClips(stored, tag);
+  storage::ClipFilter filter{.tag = request.tag, .name_contains = request.name_contains};
+  MOTIONDB_ASSIGN_OR_RETURN(filter.order, ClipOrderOf(request.sort));
+  return database.ListClips(stored, filter);
+}
+
+std::string SkeletonName(const storage::SkeletonSummary& skeleton) {
+  if (skeleton.first_clip_name.empty()) return skeleton.root_joint;
+  return absl::StrCat(skeleton.root_joint, " (", skeleton.first_clip_name, ")");
 }
 
 absl::StatusOr<SpacePage> ListSpaces(const IndexRegistry& registry, const PageRequest& page) {

@@ -19,8 +19,20 @@ struct PageRequest {
   std::string page_token;  // empty for the first page
 };
 
+// A clip listing's filters and order as the API gives them: sort is "id" (or empty), "name" or
+// "created"; another is INVALID_ARGUMENT naming `sort`.
+struct ClipListRequest {
+  std::string tag;
+  std::string name_contains;
+  std::string sort;
+};
+
 absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
-                                            const std::string& tag);
+                                            const ClipListRequest& request);
+
+// A skeleton's name for people: its root joint's and its first clip's, "Hips (01_01)"; the
+// root's alone when it has no clip.
+std::string SkeletonName(const storage::SkeletonSummary& skeleton);
 
 struct SpacePage {
   std::vector<std::shared_ptr<const SpaceSnapshot>> spaces;  // in space id order

@@ -107,6 +107,53 @@ SearchHit HitOf(const SearchResult& result, const SpaceSnapshot& snapshot) {
   return hit;
 }
 
+// ValidateSearchParams' bound on max_results.
+constexpr int kMaxResults = 10'000;
+
+// A stored query's own clip and range, for exclude_query.
+struct OwnRange {
+  int64_t clip_id = 0;
+  FrameRange frames;  // at the clip's rate
+
+  bool Overlaps(const SearchHit& hit) const {
+    return hit.clip_id == clip_id && hit.start_frame <= frames.last &&
+           hit.end_frame >= frames.first;
+  }
+};
+
+// Runs the search, without the hits overlapping `own` when given. The query's own range and
+// its near shifts rank first, so the search is asked for more results than wanted, and asked
+// again for yet more while what is left falls short and the search had more to give.
+absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const Query& query,
+                                            SearchParams params, bool exact,
+                                            const std::optional<OwnRange>& own,
+                                            SearchStats* stats) {
+  const int wanted = params.max_results;
+  int extra = own ? 4 : 0;
+  while (true) {
+    // Past ValidateSearchParams' bound the search would still run, but no client asks that.
+    params.max_results = std::min(wanted + extra, kMaxResults);
+    MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
+                              exact ? ExactSearch(*snapshot.index, query.rows(), params)
+                                    : Search(*snapshot.index, query.rows(), params));
+    *stats = found.stats;
+    std::vector<SearchHit> hits;
+    hits.reserve(found.results.size());
+    for (const SearchResult& result : found.results) {
+      SearchHit hit = HitOf(result, snapshot);
+      if (!own || !own->Overlaps(hit)) hits.push_back(std::move(hit));
+    }
+    const bool exhausted = static_cast<int>(found.results.size()) < params.max_results;
+    // At most a few rounds: the query's overlaps are few after overlap suppression.
+    if (static_cast<int>(hits.size()) >= wanted || exhausted || extra >= 256 ||
+        params.max_results == kMaxResults) {
+      if (static_cast<int>(hits.size()) > wanted) hits.resize(wanted);
+      return hits;
+    }
+    extra *= 4;
+  }
+}
+
 }  // namespace
 
 absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
@@ -117,8 +164,10 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                             FindSpace(registry_, request.space));
   const int dims = snapshot->space->dims();
   Query query;
+  std::optional<OwnRange> own;
   if (const auto* stored = std::get_if<ClipSelection>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(query, StoredQuery(*stored, *snapshot, database_));
+    if (request.exclude_query.value_or(true)) own = OwnRange{stored->clip_id, query.range};
   } else if (const auto* upload = std::get_if<UploadedQuery>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(query, QueryOfUpload(*upload, *snapshot, limits_));
   } else {
@@ -131,17 +180,11 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
   outcome.query_frames = query.row_count;
   if (snapshot->index) {
     outcome.library_frames = snapshot->index->total_frames();
-    MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
-                              request.exact ? ExactSearch(*snapshot->index, query.rows(), params)
-                                            : Search(*snapshot->index, query.rows(), params));
-    outcome.hits.reserve(found.results.size());
-    for (const SearchResult& result : found.results) {
-      outcome.hits.push_back(HitOf(result, *snapshot));
-    }
-    outcome.stats = found.stats;
-    if (found.stats.characteristic_frame >= 0) {
+    MOTIONDB_ASSIGN_OR_RETURN(outcome.hits,
+                              Hits(*snapshot, query, params, request.exact, own, &outcome.stats));
+    if (outcome.stats.characteristic_frame >= 0) {
       outcome.characteristic_frame =
-          query.frames.ToOriginal(query.first_row + found.stats.characteristic_frame);
+          query.frames.ToOriginal(query.first_row + outcome.stats.characteristic_frame);
     }
   }
   outcome.request_ms =

@@ -42,6 +42,9 @@ struct SearchRequest {
   std::optional<int> characteristic_frame;
   // The exhaustive search instead of the seeded one.
   bool exact = false;
+  // A stored-clip query: drop hits in its clip overlapping its range (unset: true), filling
+  // params.max_results with others. Ignored for an uploaded query.
+  std::optional<bool> exclude_query;
 };
 
 // A ranked time range, in the clip's own frames (inclusive).

@@ -7,6 +7,7 @@
 #include "core/motion/resample.h"
 #include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
+#include "server/listing.h"
 #include "server/space_report.h"
 #include "util/status_macros.h"
 
@@ -54,10 +55,19 @@ absl::StatusOr<int64_t> ResolveSkeleton(storage::Database& database, const Space
     return *skeleton;
   }
   if (request.skeleton_id) return *request.skeleton_id;
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::Counts counts, database.GetCounts());
-  if (counts.skeletons > 1) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "the database holds ", counts.skeletons, " skeletons: give skeleton_id or training clips"));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<storage::SkeletonSummary> skeletons,
+                            database.ListSkeletons());
+  if (skeletons.size() > 1) {
+    // Listed, so that the caller can choose one without another call.
+    std::string listed;
+    for (const storage::SkeletonSummary& skeleton : skeletons) {
+      absl::StrAppend(&listed, listed.empty() ? "" : "; ", "skeleton ", skeleton.skeleton_id, " '",
+                      SkeletonName(skeleton), "' with ", skeleton.clip_count,
+                      skeleton.clip_count == 1 ? " clip" : " clips");
+    }
+    return absl::InvalidArgumentError(absl::StrCat("the database holds ", skeletons.size(),
+                                                   " skeletons (", listed,
+                                                   "): give skeleton_id, or training clips"));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipPage page, database.ListClips(storage::Page{1, ""}));
   if (page.clips.empty()) {

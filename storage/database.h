@@ -101,9 +101,29 @@ struct Page {
   std::string page_token;  // empty for the first page
 };
 
+// The order of a clip listing; each has its own page tokens.
+enum class ClipOrder { kId, kName, kCreated };
+
+// Which clips a listing holds, and in what order.
+struct ClipFilter {
+  // The {} initialisers let callers name only the fields they set without -Wextra warnings.
+  std::string tag{};                 // only clips carrying it; empty: any
+  std::string name_contains{};       // only clips whose name holds it (bytes, case-sensitive)
+  ClipOrder order = ClipOrder::kId;  // ties (created) in id order
+};
+
 struct ClipPage {
   std::vector<ClipRecord> clips;
   std::string next_page_token;  // empty on the last page
+};
+
+// A skeleton as a listing shows it.
+struct SkeletonSummary {
+  int64_t skeleton_id = 0;
+  int joint_count = 0;
+  std::string root_joint;  // the first joint's name (a BVH file's ROOT)
+  int64_t clip_count = 0;
+  std::string first_clip_name;  // of its lowest clip id; empty when it has none
 };
 
 struct Counts {
@@ -146,6 +166,10 @@ class Database {
   // Clips in id order; optionally only those carrying `tag`. page_size 0 means 100; outside
   // 0-1000, or a malformed page_token: INVALID_ARGUMENT.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const std::string& tag = "");
+  // The same, filtered and ordered by `filter`, in one query. A page token holds the last
+  // clip's sort key and id, so pages stay stable while clips come and go; a token of another
+  // order is INVALID_ARGUMENT.
+  absl::StatusOr<ClipPage> ListClips(const Page& page, const ClipFilter& filter);
   // Deletes the clip, its projections and labels. NOT_FOUND when absent.
   absl::Status DeleteClip(int64_t clip_id);
 
@@ -163,6 +187,9 @@ class Database {
   absl::StatusOr<std::vector<Projection>> LoadProjections(int64_t space_id);
   // Ids of the clips of a skeleton, in id order.
   absl::StatusOr<std::vector<int64_t>> ClipsOfSkeleton(int64_t skeleton_id);
+
+  // Every skeleton, in id order, with its clip count and first clip, in one query.
+  absl::StatusOr<std::vector<SkeletonSummary>> ListSkeletons();
 
   absl::StatusOr<Counts> GetCounts();
 

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -8,6 +9,8 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/string_view.h"
 #include "storage/blob_codec.h"
 #include "storage/content_hash.h"
 #include "storage/database.h"
@@ -23,18 +26,58 @@ namespace {
 constexpr int kDefaultPageSize = 100;
 constexpr int kMaxPageSize = 1000;
 
-// The clip id after which a page starts: 0 for the first page, else the token, which is the last
-// clip id of the previous page in decimal.
-absl::StatusOr<int64_t> PageStart(const std::string& page_token) {
-  if (page_token.empty()) return 0;
-  int64_t after = 0;
-  const bool digits = std::all_of(page_token.begin(), page_token.end(),
-                                  [](char c) { return absl::ascii_isdigit(c); });
-  if (!digits || !absl::SimpleAtoi(page_token, &after) || after <= 0) {
+// Where a page starts: after the clip `clip_id` (0: at the first), whose sort key is `key` (a
+// name, or a time in decimal; unused in id order).
+struct PageStart {
+  int64_t clip_id = 0;
+  std::string key;
+};
+
+// The token of a page starting after `last`. Id order keeps the plain decimal id of earlier
+// servers; the others are "n.ID.BASE64(name)" and "c.ID.MS", so that a token of one order is
+// not read in another. Names may hold any printable byte, hence the base64.
+std::string PageToken(ClipOrder order, const ClipRecord& last) {
+  switch (order) {
+    case ClipOrder::kName:
+      return absl::StrCat("n.", last.clip_id, ".", absl::WebSafeBase64Escape(last.name));
+    case ClipOrder::kCreated:
+      return absl::StrCat("c.", last.clip_id, ".", last.created_unix_ms);
+    case ClipOrder::kId:
+      break;
+  }
+  return absl::StrCat(last.clip_id);
+}
+
+bool IsDecimal(absl::string_view text) {
+  return !text.empty() &&
+         std::all_of(text.begin(), text.end(), [](char c) { return absl::ascii_isdigit(c); });
+}
+
+absl::StatusOr<PageStart> ParsePageToken(ClipOrder order, const std::string& page_token) {
+  PageStart start;
+  if (page_token.empty()) return start;
+  absl::string_view id = page_token, key;
+  bool ok = true;
+  if (order != ClipOrder::kId) {
+    const std::vector<absl::string_view> parts =
+        absl::StrSplit(page_token, absl::MaxSplits('.', 2));
+    ok = parts.size() == 3 && parts[0] == (order == ClipOrder::kName ? "n" : "c");
+    if (ok) {
+      id = parts[1];
+      key = parts[2];
+    }
+  }
+  ok = ok && IsDecimal(id) && absl::SimpleAtoi(id, &start.clip_id) && start.clip_id > 0;
+  if (ok && order == ClipOrder::kName) ok = absl::WebSafeBase64Unescape(key, &start.key);
+  if (ok && order == ClipOrder::kCreated) {
+    ok = IsDecimal(key);
+    start.key = std::string(key);
+  }
+  if (!ok) {
     return absl::InvalidArgumentError(
         absl::StrCat("malformed page_token '", page_token.substr(0, 40), "'"));
   }
-  return after;
+  return start;
 }
 
 // Adds `tags` to the clip; those it carries already stay as they are.
@@ -338,32 +381,54 @@ absl::StatusOr<ClipRecord> Database::UpdateClip(int64_t clip_id, const ClipUpdat
 }
 
 absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string& tag) {
+  return ListClips(page, ClipFilter{.tag = tag});
+}
+
+absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter& filter) {
   const int page_size = page.page_size == 0 ? kDefaultPageSize : page.page_size;
   if (page_size < 1 || page_size > kMaxPageSize) {
     return absl::InvalidArgumentError(absl::StrCat("page_size must be 1 to ", kMaxPageSize,
                                                    " (0 for ", kDefaultPageSize, "), got ",
                                                    page.page_size));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t after, PageStart(page.page_token));
-  if (!tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", tag, kMaxTagBytes));
+  MOTIONDB_ASSIGN_OR_RETURN(const PageStart start, ParsePageToken(filter.order, page.page_token));
+  if (!filter.tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", filter.tag, kMaxTagBytes));
+
+  // ?1 the last id, ?2 the limit, ?3 the tag, ?4 the name part, ?5 the last sort key. The id
+  // breaks ties of the key, so (key, id) orders every clip once.
+  const absl::string_view key = filter.order == ClipOrder::kName      ? "c.name"
+                                : filter.order == ClipOrder::kCreated ? "c.created_unix_ms"
+                                                                      : "";
+  std::string sql = absl::StrCat("SELECT ", kClipRecordColumns, " FROM clips c");
+  if (!filter.tag.empty()) {
+    absl::StrAppend(&sql, " JOIN clip_tags t ON t.clip_id = c.clip_id AND t.tag = ?3");
+  }
+  absl::StrAppend(&sql, key.empty() ? " WHERE c.clip_id > ?1"
+                                    : absl::StrCat(" WHERE (", key, ", c.clip_id) > (?5, ?1)"));
+  if (!filter.name_contains.empty()) absl::StrAppend(&sql, " AND instr(c.name, ?4) > 0");
+  absl::StrAppend(&sql, " ORDER BY ", key.empty() ? "" : absl::StrCat(key, ", "),
+                  "c.clip_id LIMIT ?2");
 
   ClipPage result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
-    const std::string sql =
-        tag.empty()
-            ? absl::StrCat("SELECT ", kClipRecordColumns,
-                           " FROM clips c WHERE c.clip_id > ?1 ORDER BY c.clip_id LIMIT ?2")
-            : absl::StrCat("SELECT ", kClipRecordColumns,
-                           " FROM clip_tags t JOIN clips c ON c.clip_id = t.clip_id "
-                           "WHERE t.tag = ?3 AND t.clip_id > ?1 ORDER BY t.clip_id LIMIT ?2");
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query, db.Prepare(sql));
     // One row more than the page says whether another page follows.
-    query.BindInt64(1, after).BindInt64(2, page_size + 1);
-    if (!tag.empty()) query.BindText(3, tag);
+    query.BindInt64(1, start.clip_id).BindInt64(2, page_size + 1);
+    if (!filter.tag.empty()) query.BindText(3, filter.tag);
+    if (!filter.name_contains.empty()) query.BindText(4, filter.name_contains);
+    if (filter.order == ClipOrder::kName) query.BindText(5, start.key);
+    if (filter.order == ClipOrder::kCreated) {
+      // The first page starts below every time; a later one after the token's.
+      int64_t after_ms = std::numeric_limits<int64_t>::min();
+      if (!start.key.empty() && !absl::SimpleAtoi(start.key, &after_ms)) {
+        return absl::InvalidArgumentError("malformed page_token");
+      }
+      query.BindInt64(5, after_ms);
+    }
     MOTIONDB_ASSIGN_OR_RETURN(result.clips, ReadClipRecords(db, query));
     if (static_cast<int>(result.clips.size()) > page_size) {
       result.clips.pop_back();
-      result.next_page_token = absl::StrCat(result.clips.back().clip_id);
+      result.next_page_token = PageToken(filter.order, result.clips.back());
     }
     return absl::OkStatus();
   }));

@@ -182,6 +182,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--neutral mean|boundary|origin=mean",
                              "--exact",
                              "--no-refine",
+                             "--exclude-query,--include-query{false}=exclude",
                              "--path",
                              "--in-clip ID",
                              "--tag T",
@@ -339,14 +340,30 @@ TEST_F(CliServerTest, OutOfRangeFramesAreToldInTheFlagsThatSetThem) {
 }
 
 TEST_F(CliServerTest, SearchRowsShowTheClipId) {
-  const testing::CommandResult r =
-      Remote({"search", "--space", "body", "--clip", clip_id_, "--from", "10", "--to", "40"});
+  const testing::CommandResult r = Remote({"search", "--space", "body", "--clip", clip_id_,
+                                           "--from", "10", "--to", "40", "--include-query"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("CLIP  NAME"));
   // The query finds itself first: rank, clip id, name, start and end (s), frames, score.
   EXPECT_TRUE(std::regex_search(
       r.out, std::regex("\n +1 +" + clip_id_ + " +walk54 +[0-9.]+ +[0-9.]+ +[0-9]+-[0-9]+ ")))
       << r.out;
+}
+
+TEST_F(CliServerTest, SearchLeavesOutTheQuerysOwnRangeUnlessAskedToKeepIt) {
+  for (const bool include : {false, true}) {
+    std::vector<std::string> args = {"search", "--space", "body", "--clip", clip_id_,
+                                     "--from", "10",      "--to", "40",     "--json"};
+    if (include) args.push_back("--include-query");
+    const testing::CommandResult r = Remote(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    bool own = false;
+    const nlohmann::json found = nlohmann::json::parse(r.out);
+    for (const nlohmann::json& result : found["results"]) {
+      own = own || (result["start_frame"].get<int>() <= 40 && result["end_frame"].get<int>() >= 10);
+    }
+    EXPECT_EQ(own, include) << r.out;
+  }
 }
 
 TEST_F(CliServerTest, TokenFromAFileOrTheEnvironment) {
@@ -376,6 +393,170 @@ TEST_F(CliServerTest, TokenFromAFileOrTheEnvironment) {
   const testing::CommandResult blank = RunCli({"info", "--server", address, "--token-file", empty});
   EXPECT_EQ(blank.exit_code, 2);
   EXPECT_THAT(blank.err, HasSubstr("the token is empty"));
+}
+
+// Two takes of one file name in two session folders, as a studio's tree holds them.
+TEST_F(CliServerTest, IngestNamesFolderClipsByRelativePathAndReportsEachOutcome) {
+  const auto assimp = testing::AssimpBvhDir();
+  if (!assimp) GTEST_SKIP() << "assimp-testmodels is not installed; skipped";
+  const std::filesystem::path tree = dir_ / "tree";
+  std::filesystem::create_directories(tree / "session1");
+  std::filesystem::create_directories(tree / "session2");
+  std::filesystem::copy_file(*assimp / "01_01.bvh", tree / "session1" / "take_001.bvh");
+  std::filesystem::copy_file(*assimp / "01_03.bvh", tree / "session2" / "take_001.bvh");
+
+  testing::CommandResult r = Remote({"ingest", tree.string(), "--recursive", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json listed = nlohmann::json::parse(r.out)["ingested"];
+  ASSERT_EQ(listed.size(), 2u) << r.out;
+  EXPECT_EQ(listed[0]["name"], "session1/take_001");
+  EXPECT_EQ(listed[1]["name"], "session2/take_001");
+  EXPECT_EQ(listed[0]["result"], "stored");
+
+  // Again: what is stored is skipped, so a batch ingest can be re-run.
+  r = Remote({"ingest", tree.string(), "--recursive"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("'session1/take_001' (2752 frames): skipped (identical)"));
+  EXPECT_THAT(r.out, HasSubstr("ingested 2 of 2 files"));
+
+  // A file named directly keeps its base name; identical content under it is warned about.
+  const std::string copy = (dir_ / "copy.bvh").string();
+  std::filesystem::copy_file(tree / "session1" / "take_001.bvh", copy);
+  r = Remote({"ingest", copy});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("'copy' (2752 frames): stored"));
+  EXPECT_THAT(r.err, HasSubstr("warning: identical content to clip"));
+  EXPECT_THAT(r.err, HasSubstr("session1/take_001"));
+
+  // Other motion under a taken name: refused by default, replaced when asked.
+  const std::string other = (tree / "session2" / "take_001.bvh").string();
+  r = Remote({"ingest", other, "--name", "session1/take_001"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("ALREADY_EXISTS"));
+  r = Remote({"ingest", other, "--name", "session1/take_001", "--on-conflict", "replace"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("'session1/take_001'"));
+  EXPECT_THAT(r.out,
+              HasSubstr(": replaced clip " + std::to_string(listed[0]["clip_id"].get<int>())));
+  r = Remote({"ingest", other, "--name", "session1/take_001", "--on-conflict", "skip", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["ingested"][0]["result"], "skipped");
+
+  r = Remote({"ingest", tree.string(), "--recursive", "--name", "x"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--name names one clip, but the paths hold 2 files"));
+  r = Remote({"ingest", copy, "--on-conflict", "overwrite"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--on-conflict"));
+}
+
+TEST_F(CliServerTest, ClipUpdateRenamesAndRetagsAndPrintsTheClip) {
+  testing::CommandResult r =
+      Remote({"clip", "update", clip_id_, "--name", "walks/slow", "--tag", "+gait", "--tag", "+a"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("clip " + clip_id_ + ": walks/slow (from walk54.bvh)"));
+  EXPECT_THAT(r.out, HasSubstr("tags:     a, gait"));
+  r = Remote({"clip", "update", clip_id_, "--tag", "-a", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json updated = nlohmann::json::parse(r.out);
+  EXPECT_EQ(updated["name"], "walks/slow");
+  EXPECT_EQ(updated["tags"], nlohmann::json({"gait"}));
+  r = Remote({"clip", "show", clip_id_, "--json"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["tags"], nlohmann::json({"gait"}));
+
+  r = Remote({"clip", "update", clip_id_, "--name", "a//b"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--name 'a//b' has an empty segment"));
+  r = Remote({"clip", "update", clip_id_, "--tag", "+x", "--tag", "-x"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--tag -x"));
+  EXPECT_EQ(Remote({"clip", "update", "999", "--name", "x"}).exit_code, 1);
+  r = Remote({"clip", "update", clip_id_, "--tag", "gait"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("neither +TAG (add) nor -TAG (remove)"));
+}
+
+TEST_F(CliServerTest, ClipsShowTheSkeletonAndPageFilterAndSort) {
+  ASSERT_EQ(Remote({"ingest", walk_}).exit_code, 0);  // another skeleton
+  ASSERT_EQ(Remote({"ingest", (dir_ / "walk54.bvh").string(), "--name", "b/walk54"}).exit_code, 0);
+  testing::CommandResult r = Remote({"clips", "--sort", "name", "--limit", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("ID +NAME +SKELETON +FRAMES"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("b/walk54 +1 +54 "))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(" walk +2 +61 "))) << r.out;
+  EXPECT_THAT(r.out, Not(HasSubstr("  walk54 ")));
+  std::smatch token;
+  ASSERT_TRUE(std::regex_search(r.err, token, std::regex("next page: --page-token (\\S+)")))
+      << r.err;
+  r = Remote({"clips", "--sort", "name", "--limit", "2", "--page-token", token.str(1), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json page = nlohmann::json::parse(r.out);
+  ASSERT_EQ(page["clips"].size(), 1u);
+  EXPECT_EQ(page["clips"][0]["name"], "walk54");
+  EXPECT_FALSE(page.contains("next_page_token"));
+  EXPECT_TRUE(r.err.empty()) << r.err;
+
+  r = Remote({"clips", "--limit", "1", "--json", "--name-contains", "walk5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  page = nlohmann::json::parse(r.out);
+  ASSERT_EQ(page["clips"].size(), 1u);
+  EXPECT_EQ(page["clips"][0]["name"], "walk54");  // id order
+  EXPECT_FALSE(page["next_page_token"].get<std::string>().empty());
+  r = Remote({"clips", "--json", "--sort", "created"});  // every page
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["clips"].size(), 3u);
+
+  r = Remote({"clips", "--sort", "size"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--sort"));
+  r = Remote({"clips", "--page-token", "bogus"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("INVALID_ARGUMENT"));
+}
+
+TEST_F(CliServerTest, SkeletonsListAndSpaceCreateWithSeveralSaysWhichToGive) {
+  testing::CommandResult r = Remote({"skeletons"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex("ID +NAME +JOINTS +CLIPS\n +1  Hips \\(walk54\\) +[0-9]+ +1\n")))
+      << r.out;
+  // One skeleton: space create needs no flag (the fixture's "body" was made so).
+  ASSERT_EQ(Remote({"ingest", walk_, "--tag", "chain"}).exit_code, 0);
+  r = Remote({"skeletons", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json skeletons = nlohmann::json::parse(r.out)["skeletons"];
+  ASSERT_EQ(skeletons.size(), 2u) << r.out;
+  EXPECT_EQ(skeletons[1]["skeleton_id"], 2);
+  EXPECT_EQ(skeletons[1]["name"], "root (walk)");
+  EXPECT_EQ(skeletons[1]["root_joint"], "root");
+  EXPECT_EQ(skeletons[1]["joint_count"], 3);
+  EXPECT_EQ(skeletons[1]["clip_count"], 1);
+
+  r = Remote({"space", "create", "second"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("the database holds 2 skeletons (skeleton 1 'Hips (walk54)' with 1 "
+                               "clip; skeleton 2 'root (walk)' with 1 clip): give --skeleton"));
+  EXPECT_THAT(r.err, Not(HasSubstr("skeleton_id")));
+  EXPECT_EQ(Remote({"space", "create", "second", "--skeleton", "2"}).exit_code, 0);
+}
+
+TEST_F(CliServerTest, SpaceListAndShowCountTheClipsIngestedSinceTheBuild) {
+  ASSERT_EQ(Remote({"ingest", (dir_ / "walk54.bvh").string(), "--name", "again"}).exit_code, 0);
+  testing::CommandResult r = Remote({"space", "list"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(", 2 clips"));
+  r = Remote({"space", "show", "body"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("1 clips projected when built"));
+  EXPECT_THAT(r.out, HasSubstr("index: 2 clips"));
+  r = Remote({"space", "list", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json listed = nlohmann::json::parse(r.out);
+  EXPECT_EQ(listed["spaces"][0]["clips"], 2);
+  EXPECT_EQ(listed["spaces"][0]["projected_clips"], 1);
+  ASSERT_EQ(Remote({"clip", "delete", clip_id_}).exit_code, 0);
+  r = Remote({"space", "show", "body", "--json"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["clips"], 1);
 }
 
 TEST(CliAssimp, InspectsDebianTestModels) {

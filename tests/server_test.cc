@@ -137,12 +137,15 @@ class Client {
   std::unique_ptr<v1::ServerService::Stub> server_;
 };
 
+// A stored range as the query. These tests check that a search finds its own query first,
+// so the query's range is kept (exclude_query defaults to true).
 v1::SearchRequest ClipQuery(const std::string& space, int64_t clip_id, int first, int last) {
   v1::SearchRequest request;
   request.set_space(space);
   request.mutable_clip()->set_clip_id(clip_id);
   request.mutable_clip()->set_first_frame(first);
   request.mutable_clip()->set_last_frame(last);
+  request.set_exclude_query(false);
   return request;
 }
 
@@ -687,6 +690,31 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
     EXPECT_NEAR(same->score(), r.score(), 1e-4);
   }
 
+  // By default a stored query's own range is left out, and max_results still filled.
+  for (const bool exact : {false, true}) {
+    v1::SearchRequest unset = query;
+    unset.clear_exclude_query();
+    unset.set_exact(exact);
+    unset.set_max_results(found.results_size());
+    v1::SearchResponse others;
+    ASSERT_TRUE(client.Search(unset, &others).ok());
+    EXPECT_EQ(others.results_size(), found.results_size()) << exact;
+    for (const v1::SearchResult& r : others.results()) {
+      EXPECT_FALSE(r.clip_id() == raise_clip && r.start_frame() <= raise.last_frame &&
+                   r.end_frame() >= raise.first_frame)
+          << "exact " << exact << ": " << r.start_frame() << "-" << r.end_frame();
+    }
+    // The other raises stay on top.
+    ASSERT_GE(others.results_size(), 1);
+    EXPECT_LT(others.results(0).score(), found.results(3).score() + 1e-9) << exact;
+  }
+  // An upload is no stored range: exclude_query does not apply.
+  v1::SearchRequest uploaded_excluding = uploaded;
+  uploaded_excluding.set_exclude_query(true);
+  v1::SearchResponse found_uploaded_excluding;
+  ASSERT_TRUE(client.Search(uploaded_excluding, &found_uploaded_excluding).ok());
+  EXPECT_EQ(found_uploaded_excluding.results_size(), found_uploaded.results_size());
+
   // Filters, a given characteristic frame, and exact mode.
   v1::SearchRequest filtered = query;
   filtered.add_tags("clip" + std::to_string(raise.clip));
@@ -1012,6 +1040,11 @@ TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
   v1::ListClipsResponse page;
   EXPECT_EQ(client.clips().ListClips(client.Context().get(), list, &page).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+  v1::ListClipsRequest sorted;
+  sorted.set_sort("size");
+  status = client.clips().ListClips(client.Context().get(), sorted, &page);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("sort: 'size' is not id, name or created"));
   v1::ListSpacesRequest list_spaces;
   list_spaces.set_page_token("x");
   v1::ListSpacesResponse spaces;

@@ -247,6 +247,90 @@ TEST_F(StorageTest, TagFilterListsOnlyTaggedClips) {
   EXPECT_EQ(Db().ListClips({})->clips.size(), 4u);
 }
 
+TEST_F(StorageTest, ListClipsFiltersByNameAndPagesStablyInEachOrder) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 2);
+  // Ids in insertion order; names and creation times in other orders, two times equal.
+  const std::vector<std::pair<std::string, int64_t>> named = {
+      {"s2/walk", 3000}, {"s1/walk", 1000}, {"s1/run", 2000}, {"s2/run.fast", 1000}, {"jump", 500}};
+  std::map<std::string, int64_t> ids;
+  for (const auto& [name, ms] : named) {
+    ClipRecord record = Named(name, {"t"});
+    record.created_unix_ms = ms;
+    ids[name] = Insert(record, clip);
+  }
+  // Every clip `filter` lists, a page of two at a time, following the tokens.
+  auto names = [&](const ClipFilter& filter) {
+    std::vector<std::string> listed;
+    Page page = Sized(2);
+    for (int pages = 0; pages < 10; ++pages) {
+      const absl::StatusOr<ClipPage> result = Db().ListClips(page, filter);
+      EXPECT_TRUE(result.ok()) << result.status();
+      if (!result.ok()) break;
+      for (const ClipRecord& record : result->clips) listed.push_back(record.name);
+      page.page_token = result->next_page_token;
+      if (page.page_token.empty()) break;
+    }
+    return listed;
+  };
+  using ::testing::ElementsAre;
+  EXPECT_THAT(names({.order = ClipOrder::kId}),
+              ElementsAre("s2/walk", "s1/walk", "s1/run", "s2/run.fast", "jump"));
+  EXPECT_THAT(names({.order = ClipOrder::kName}),
+              ElementsAre("jump", "s1/run", "s1/walk", "s2/run.fast", "s2/walk"));
+  // Equal times in id order.
+  EXPECT_THAT(names({.order = ClipOrder::kCreated}),
+              ElementsAre("jump", "s1/walk", "s2/run.fast", "s1/run", "s2/walk"));
+  EXPECT_THAT(names({.name_contains = "run", .order = ClipOrder::kName}),
+              ElementsAre("s1/run", "s2/run.fast"));
+  EXPECT_THAT(names({.tag = "t", .name_contains = "s2/"}), ElementsAre("s2/walk", "s2/run.fast"));
+  EXPECT_THAT(names({.name_contains = "WALK"}), ElementsAre());  // case-sensitive
+  EXPECT_THAT(names({.name_contains = "%"}), ElementsAre());     // not a LIKE pattern
+
+  // A name page's token holds its place while a clip before it goes and one after it comes.
+  const absl::StatusOr<ClipPage> first = Db().ListClips(Sized(2), {.order = ClipOrder::kName});
+  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_TRUE(Db().DeleteClip(ids["jump"]).ok());
+  Insert(Named("s1/sit"), clip);
+  const absl::StatusOr<ClipPage> second = Db().ListClips(
+      {.page_size = 2, .page_token = first->next_page_token}, {.order = ClipOrder::kName});
+  ASSERT_TRUE(second.ok()) << second.status();
+  ASSERT_EQ(second->clips.size(), 2u);
+  EXPECT_EQ(second->clips[0].name, "s1/sit");
+  EXPECT_EQ(second->clips[1].name, "s1/walk");
+
+  // A token of one order is refused in another.
+  EXPECT_EQ(Db().ListClips({.page_token = first->next_page_token}, ClipFilter{}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  for (const std::string token : {"n.1", "n.x.YQ", "c.1.x", "c.1", "n.1.@@"}) {
+    EXPECT_EQ(Db().ListClips({.page_token = token}, {.order = ClipOrder::kName}).status().code(),
+              absl::StatusCode::kInvalidArgument)
+        << token;
+  }
+  EXPECT_EQ(
+      Db().ListClips({.page_token = "n.1.YQ"}, {.order = ClipOrder::kCreated}).status().code(),
+      absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(StorageTest, ListSkeletonsCountsClipsAndNamesTheFirst) {
+  EXPECT_TRUE(Db().ListSkeletons()->empty());
+  Insert(Named("b"), Motion(testing::ChainSkeleton(), 2));
+  Insert(Named("a"), Motion(testing::ChainSkeleton(), 3));
+  const int64_t humanoid = Insert(Named("h"), Motion(testing::HumanoidSkeleton(true), 2));
+  const absl::StatusOr<std::vector<SkeletonSummary>> skeletons = Db().ListSkeletons();
+  ASSERT_TRUE(skeletons.ok()) << skeletons.status();
+  ASSERT_EQ(skeletons->size(), 2u);
+  EXPECT_EQ((*skeletons)[0].root_joint, "root");
+  EXPECT_EQ((*skeletons)[0].joint_count, 3);
+  EXPECT_EQ((*skeletons)[0].clip_count, 2);
+  EXPECT_EQ((*skeletons)[0].first_clip_name, "b");  // by id, not by name
+  EXPECT_EQ((*skeletons)[1].root_joint, "Root");
+  ASSERT_TRUE(Db().DeleteClip(humanoid).ok());
+  const absl::StatusOr<std::vector<SkeletonSummary>> after = Db().ListSkeletons();
+  ASSERT_EQ(after->size(), 2u);  // a skeleton outlives its clips
+  EXPECT_EQ((*after)[1].clip_count, 0);
+  EXPECT_EQ((*after)[1].first_clip_name, "");
+}
+
 TEST_F(StorageTest, PaginationVisitsEveryClipOnce) {
   const Clip clip = Motion(testing::ChainSkeleton(), 2);
   std::vector<int64_t> inserted;

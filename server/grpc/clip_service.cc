@@ -59,10 +59,25 @@ grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
                                         v1::ListClipsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::ClipPage> page =
-        server::ListClips(database_, {request->page_size(), request->page_token()}, request->tag());
+        server::ListClips(database_, {request->page_size(), request->page_token()},
+                          {request->tag(), request->name_contains(), request->sort()});
     if (!page.ok()) return ToGrpcStatus(page.status());
     for (const storage::ClipRecord& record : page->clips) ToProto(record, response->add_clips());
     response->set_next_page_token(page->next_page_token);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status ClipServiceImpl::ListSkeletons(grpc::ServerContext* context,
+                                            const v1::ListSkeletonsRequest* /*request*/,
+                                            v1::ListSkeletonsResponse* response) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<std::vector<storage::SkeletonSummary>> skeletons =
+        database_.ListSkeletons();
+    if (!skeletons.ok()) return ToGrpcStatus(skeletons.status());
+    for (const storage::SkeletonSummary& skeleton : *skeletons) {
+      ToProto(skeleton, response->add_skeletons());
+    }
     return grpc::Status::OK;
   });
 }

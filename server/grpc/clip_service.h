@@ -32,6 +32,8 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                           v1::Clip* response) override;
   grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
                           v1::ExportClipResponse* response) override;
+  grpc::Status ListSkeletons(grpc::ServerContext* context, const v1::ListSkeletonsRequest* request,
+                             v1::ListSkeletonsResponse* response) override;
 
  private:
   absl::Status ReadStream(grpc::ServerReader<v1::IngestClipStreamRequest>* reader,

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/space/joint_weights.h"
+#include "server/listing.h"
 #include "util/byte_coding.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -164,6 +165,7 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
     out.characteristic_frame = request.characteristic_frame();
   }
   out.exact = request.exact();
+  out.exclude_query = Optional(request.has_exclude_query(), request.exclude_query());
   return out;
 }
 
@@ -210,6 +212,14 @@ void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
   clip->set_duration_s(fps > 0 ? record.frame_count / fps : 0.0);
   clip->set_joint_count(record.joint_count);
   clip->set_content_hash(record.content_hash);
+}
+
+void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton) {
+  skeleton->set_skeleton_id(summary.skeleton_id);
+  skeleton->set_name(SkeletonName(summary));
+  skeleton->set_joint_count(summary.joint_count);
+  skeleton->set_clip_count(summary.clip_count);
+  skeleton->set_root_joint(summary.root_joint);
 }
 
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {

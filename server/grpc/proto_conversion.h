@@ -33,6 +33,7 @@ CurveRequest FromProto(const v1::GetCurveRequest& request);
 
 // Results.
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
+void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
 void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response);
 void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response);
