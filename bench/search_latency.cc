@@ -15,12 +15,12 @@
 #include <string>
 
 #include "bench/measure.h"
-#include "util/cli_conventions.h"
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
 #include "core/space/search_coordinates.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
+#include "util/cli_conventions.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -48,10 +48,10 @@ struct Bench {
 absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int query_count) {
   Bench bench;
   Clock::time_point start = Clock::now();
-  SyntheticLibraryOptions options;
+  SyntheticCorpusOptions options;
   options.fps = rate;
   options.target_duration_s = duration_s;
-  MOTIONDB_ASSIGN_OR_RETURN(SyntheticLibrary generated, GenerateSyntheticLibrary(options));
+  MOTIONDB_ASSIGN_OR_RETURN(SyntheticCorpus generated, GenerateSyntheticCorpus(options));
   bench.generate_s = SecondsSince(start);
 
   start = Clock::now();
@@ -79,7 +79,7 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
     if (first + length > curve.rows()) continue;
     bench.queries.push_back({curve.middleRows(first, length), segment.peak_first_frame - first});
   }
-  generated = SyntheticLibrary();  // the joint rotations are not needed any more
+  generated = SyntheticCorpus();  // the joint rotations are not needed any more
   bench.project_s = SecondsSince(start);
 
   const double rss_before = StatusMiB(getpid(), "VmRSS");

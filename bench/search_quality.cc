@@ -14,9 +14,9 @@
 #include <tuple>
 
 #include "bench/measure.h"
-#include "util/cli_conventions.h"
-#include "testing/labelled_library.h"
+#include "testing/labelled_index.h"
 #include "testing/retrieval_evaluation.h"
+#include "util/cli_conventions.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -91,8 +91,8 @@ absl::Status Run(QualityFlags& flags) {
   params.refine = !flags.no_refine;
 
   const bench::Clock::time_point start = bench::Clock::now();
-  MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledLibrary library,
-                            testing::LoadLabelledLibrary(folder, space_options, {params.ann_dims}));
+  MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledIndex library,
+                            testing::LoadLabelledIndex(folder, space_options, {params.ann_dims}));
   const double setup_s = bench::SecondsSince(start);
   MOTIONDB_ASSIGN_OR_RETURN(const RetrievalReport report,
                             EvaluateLeaveOneOut(*library.index, library.labels, options));

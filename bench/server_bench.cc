@@ -33,7 +33,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "bench/measure.h"
-#include "util/cli_conventions.h"
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
@@ -43,7 +42,8 @@
 #include "server/search_runner.h"
 #include "storage/database.h"
 #include "testing/server_process.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
+#include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
@@ -360,10 +360,10 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   Clock::time_point start = Clock::now();
   int64_t frames = 0;
   {
-    SyntheticLibraryOptions options;
+    SyntheticCorpusOptions options;
     options.fps = 30;
     options.target_duration_s = hours * 3600;
-    MOTIONDB_ASSIGN_OR_RETURN(SyntheticLibrary generated, GenerateSyntheticLibrary(options));
+    MOTIONDB_ASSIGN_OR_RETURN(SyntheticCorpus generated, GenerateSyntheticCorpus(options));
     MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
                               storage::Database::Open(db));
     server::IndexRegistry registry;
@@ -400,12 +400,12 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const std::string log = server.Log();
 
   // Ingest into the large library: 10 clips of a minute, projected and indexed on arrival.
-  SyntheticLibraryOptions extra;
+  SyntheticCorpusOptions extra;
   extra.seed = 2;
   extra.fps = 30;
   extra.target_duration_s = 600;
   extra.max_clip_duration_s = 60;
-  MOTIONDB_ASSIGN_OR_RETURN(const SyntheticLibrary more, GenerateSyntheticLibrary(extra));
+  MOTIONDB_ASSIGN_OR_RETURN(const SyntheticCorpus more, GenerateSyntheticCorpus(extra));
   std::vector<std::string> texts;
   int64_t more_frames = 0;
   for (const Clip& clip : more.clips) {

@@ -11,7 +11,7 @@ int ActionFrames(SyntheticAction action, double scale, double fps) {
   return std::max(3, static_cast<int>(std::lround(NominalPhases(action).total() * scale * fps)));
 }
 
-PlannedAction PlanAction(SyntheticAction action, const SyntheticLibraryOptions& options,
+PlannedAction PlanAction(SyntheticAction action, const SyntheticCorpusOptions& options,
                          Random& random) {
   PlannedAction plan;
   plan.action = action;
@@ -55,7 +55,7 @@ int RestFrames(double seconds, double fps) {
   return std::max(1, static_cast<int>(std::lround(seconds * fps)));
 }
 
-std::vector<PlannedAction> PlanLibrary(const SyntheticLibraryOptions& options, Random& random,
+std::vector<PlannedAction> PlanLibrary(const SyntheticCorpusOptions& options, Random& random,
                                        int& final_rest_frames) {
   const int64_t target_frames =
       static_cast<int64_t>(std::ceil(options.target_duration_s * options.fps - 1e-9));

@@ -8,9 +8,9 @@
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
 #include "core/space/search_coordinates.h"
-#include "testing/labelled_library.h"
+#include "testing/labelled_index.h"
 #include "testing/retrieval_evaluation.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 #include "tests/test_data.h"
 
 namespace motiondb {
@@ -19,9 +19,9 @@ namespace {
 class SyntheticValidation : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    absl::StatusOr<SyntheticLibrary> generated = GenerateSyntheticLibrary({});
+    absl::StatusOr<SyntheticCorpus> generated = GenerateSyntheticCorpus({});
     ASSERT_TRUE(generated.ok()) << generated.status();
-    synthetic_ = new SyntheticLibrary(*std::move(generated));
+    synthetic_ = new SyntheticCorpus(*std::move(generated));
     std::vector<TrainingClip> training;
     for (const Clip& clip : synthetic_->clips)
       training.push_back({"synthetic", clip, std::nullopt});
@@ -73,12 +73,12 @@ class SyntheticValidation : public ::testing::Test {
     return query;
   }
 
-  static SyntheticLibrary* synthetic_;
+  static SyntheticCorpus* synthetic_;
   static MotionSpace* space_;
   static LibraryIndex* library_;
 };
 
-SyntheticLibrary* SyntheticValidation::synthetic_ = nullptr;
+SyntheticCorpus* SyntheticValidation::synthetic_ = nullptr;
 MotionSpace* SyntheticValidation::space_ = nullptr;
 LibraryIndex* SyntheticValidation::library_ = nullptr;
 
@@ -154,8 +154,8 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
 // fast search's recall@10 against exact search >= 0.9, with the default (unit) metric.
 TEST(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
   MOTIONDB_REQUIRE_MOCAP(mocap);
-  absl::StatusOr<testing::LabelledLibrary> library =
-      testing::LoadLabelledLibrary(mocap / "bandai2-normal", {}, {});
+  absl::StatusOr<testing::LabelledIndex> library =
+      testing::LoadLabelledIndex(mocap / "bandai2-normal", {}, {});
   ASSERT_TRUE(library.ok()) << library.status();
   ASSERT_EQ(library->index->clip_count(), 465);
   RetrievalOptions options;

@@ -25,7 +25,7 @@
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "testing/server_process.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 #include "tests/clip_builder.h"
 #include "tests/test_data.h"
 
@@ -41,9 +41,9 @@ using testing::ServerProcess;
 
 // A small library of the synthetic humanoid (21 joints) with arm raises and shrugs at 50 fps,
 // in clips of about 20 s; generated once.
-const SyntheticLibrary& Humanoid() {
-  static const SyntheticLibrary* const library = [] {
-    SyntheticLibraryOptions options;
+const SyntheticCorpus& Humanoid() {
+  static const SyntheticCorpus* const library = [] {
+    SyntheticCorpusOptions options;
     options.seed = 7;
     options.script = {{SyntheticAction::kRightArmRaise, 4},
                       {SyntheticAction::kLeftArmRaise, 4},
@@ -51,9 +51,9 @@ const SyntheticLibrary& Humanoid() {
                       {SyntheticAction::kShrug, 3}};
     options.max_clip_duration_s = 20;
     options.threads = 2;
-    absl::StatusOr<SyntheticLibrary> generated = GenerateSyntheticLibrary(options);
+    absl::StatusOr<SyntheticCorpus> generated = GenerateSyntheticCorpus(options);
     EXPECT_TRUE(generated.ok()) << generated.status();
-    return new SyntheticLibrary(*std::move(generated));
+    return new SyntheticCorpus(*std::move(generated));
   }();
   return *library;
 }
@@ -200,7 +200,7 @@ class ServerTest : public ::testing::Test {
   // returns the clip ids.
   std::vector<int64_t> IngestHumanoid(Client& client) {
     std::vector<int64_t> ids;
-    const SyntheticLibrary& library = Humanoid();
+    const SyntheticCorpus& library = Humanoid();
     for (size_t i = 0; i < library.clips.size(); ++i) {
       ids.push_back(client.IngestOrFail("humanoid_" + std::to_string(i) + ".bvh",
                                         BvhText(library.clips[i]),
@@ -1360,11 +1360,11 @@ TEST_F(ServerTest, DeadlineStopsALongExactSearch) {
   ASSERT_NE(server, nullptr);
   Client client(testing::InsecureChannel(server->address()));
   // A longer library: the whole thesis script, about five minutes at 50 fps.
-  SyntheticLibraryOptions options;
+  SyntheticCorpusOptions options;
   options.seed = 3;
   options.threads = 2;
   options.max_clip_duration_s = 60;
-  absl::StatusOr<SyntheticLibrary> library = GenerateSyntheticLibrary(options);
+  absl::StatusOr<SyntheticCorpus> library = GenerateSyntheticCorpus(options);
   ASSERT_TRUE(library.ok()) << library.status();
   std::vector<int64_t> ids;
   for (size_t i = 0; i < library->clips.size(); ++i) {

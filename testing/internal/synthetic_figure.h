@@ -1,5 +1,5 @@
-// The synthetic library's figure (testing/synthetic_library.h): its joints, and its poses as
-// joint angles, the rest pose and each action's peak pose. Part of GenerateSyntheticLibrary.
+// The synthetic library's figure (testing/synthetic_corpus.h): its joints, and its poses as
+// joint angles, the rest pose and each action's peak pose. Part of GenerateSyntheticCorpus.
 #ifndef MOTIONDB_TESTING_INTERNAL_SYNTHETIC_FIGURE_H_
 #define MOTIONDB_TESTING_INTERNAL_SYNTHETIC_FIGURE_H_
 
@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/motion/rotation.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 
 namespace motiondb::synthetic {
 

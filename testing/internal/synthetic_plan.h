@@ -1,6 +1,6 @@
-// The synthetic library's plan (testing/synthetic_library.h): every random draw, made in one
+// The synthetic library's plan (testing/synthetic_corpus.h): every random draw, made in one
 // sequence before anything is rendered, and the library's layout into clips, which together fix
-// every frame and segment. Part of GenerateSyntheticLibrary.
+// every frame and segment. Part of GenerateSyntheticCorpus.
 #ifndef MOTIONDB_TESTING_INTERNAL_SYNTHETIC_PLAN_H_
 #define MOTIONDB_TESTING_INTERNAL_SYNTHETIC_PLAN_H_
 
@@ -11,7 +11,7 @@
 #include <Eigen/Core>
 
 #include "testing/internal/synthetic_figure.h"
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 
 namespace motiondb::synthetic {
 
@@ -70,7 +70,7 @@ struct ClipPlan {
 };
 
 // Draws every action of the library in order, then the closing rest.
-std::vector<PlannedAction> PlanLibrary(const SyntheticLibraryOptions& options, Random& random,
+std::vector<PlannedAction> PlanLibrary(const SyntheticCorpusOptions& options, Random& random,
                                        int& final_rest_frames);
 
 // Packs the actions greedily into clips of at most `max_frames`. A clip closes with the rest

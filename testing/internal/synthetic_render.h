@@ -1,6 +1,6 @@
-// The synthetic library's rendering (testing/synthetic_library.h): a plan turned into frames,
+// The synthetic library's rendering (testing/synthetic_corpus.h): a plan turned into frames,
 // each action eased from the rest pose to its peak and back, over an idle sway that keeps rest
-// frames from repeating. Part of GenerateSyntheticLibrary.
+// frames from repeating. Part of GenerateSyntheticCorpus.
 #ifndef MOTIONDB_TESTING_INTERNAL_SYNTHETIC_RENDER_H_
 #define MOTIONDB_TESTING_INTERNAL_SYNTHETIC_RENDER_H_
 

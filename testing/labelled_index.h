@@ -1,8 +1,8 @@
 // A labelled folder of BVH files (e.g. ../shared/mocap/bandai2-normal) made searchable: a space
 // trained on every clip, and every clip's projection indexed. Shared by the retrieval-quality
 // test and the search_quality measurement program.
-#ifndef MOTIONDB_TESTING_LABELLED_LIBRARY_H_
-#define MOTIONDB_TESTING_LABELLED_LIBRARY_H_
+#ifndef MOTIONDB_TESTING_LABELLED_INDEX_H_
+#define MOTIONDB_TESTING_LABELLED_INDEX_H_
 
 #include <filesystem>
 #include <memory>
@@ -15,7 +15,7 @@
 
 namespace motiondb::testing {
 
-struct LabelledLibrary {
+struct LabelledIndex {
   std::unique_ptr<MotionSpace> space;
   std::unique_ptr<LibraryIndex> index;
   std::vector<std::string> labels;  // per clip: the file name's content field
@@ -24,10 +24,10 @@ struct LabelledLibrary {
 // "dataset-2_raise-up-left-hand_normal_003.bvh" -> "raise-up-left-hand".
 std::string ContentLabel(const std::filesystem::path& path);
 
-absl::StatusOr<LabelledLibrary> LoadLabelledLibrary(const std::filesystem::path& folder,
-                                                    const SpaceOptions& space_options,
-                                                    const LibraryIndexOptions& index_options);
+absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
+                                                const SpaceOptions& space_options,
+                                                const LibraryIndexOptions& index_options);
 
 }  // namespace motiondb::testing
 
-#endif  // MOTIONDB_TESTING_LABELLED_LIBRARY_H_
+#endif  // MOTIONDB_TESTING_LABELLED_INDEX_H_

@@ -1,4 +1,4 @@
-#include "testing/labelled_library.h"
+#include "testing/labelled_index.h"
 
 #include <algorithm>
 
@@ -14,15 +14,15 @@ std::string ContentLabel(const std::filesystem::path& path) {
   return parts.size() >= 2 ? parts[1] : path.stem().string();
 }
 
-absl::StatusOr<LabelledLibrary> LoadLabelledLibrary(const std::filesystem::path& folder,
-                                                    const SpaceOptions& space_options,
-                                                    const LibraryIndexOptions& index_options) {
+absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
+                                                const SpaceOptions& space_options,
+                                                const LibraryIndexOptions& index_options) {
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (entry.path().extension() == ".bvh") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
-  LabelledLibrary library;
+  LabelledIndex library;
   std::vector<TrainingClip> clips;
   for (const std::filesystem::path& path : files) {
     MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));

@@ -11,8 +11,8 @@
 //
 // Memory: every clip is stored whole; 10 h at 120 fps is 4.3M frames x 84 doubles = 2.9 GB.
 // All functions are pure and thread-safe.
-#ifndef MOTIONDB_TESTING_SYNTHETIC_LIBRARY_H_
-#define MOTIONDB_TESTING_SYNTHETIC_LIBRARY_H_
+#ifndef MOTIONDB_TESTING_SYNTHETIC_CORPUS_H_
+#define MOTIONDB_TESTING_SYNTHETIC_CORPUS_H_
 
 #include <cstdint>
 #include <memory>
@@ -51,7 +51,7 @@ struct SyntheticScriptStep {
 // raises, 10 shrugs, 10 slouches (about 300 s with the default options).
 std::vector<SyntheticScriptStep> ThesisSyntheticScript();
 
-struct SyntheticLibraryOptions {
+struct SyntheticCorpusOptions {
   // Seeds the std::mt19937_64 behind every random draw: equal options give bit-identical clips
   // (with the same build; std::sin and std::cos come from the platform's libm).
   uint64_t seed = 1;
@@ -89,7 +89,7 @@ struct SyntheticLibraryOptions {
 
 // One action's place in the library, at the clip's frame rate, inclusive.
 struct SyntheticSegment {
-  int clip = 0;  // index into SyntheticLibrary::clips
+  int clip = 0;  // index into SyntheticCorpus::clips
   SyntheticAction action = SyntheticAction::kRightArmRaise;
   int first_frame = 0;  // the first frame off the rest pose
   int last_frame = 0;   // the last frame before the rest pose is back
@@ -100,14 +100,14 @@ struct SyntheticSegment {
   double timing_scale = 1.0;  // the drawn stretch of the action's nominal duration
 };
 
-struct SyntheticLibrary {
+struct SyntheticCorpus {
   std::vector<Clip> clips;  // all on SyntheticSkeleton(), each starting and ending at rest
   std::vector<SyntheticSegment> segments;  // in the order performed: by clip, then by frame
 };
 
 // Generates the library. INVALID_ARGUMENT names the offending option.
-absl::StatusOr<SyntheticLibrary> GenerateSyntheticLibrary(const SyntheticLibraryOptions& options);
+absl::StatusOr<SyntheticCorpus> GenerateSyntheticCorpus(const SyntheticCorpusOptions& options);
 
 }  // namespace motiondb
 
-#endif  // MOTIONDB_TESTING_SYNTHETIC_LIBRARY_H_
+#endif  // MOTIONDB_TESTING_SYNTHETIC_CORPUS_H_

@@ -1,4 +1,4 @@
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 
 #include <algorithm>
 #include <functional>
@@ -17,15 +17,15 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-SyntheticLibrary Generate(const SyntheticLibraryOptions& options) {
-  absl::StatusOr<SyntheticLibrary> library = GenerateSyntheticLibrary(options);
+SyntheticCorpus Generate(const SyntheticCorpusOptions& options) {
+  absl::StatusOr<SyntheticCorpus> library = GenerateSyntheticCorpus(options);
   EXPECT_TRUE(library.ok()) << library.status();
-  return library.ok() ? *std::move(library) : SyntheticLibrary{};
+  return library.ok() ? *std::move(library) : SyntheticCorpus{};
 }
 
 // The default library, generated once: several tests read it.
-const SyntheticLibrary& DefaultLibrary() {
-  static const SyntheticLibrary* const library = new SyntheticLibrary(Generate({}));
+const SyntheticCorpus& DefaultLibrary() {
+  static const SyntheticCorpus* const library = new SyntheticCorpus(Generate({}));
   return *library;
 }
 
@@ -46,7 +46,7 @@ int Joint(absl::string_view name) {
 
 // The largest rotation of `joint` during the segment away from its pose on the rest frame just
 // before it.
-double MaxAngleFromRest(const SyntheticLibrary& library, const SyntheticSegment& segment,
+double MaxAngleFromRest(const SyntheticCorpus& library, const SyntheticSegment& segment,
                         int joint) {
   const Clip& clip = library.clips[segment.clip];
   const Quat rest = clip.rotation(segment.first_frame - 1, joint);
@@ -109,8 +109,8 @@ TEST(SyntheticSkeleton, IsAHumanoidWithBvhChannels) {
   EXPECT_LT(p[Joint("RightWrist")].y(), p[Joint("RightShoulder")].y() - 40.0);  // arms hang
 }
 
-TEST(SyntheticLibrary, DefaultScriptIsTheThesisValidationSet) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, DefaultScriptIsTheThesisValidationSet) {
+  const SyntheticCorpus& library = DefaultLibrary();
   ASSERT_EQ(library.clips.size(), 1u);  // about 300 s, under the 600 s clip limit
   const Clip& clip = library.clips[0];
   EXPECT_DOUBLE_EQ(clip.fps(), 50.0);
@@ -131,7 +131,7 @@ TEST(SyntheticLibrary, DefaultScriptIsTheThesisValidationSet) {
 
 // Checks what every library must satisfy: segments inside their clips, at rest on both sides,
 // in order without overlap, with the peak inside; rest frames near the clip's first frame.
-void ExpectWellFormed(const SyntheticLibrary& library) {
+void ExpectWellFormed(const SyntheticCorpus& library) {
   for (size_t i = 0; i < library.segments.size(); ++i) {
     const SyntheticSegment& s = library.segments[i];
     ASSERT_GE(s.clip, 0);
@@ -165,8 +165,8 @@ void ExpectWellFormed(const SyntheticLibrary& library) {
   }
 }
 
-TEST(SyntheticLibrary, SegmentsLieInsideTheirClipsSeparatedByRest) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, SegmentsLieInsideTheirClipsSeparatedByRest) {
+  const SyntheticCorpus& library = DefaultLibrary();
   ExpectWellFormed(library);
   // The idle sway keeps rest frames apart, but small.
   const Clip& clip = library.clips[0];
@@ -174,8 +174,8 @@ TEST(SyntheticLibrary, SegmentsLieInsideTheirClipsSeparatedByRest) {
   EXPECT_NE(clip.positions().row(0), clip.positions().row(10));
 }
 
-TEST(SyntheticLibrary, ActionDurationsScaleWithinTheTimingRange) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, ActionDurationsScaleWithinTheTimingRange) {
+  const SyntheticCorpus& library = DefaultLibrary();
   double lowest = 10.0, highest = 0.0;
   for (const SyntheticSegment& s : library.segments) {
     const double nominal_frames = SyntheticActionNominalDuration(s.action) * 50.0;
@@ -194,11 +194,11 @@ TEST(SyntheticLibrary, ActionDurationsScaleWithinTheTimingRange) {
   EXPECT_GT(highest, 1.4);
 }
 
-TEST(SyntheticLibrary, IsDeterministicPerSeed) {
-  SyntheticLibraryOptions options;
+TEST(SyntheticCorpus, IsDeterministicPerSeed) {
+  SyntheticCorpusOptions options;
   options.seed = 7;
-  const SyntheticLibrary a = Generate(options);
-  const SyntheticLibrary b = Generate(options);
+  const SyntheticCorpus a = Generate(options);
+  const SyntheticCorpus b = Generate(options);
   ASSERT_EQ(a.clips.size(), b.clips.size());
   for (size_t c = 0; c < a.clips.size(); ++c) {
     EXPECT_EQ(a.clips[c].rotations(), b.clips[c].rotations());  // bit-identical
@@ -212,12 +212,12 @@ TEST(SyntheticLibrary, IsDeterministicPerSeed) {
   }
 
   // Clips rendered on several threads are the same as on one.
-  SyntheticLibraryOptions threaded = options;
+  SyntheticCorpusOptions threaded = options;
   threaded.max_clip_duration_s = 30.0;
   threaded.threads = 1;
-  const SyntheticLibrary serial = Generate(threaded);
+  const SyntheticCorpus serial = Generate(threaded);
   threaded.threads = 4;
-  const SyntheticLibrary parallel = Generate(threaded);
+  const SyntheticCorpus parallel = Generate(threaded);
   ASSERT_GT(serial.clips.size(), 8u);
   ASSERT_EQ(serial.clips.size(), parallel.clips.size());
   for (size_t c = 0; c < serial.clips.size(); ++c) {
@@ -226,15 +226,15 @@ TEST(SyntheticLibrary, IsDeterministicPerSeed) {
   }
 
   options.seed = 8;
-  const SyntheticLibrary other = Generate(options);
+  const SyntheticCorpus other = Generate(options);
   ASSERT_EQ(other.segments.size(), a.segments.size());  // the same script
   EXPECT_NE(other.segments[0].timing_scale, a.segments[0].timing_scale);
   EXPECT_FALSE(other.clips[0].frame_count() == a.clips[0].frame_count() &&
                other.clips[0].rotations() == a.clips[0].rotations());
 }
 
-TEST(SyntheticLibrary, EachActionMovesItsOwnJoints) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, EachActionMovesItsOwnJoints) {
+  const SyntheticCorpus& library = DefaultLibrary();
   const int right = Joint("RightShoulder"), left = Joint("LeftShoulder");
   const int spine = Joint("Spine"), chest = Joint("Chest");
   const int left_collar = Joint("LeftCollar"), right_collar = Joint("RightCollar");
@@ -283,8 +283,8 @@ TEST(SyntheticLibrary, EachActionMovesItsOwnJoints) {
   EXPECT_GT(*high - *low, std::sin(0.5 * 3.0 * kDeg));
 }
 
-TEST(SyntheticLibrary, RaisedHandGoesAboveTheHeadOnItsSideAndVaries) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, RaisedHandGoesAboveTheHeadOnItsSideAndVaries) {
+  const SyntheticCorpus& library = DefaultLibrary();
   const int head = Joint("Head");
   Eigen::Vector3d low = Eigen::Vector3d::Constant(1e9), high = -low;
   for (const SyntheticSegment& s : library.segments) {
@@ -315,11 +315,11 @@ TEST(SyntheticLibrary, RaisedHandGoesAboveTheHeadOnItsSideAndVaries) {
   }
 }
 
-TEST(SyntheticLibrary, TargetDurationRepeatsTheScriptInClipsNeverCuttingAnAction) {
-  SyntheticLibraryOptions options;
+TEST(SyntheticCorpus, TargetDurationRepeatsTheScriptInClipsNeverCuttingAnAction) {
+  SyntheticCorpusOptions options;
   options.fps = 30.0;
   options.target_duration_s = 3600.0;
-  const SyntheticLibrary library = Generate(options);
+  const SyntheticCorpus library = Generate(options);
   double total = 0.0;
   for (const Clip& clip : library.clips) {
     EXPECT_LE(clip.duration_s(), options.max_clip_duration_s + 1e-9);
@@ -345,7 +345,7 @@ TEST(SyntheticLibrary, TargetDurationRepeatsTheScriptInClipsNeverCuttingAnAction
 
   // Where the library is cut does not change what is drawn.
   options.max_clip_duration_s = 60.0;
-  const SyntheticLibrary short_clips = Generate(options);
+  const SyntheticCorpus short_clips = Generate(options);
   EXPECT_GT(short_clips.clips.size(), 50u);
   for (const Clip& clip : short_clips.clips) EXPECT_LE(clip.duration_s(), 60.0 + 1e-9);
   ASSERT_EQ(short_clips.segments.size(), library.segments.size());
@@ -358,11 +358,11 @@ TEST(SyntheticLibrary, TargetDurationRepeatsTheScriptInClipsNeverCuttingAnAction
   ExpectWellFormed(short_clips);
 }
 
-TEST(SyntheticLibrary, FrameRateChangesOnlyTheSampling) {
-  SyntheticLibraryOptions options;
+TEST(SyntheticCorpus, FrameRateChangesOnlyTheSampling) {
+  SyntheticCorpusOptions options;
   options.fps = 120.0;
-  const SyntheticLibrary fast = Generate(options);
-  const SyntheticLibrary& slow = DefaultLibrary();
+  const SyntheticCorpus fast = Generate(options);
+  const SyntheticCorpus& slow = DefaultLibrary();
   ASSERT_EQ(fast.segments.size(), slow.segments.size());
   EXPECT_NEAR(fast.clips[0].duration_s(), slow.clips[0].duration_s(), 0.5);
   for (size_t i = 0; i < fast.segments.size(); ++i) {
@@ -371,20 +371,20 @@ TEST(SyntheticLibrary, FrameRateChangesOnlyTheSampling) {
   }
 }
 
-TEST(SyntheticLibrary, CustomScriptAndWideTargets) {
+TEST(SyntheticCorpus, CustomScriptAndWideTargets) {
   // The thesis's second set: arm raises only, with a larger target volume.
-  SyntheticLibraryOptions options;
+  SyntheticCorpusOptions options;
   options.script = {{SyntheticAction::kLeftArmRaise, 2}, {SyntheticAction::kRightArmRaise, 3}};
   options.target_jitter_m = 0.3;
-  const SyntheticLibrary library = Generate(options);
+  const SyntheticCorpus library = Generate(options);
   ASSERT_EQ(library.segments.size(), 5u);
   EXPECT_EQ(library.segments[1].action, SyntheticAction::kLeftArmRaise);
   EXPECT_EQ(library.segments[2].action, SyntheticAction::kRightArmRaise);
   ExpectWellFormed(library);
 }
 
-TEST(SyntheticLibrary, ClipWritesToBvhAndReadsBack) {
-  const SyntheticLibrary& library = DefaultLibrary();
+TEST(SyntheticCorpus, ClipWritesToBvhAndReadsBack) {
+  const SyntheticCorpus& library = DefaultLibrary();
   const SyntheticSegment& s = library.segments.at(0);
   const Clip& clip = library.clips[s.clip];
   const FrameRange range{s.first_frame - 1, s.last_frame + 1};
@@ -406,39 +406,39 @@ TEST(SyntheticLibrary, ClipWritesToBvhAndReadsBack) {
   EXPECT_LT(testing::MaxRelativePositionError(back->clip, *expected), 1e-6);
 }
 
-TEST(SyntheticLibrary, RejectsBadOptions) {
-  const std::vector<std::pair<std::string, std::function<void(SyntheticLibraryOptions&)>>> cases = {
-      {"fps", [](SyntheticLibraryOptions& o) { o.fps = 0.0; }},
-      {"fps", [](SyntheticLibraryOptions& o) { o.fps = -50.0; }},
-      {"fps", [](SyntheticLibraryOptions& o) { o.fps = std::nan(""); }},
-      {"fps", [](SyntheticLibraryOptions& o) { o.fps = 1e6; }},
-      {"timing_scale_min", [](SyntheticLibraryOptions& o) { o.timing_scale_min = 1.6; }},
-      {"timing_scale_min", [](SyntheticLibraryOptions& o) { o.timing_scale_min = 0.0; }},
-      {"timing_scale_max", [](SyntheticLibraryOptions& o) { o.timing_scale_max = INFINITY; }},
-      {"target_jitter_m", [](SyntheticLibraryOptions& o) { o.target_jitter_m = NAN; }},
-      {"target_jitter_m", [](SyntheticLibraryOptions& o) { o.target_jitter_m = -0.1; }},
-      {"posture_lean_deg", [](SyntheticLibraryOptions& o) { o.posture_lean_deg = 90.0; }},
-      {"rest_min_s", [](SyntheticLibraryOptions& o) { o.rest_min_s = 3.0; }},
-      {"rest_min_s", [](SyntheticLibraryOptions& o) { o.rest_min_s = -1.0; }},
-      {"target_duration_s", [](SyntheticLibraryOptions& o) { o.target_duration_s = 101 * 3600.0; }},
-      {"target_duration_s", [](SyntheticLibraryOptions& o) { o.target_duration_s = NAN; }},
-      {"max_clip_duration_s", [](SyntheticLibraryOptions& o) { o.max_clip_duration_s = 5.0; }},
-      {"threads", [](SyntheticLibraryOptions& o) { o.threads = -1; }},
-      {"script", [](SyntheticLibraryOptions& o) { o.script.clear(); }},
-      {"count", [](SyntheticLibraryOptions& o) { o.script[0].count = -1; }},
+TEST(SyntheticCorpus, RejectsBadOptions) {
+  const std::vector<std::pair<std::string, std::function<void(SyntheticCorpusOptions&)>>> cases = {
+      {"fps", [](SyntheticCorpusOptions& o) { o.fps = 0.0; }},
+      {"fps", [](SyntheticCorpusOptions& o) { o.fps = -50.0; }},
+      {"fps", [](SyntheticCorpusOptions& o) { o.fps = std::nan(""); }},
+      {"fps", [](SyntheticCorpusOptions& o) { o.fps = 1e6; }},
+      {"timing_scale_min", [](SyntheticCorpusOptions& o) { o.timing_scale_min = 1.6; }},
+      {"timing_scale_min", [](SyntheticCorpusOptions& o) { o.timing_scale_min = 0.0; }},
+      {"timing_scale_max", [](SyntheticCorpusOptions& o) { o.timing_scale_max = INFINITY; }},
+      {"target_jitter_m", [](SyntheticCorpusOptions& o) { o.target_jitter_m = NAN; }},
+      {"target_jitter_m", [](SyntheticCorpusOptions& o) { o.target_jitter_m = -0.1; }},
+      {"posture_lean_deg", [](SyntheticCorpusOptions& o) { o.posture_lean_deg = 90.0; }},
+      {"rest_min_s", [](SyntheticCorpusOptions& o) { o.rest_min_s = 3.0; }},
+      {"rest_min_s", [](SyntheticCorpusOptions& o) { o.rest_min_s = -1.0; }},
+      {"target_duration_s", [](SyntheticCorpusOptions& o) { o.target_duration_s = 101 * 3600.0; }},
+      {"target_duration_s", [](SyntheticCorpusOptions& o) { o.target_duration_s = NAN; }},
+      {"max_clip_duration_s", [](SyntheticCorpusOptions& o) { o.max_clip_duration_s = 5.0; }},
+      {"threads", [](SyntheticCorpusOptions& o) { o.threads = -1; }},
+      {"script", [](SyntheticCorpusOptions& o) { o.script.clear(); }},
+      {"count", [](SyntheticCorpusOptions& o) { o.script[0].count = -1; }},
       {"script",
-       [](SyntheticLibraryOptions& o) {
+       [](SyntheticCorpusOptions& o) {
          o.script = {{SyntheticAction::kShrug, 0}};
        }},
       {"script may last",
-       [](SyntheticLibraryOptions& o) {
+       [](SyntheticCorpusOptions& o) {
          o.script = {{SyntheticAction::kSlouch, 1'000'000}};
        }},
   };
   for (const auto& [expected, change] : cases) {
-    SyntheticLibraryOptions options;
+    SyntheticCorpusOptions options;
     change(options);
-    const absl::StatusOr<SyntheticLibrary> library = GenerateSyntheticLibrary(options);
+    const absl::StatusOr<SyntheticCorpus> library = GenerateSyntheticCorpus(options);
     EXPECT_EQ(library.status().code(), absl::StatusCode::kInvalidArgument) << expected;
     EXPECT_NE(library.status().message().find(expected), absl::string_view::npos)
         << library.status();

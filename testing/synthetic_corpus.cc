@@ -1,4 +1,4 @@
-#include "testing/synthetic_library.h"
+#include "testing/synthetic_corpus.h"
 
 #include <algorithm>
 #include <cmath>
@@ -53,7 +53,7 @@ absl::Status CheckOrdered(absl::string_view low_name, double low, absl::string_v
   return absl::OkStatus();
 }
 
-absl::Status ValidateOptions(const SyntheticLibraryOptions& options) {
+absl::Status ValidateOptions(const SyntheticCorpusOptions& options) {
   MOTIONDB_RETURN_IF_ERROR(CheckFinite("fps", options.fps));
   if (options.fps <= 0.0 || options.fps > kMaxFps) {
     return absl::InvalidArgumentError(
@@ -148,7 +148,7 @@ std::vector<SyntheticScriptStep> ThesisSyntheticScript() {
           {SyntheticAction::kSlouch, 10}};
 }
 
-absl::StatusOr<SyntheticLibrary> GenerateSyntheticLibrary(const SyntheticLibraryOptions& options) {
+absl::StatusOr<SyntheticCorpus> GenerateSyntheticCorpus(const SyntheticCorpusOptions& options) {
   MOTIONDB_RETURN_IF_ERROR(ValidateOptions(options));
   // Every draw happens here, in one sequence, before any rendering: the clips then depend only
   // on the plan, whatever the thread count.
@@ -164,7 +164,7 @@ absl::StatusOr<SyntheticLibrary> GenerateSyntheticLibrary(const SyntheticLibrary
   const int threads = options.threads > 0
                           ? options.threads
                           : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  SyntheticLibrary library;
+  SyntheticCorpus library;
   MOTIONDB_ASSIGN_OR_RETURN(library.clips,
                             synthetic::RenderClips(sway, options.fps, plans, layout, threads));
   library.segments = synthetic::Segments(plans, layout);
