@@ -107,9 +107,6 @@ SearchHit HitOf(const SearchResult& result, const SpaceSnapshot& snapshot) {
   return hit;
 }
 
-// ValidateSearchParams' bound on max_results.
-constexpr int kMaxResults = 10'000;
-
 // A stored query's own clip and range, for exclude_query.
 struct OwnRange {
   int64_t clip_id = 0;
@@ -131,8 +128,7 @@ absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const
   const int wanted = params.max_results;
   int extra = own ? 4 : 0;
   while (true) {
-    // Past ValidateSearchParams' bound the search would still run, but no client asks that.
-    params.max_results = std::min(wanted + extra, kMaxResults);
+    params.max_results = std::min(wanted + extra, kMaxSearchResults);
     MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
                               exact ? ExactSearch(*snapshot.index, query.rows(), params)
                                     : Search(*snapshot.index, query.rows(), params));
@@ -146,7 +142,7 @@ absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const
     const bool exhausted = static_cast<int>(found.results.size()) < params.max_results;
     // At most a few rounds: the query's overlaps are few after overlap suppression.
     if (static_cast<int>(hits.size()) >= wanted || exhausted || extra >= 256 ||
-        params.max_results == kMaxResults) {
+        params.max_results == kMaxSearchResults) {
       if (static_cast<int>(hits.size()) > wanted) hits.resize(wanted);
       return hits;
     }

@@ -32,7 +32,7 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (params.slope_limit < 1 || params.slope_limit > kMaxSlopeLimit) {
     return OutOfRange("slope_limit", params.slope_limit, absl::StrCat("1..", kMaxSlopeLimit));
   }
-  if (params.max_results < 1 || params.max_results > 10'000) {
+  if (params.max_results < 1 || params.max_results > kMaxSearchResults) {
     return OutOfRange("max_results", params.max_results, "1..10000");
   }
   if (!std::isfinite(params.cluster_gap_s) || params.cluster_gap_s < 0 ||

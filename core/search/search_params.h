@@ -20,6 +20,9 @@ enum class NeutralPose {
   kOrigin,        // the space origin: the training set's mean pose
 };
 
+// The most results one search returns (max_results' upper bound).
+inline constexpr int kMaxSearchResults = 10'000;
+
 struct SearchParams {
   // Dimensions of the nearest-neighbour seed search (the index's kd-tree dimensions: others
   // fall back to a linear scan).
