@@ -63,7 +63,6 @@ struct ListFlags {
 };
 
 absl::Status ListClips(const ListFlags& flags, bool json, const ServerConnection& connection) {
-  const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::ListClipsRequest request;
   request.set_page_size(flags.limit.value_or(1000));
   request.set_page_token(flags.page_token);
@@ -75,11 +74,10 @@ absl::Status ListClips(const ListFlags& flags, bool json, const ServerConnection
   bool first_page = true;
   v1::ListClipsResponse response;
   do {
-    response.Clear();
-    MOTIONDB_RETURN_IF_ERROR(Call(
-        connection,
-        [&](grpc::ClientContext* context) { return stub->ListClips(context, request, &response); },
-        {{"page_size", "--limit"}, {"page_token", "--page-token"}, {"sort", "--sort"}}));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        response,
+        CallUnary(connection, &v1::ClipService::Stub::ListClips, request,
+                  {{"page_size", "--limit"}, {"page_token", "--page-token"}, {"sort", "--sort"}}));
     if (first_page && !json) {
       absl::PrintF("%8s  %-40s %8s %8s %8s %9s  %s\n", "ID", "NAME", "SKELETON", "FRAMES", "FPS",
                    "SECONDS", "TAGS");
@@ -109,11 +107,9 @@ absl::Status ListClips(const ListFlags& flags, bool json, const ServerConnection
 }
 
 absl::Status ListSkeletons(bool json, const ServerConnection& connection) {
-  const auto stub = v1::ClipService::NewStub(connection.channel());
-  v1::ListSkeletonsResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->ListSkeletons(context, v1::ListSkeletonsRequest(), &response);
-  }));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::ListSkeletonsResponse response,
+      CallUnary(connection, &v1::ClipService::Stub::ListSkeletons, v1::ListSkeletonsRequest()));
   if (json) {
     nlohmann::json skeletons = nlohmann::json::array();
     for (const v1::Skeleton& skeleton : response.skeletons()) {
@@ -135,13 +131,10 @@ absl::Status ListSkeletons(bool json, const ServerConnection& connection) {
 }
 
 absl::Status ShowClip(int64_t id, bool json, const ServerConnection& connection) {
-  const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::GetClipRequest request;
   request.set_clip_id(id);
-  v1::Clip clip;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->GetClip(context, request, &clip);
-  }));
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::Clip clip,
+                            CallUnary(connection, &v1::ClipService::Stub::GetClip, request));
   PrintClip(clip, json);
   return absl::OkStatus();
 }
@@ -165,24 +158,18 @@ absl::Status UpdateClip(const UpdateFlags& flags, bool json, const ServerConnect
                        absl::StrCat("--tag ", tag));
     *(add ? request.add_add_tags() : request.add_remove_tags()) = tag.substr(1);
   }
-  const auto stub = v1::ClipService::NewStub(connection.channel());
-  v1::Clip clip;
-  MOTIONDB_RETURN_IF_ERROR(Call(
-      connection,
-      [&](grpc::ClientContext* context) { return stub->UpdateClip(context, request, &clip); },
-      names));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::Clip clip,
+      CallUnary(connection, &v1::ClipService::Stub::UpdateClip, request, names));
   PrintClip(clip, json);
   return absl::OkStatus();
 }
 
 absl::Status DeleteClip(int64_t id, bool json, const ServerConnection& connection) {
-  const auto stub = v1::ClipService::NewStub(connection.channel());
   v1::DeleteClipRequest request;
   request.set_clip_id(id);
-  v1::DeleteClipResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->DeleteClip(context, request, &response);
-  }));
+  MOTIONDB_RETURN_IF_ERROR(
+      CallUnary(connection, &v1::ClipService::Stub::DeleteClip, request).status());
   if (json) {
     std::cout << nlohmann::json{{"deleted", id}}.dump() << "\n";
   } else {
@@ -202,12 +189,10 @@ absl::Status Export(const ExportFlags& flags, bool json, const ServerConnection&
   request.mutable_clip()->set_clip_id(flags.id);
   if (flags.range.from) request.mutable_clip()->set_first_frame(*flags.range.from);
   if (flags.range.to) request.mutable_clip()->set_last_frame(*flags.range.to);
-  const auto stub = v1::ClipService::NewStub(connection.channel());
-  v1::ExportClipResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(
-      connection,
-      [&](grpc::ClientContext* context) { return stub->ExportClip(context, request, &response); },
-      {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"}}));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::ExportClipResponse response,
+      CallUnary(connection, &v1::ClipService::Stub::ExportClip, request,
+                {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"}}));
   MOTIONDB_RETURN_IF_ERROR(WriteFileAtomically(flags.out, response.bvh()));
   if (json) {
     std::cout << nlohmann::json{{"file", flags.out},

@@ -14,11 +14,9 @@ namespace motiondb::cli {
 namespace {
 
 absl::Status Info(bool json, const ServerConnection& connection) {
-  const auto stub = v1::ServerService::NewStub(connection.channel());
-  v1::ServerInfo info;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->GetServerInfo(context, v1::GetServerInfoRequest(), &info);
-  }));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::ServerInfo info,
+      CallUnary(connection, &v1::ServerService::Stub::GetServerInfo, v1::GetServerInfoRequest()));
   const v1::DatabaseCounts& c = info.counts();
   if (json) {
     nlohmann::json indices = nlohmann::json::array();

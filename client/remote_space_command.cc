@@ -146,22 +146,17 @@ void PrintSpaceOrJson(const v1::Space& space, bool json) {
 
 absl::Status Create(const CreateFlags& flags, bool json, const ServerConnection& connection) {
   MOTIONDB_ASSIGN_OR_RETURN(const v1::CreateSpaceRequest request, CreateRequest(flags));
-  const auto stub = v1::SpaceService::NewStub(connection.channel());
-  v1::Space space;
-  MOTIONDB_RETURN_IF_ERROR(Call(
-      connection,
-      [&](grpc::ClientContext* context) { return stub->CreateSpace(context, request, &space); },
-      CreateFlagNames(flags)));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::Space space,
+      CallUnary(connection, &v1::SpaceService::Stub::CreateSpace, request, CreateFlagNames(flags)));
   PrintSpaceOrJson(space, json);
   return absl::OkStatus();
 }
 
 absl::Status List(bool json, const ServerConnection& connection) {
-  const auto stub = v1::SpaceService::NewStub(connection.channel());
-  v1::ListSpacesResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->ListSpaces(context, v1::ListSpacesRequest(), &response);
-  }));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::ListSpacesResponse response,
+      CallUnary(connection, &v1::SpaceService::Stub::ListSpaces, v1::ListSpacesRequest()));
   nlohmann::json spaces = nlohmann::json::array();
   for (const v1::Space& space : response.spaces()) {
     if (json) {
@@ -177,25 +172,19 @@ absl::Status List(bool json, const ServerConnection& connection) {
 }
 
 absl::Status Show(const std::string& name, bool json, const ServerConnection& connection) {
-  const auto stub = v1::SpaceService::NewStub(connection.channel());
   v1::GetSpaceRequest request;
   request.set_name(name);
-  v1::Space space;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->GetSpace(context, request, &space);
-  }));
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::Space space,
+                            CallUnary(connection, &v1::SpaceService::Stub::GetSpace, request));
   PrintSpaceOrJson(space, json);
   return absl::OkStatus();
 }
 
 absl::Status Delete(const std::string& name, bool json, const ServerConnection& connection) {
-  const auto stub = v1::SpaceService::NewStub(connection.channel());
   v1::DeleteSpaceRequest request;
   request.set_name(name);
-  v1::DeleteSpaceResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(connection, [&](grpc::ClientContext* context) {
-    return stub->DeleteSpace(context, request, &response);
-  }));
+  MOTIONDB_RETURN_IF_ERROR(
+      CallUnary(connection, &v1::SpaceService::Stub::DeleteSpace, request).status());
   std::cout << (json ? nlohmann::json{{"deleted", name}}.dump()
                      : absl::StrCat("deleted space ", name))
             << "\n";

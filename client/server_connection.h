@@ -63,6 +63,23 @@ absl::Status Call(const ServerConnection& connection,
                   const std::function<grpc::Status(grpc::ClientContext*)>& rpc,
                   const FlagNames& flags = {});
 
+// One unary RPC of a generated stub, e.g. CallUnary(connection, &v1::ClipService::Stub::GetClip,
+// request): its answer, or Call's error.
+template <typename Stub, typename Request, typename Response>
+absl::StatusOr<Response> CallUnary(const ServerConnection& connection,
+                                   grpc::Status (Stub::*rpc)(grpc::ClientContext*, const Request&,
+                                                             Response*),
+                                   const Request& request, const FlagNames& flags = {}) {
+  Stub stub(connection.channel());
+  Response response;
+  const absl::Status status = Call(
+      connection,
+      [&](grpc::ClientContext* context) { return (stub.*rpc)(context, request, &response); },
+      flags);
+  if (!status.ok()) return status;
+  return response;
+}
+
 }  // namespace motiondb::cli
 
 #endif  // MOTIONDB_CLIENT_SERVER_CONNECTION_H_
