@@ -5,7 +5,7 @@
 // anchored at the action's peak (the thesis's manual characteristic point).
 //
 // usage: search_latency [--scenario 70s120|1h30|10h30|10h120|sweeps|all] [--queries N]
-//          [--exact-queries N]
+//          [--exact-queries N] [--places N ...]
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <string>
 
+#include "absl/strings/str_cat.h"
 #include "bench/measure.h"
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
@@ -147,8 +148,26 @@ double RecallAtTen(const Run& fast, const Run& exact) {
   return total > 0 ? static_cast<double>(found) / total : 0.0;
 }
 
+// The fast search as configured by default (the thesis's seeds, refined), without
+// refinement, and with distinct places as seeds: 128 of them and the --places values.
+std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int>& compare) {
+  SearchParams unrefined;
+  unrefined.refine = false;
+  std::vector<std::pair<std::string, SearchParams>> variants = {{"fast", {}},
+                                                                {"fast, no refinement", unrefined}};
+  std::vector<int> places = {SearchParams().places};
+  places.insert(places.end(), compare.begin(), compare.end());
+  for (int count : places) {
+    SearchParams params;
+    params.seed_selection = SeedSelection::kDistinctPlaces;
+    params.places = count;
+    variants.emplace_back(absl::StrCat("fast, ", count, " distinct places"), params);
+  }
+  return variants;
+}
+
 absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
-                      int exact_queries) {
+                      int exact_queries, const std::vector<int>& compare) {
   MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(duration_s, rate, 16, queries));
   const LibraryIndex& library = *bench.library;
   const double indexed_mib = library.total_frames() * library.ann_dims() * 4 / 1048576.0;
@@ -164,20 +183,17 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
       library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
       library.tree_bytes() / 1048576.0 / indexed_mib, library.coordinate_bytes() / 1048576.0,
       bench.build_rss_mib);
-  SearchParams thesis;
-  thesis.refine = false;
-  MOTIONDB_ASSIGN_OR_RETURN(const Run fast, RunQueries(bench, {}, false, queries, 3));
-  MOTIONDB_ASSIGN_OR_RETURN(const Run unrefined, RunQueries(bench, thesis, false, queries, 3));
   MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, exact_queries, 1));
-  for (const auto& [label, run] :
-       {std::pair<const char*, const Run&>{"fast", fast}, {"fast, no refinement", unrefined}}) {
+  for (const auto& [label, params] : Variants(compare)) {
+    MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
     std::printf(
         "%s: p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f refine %.3f "
         "ranking %.3f ms | %.0f seeds, %.1f clusters, %.1f warps, %.1f results | recall@10 vs "
         "exact %.3f\n",
-        label, Percentile(run.latencies, 0.5), Percentile(run.latencies, 0.99), run.seeds_ms,
-        run.clusters_ms, run.warps_ms, run.refine_ms, run.ranking_ms, run.seeds, run.clusters,
-        run.warps, run.results, RecallAtTen(run, exact));
+        label.c_str(), Percentile(run.latencies, 0.5), Percentile(run.latencies, 0.99),
+        run.seeds_ms, run.clusters_ms, run.warps_ms, run.refine_ms, run.ranking_ms, run.seeds,
+        run.clusters, run.warps, run.results, RecallAtTen(run, exact));
+    std::fflush(stdout);
   }
   std::printf("exact: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
@@ -220,12 +236,12 @@ absl::Status Sweeps(int queries) {
   return absl::OkStatus();
 }
 
-absl::Status Main(const std::string& scenario, int q, int e) {
+absl::Status Main(const std::string& scenario, int q, int e, const std::vector<int>& p) {
   const auto wants = [&](const char* name) { return scenario == "all" || scenario == name; };
-  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e));
-  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e));
-  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e));
-  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e));
+  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e, p));
+  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e, p));
+  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e, p));
+  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e, p));
   if (wants("sweeps")) MOTIONDB_RETURN_IF_ERROR(Sweeps(q));
   return absl::OkStatus();
 }
@@ -250,10 +266,14 @@ int main(int argc, char** argv) {
       ->type_name("N")
       ->capture_default_str()
       ->check(motiondb::cli::WholeAtLeast(0));
+  std::vector<int> places;
+  app.add_option("--places", places, "also measure the fast search with these numbers of places")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
-  const absl::Status status = motiondb::Main(scenario, queries, exact_queries);
+  const absl::Status status = motiondb::Main(scenario, queries, exact_queries, places);
   if (!status.ok()) {
     std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());
     return 1;

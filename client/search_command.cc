@@ -24,7 +24,8 @@ struct SearchFlags {
   std::optional<int64_t> clip;
   std::string bvh;
   FrameRangeFlags range;
-  std::optional<int> neighbours, ann_dims, dtw_dims, slope, max, char_frame;
+  std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, exact_threads;
+  std::string seeds = "frames";
   std::optional<double> epsilon;
   std::string neutral = "mean";
   bool exact = false, path = false, no_refine = false;
@@ -46,7 +47,9 @@ struct Parameter {
   void (v1::SearchRequest::*set)(int32_t);
 };
 constexpr Parameter kParameters[] = {
-    {"--neighbours", "neighbours", "K", "1000", "seeds: library frames nearest the char. pose",
+    {"--places", "places", "N", "128", "--seeds places: distinct places, one warp each",
+     &SearchFlags::places, &v1::SearchRequest::set_places},
+    {"--neighbours", "neighbours", "K", "1000", "--seeds frames: nearest frames, clustered",
      &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours},
     {"--ann-dims", "ann_dims", "N", "10", "dimensions of the seed search", &SearchFlags::ann_dims,
      &v1::SearchRequest::set_ann_dims},
@@ -63,7 +66,8 @@ FlagNames SearchFlagNames(const SearchFlags& flags) {
   FlagNames names = {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"},
                      {"bvh.first_frame", "--from"},  {"bvh.last_frame", "--to"},
                      {"bvh", "--bvh " + flags.bvh},  {"characteristic_frame", "--char-frame"},
-                     {"epsilon", "--epsilon"},       {"neutral", "--neutral"}};
+                     {"epsilon", "--epsilon"},       {"neutral", "--neutral"},
+                     {"exact_threads", "--threads"}};
   for (const Parameter& parameter : kParameters) names.push_back({parameter.field, parameter.flag});
   return names;
 }
@@ -86,6 +90,9 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
     if (const std::optional<int>& value = flags.*parameter.value) (request.*parameter.set)(*value);
   }
   if (flags.char_frame) request.set_characteristic_frame(*flags.char_frame);
+  if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
+  request.set_seed_selection(flags.seeds == "places" ? v1::SEED_SELECTION_DISTINCT_PLACES
+                                                     : v1::SEED_SELECTION_NEAREST_FRAMES);
   if (flags.epsilon) request.set_epsilon(static_cast<float>(*flags.epsilon));
   request.set_neutral(flags.neutral == "boundary" ? v1::NEUTRAL_POSE_BOUNDARY_MEAN
                       : flags.neutral == "origin" ? v1::NEUTRAL_POSE_ORIGIN
@@ -133,12 +140,9 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
 
 absl::Status Search(const SearchFlags& flags, bool json, const ServerConnection& connection) {
   MOTIONDB_ASSIGN_OR_RETURN(const v1::SearchRequest request, BuildRequest(flags));
-  const auto stub = v1::SearchService::NewStub(connection.channel());
-  v1::SearchResponse response;
-  MOTIONDB_RETURN_IF_ERROR(Call(
-      connection,
-      [&](grpc::ClientContext* context) { return stub->Search(context, request, &response); },
-      SearchFlagNames(flags)));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::SearchResponse response,
+      CallUnary(connection, &v1::SearchService::Stub::Search, request, SearchFlagNames(flags)));
   if (json) {
     std::cout << ResponseJson(response).dump() << "\n";
     return absl::OkStatus();
@@ -203,7 +207,15 @@ void AddSearch(Commands& commands) {
                            "auto --char-frame: the pose farthest from this"),
         {"mean", "boundary", "origin"})
       ->capture_default_str();
+  OneOf(search->add_option("--seeds", flags->seeds,
+                           "seeds: the thesis's nearest frames, or distinct places"),
+        {"frames", "places"})
+      ->capture_default_str();
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
+  search->add_option("--threads", flags->exact_threads, "--exact: threads scanning the library")
+      ->type_name("N")
+      ->default_str("0 = one per core")
+      ->check(WholeAtLeast(0));
   search->add_flag("--no-refine", flags->no_refine,
                    "the thesis's search as is (faster, lower recall)");
   search
@@ -220,6 +232,7 @@ void AddSearch(Commands& commands) {
       ->allow_extra_args(false);
   search->footer(
       "Unset parameters take the server's defaults, the thesis's (Table 6.2), shown here.\n"
+      "--seeds places: warps from distinct places (higher recall in hours of capture, slower).\n"
       "--ann-dims and --dtw-dims are at most the space's dimensions. --neutral: the query's\n"
       "mean pose, the mean of its first and last poses, or the space's origin. --no-refine\n"
       "skips re-warping each candidate free of its seed. --exact ignores the seed parameters.\n"

@@ -172,7 +172,10 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--bvh FILE",
                              "--from F=0",
                              "--to T=last",
+                             "--seeds frames|places=frames",
+                             "--places N=128",
                              "--neighbours K=1000",
+                             "--threads N=0 = one per core",
                              "--ann-dims N=10",
                              "--dtw-dims N=5",
                              "--slope S=2",
@@ -348,6 +351,33 @@ TEST_F(CliServerTest, SearchRowsShowTheClipId) {
   EXPECT_TRUE(std::regex_search(
       r.out, std::regex("\n +1 +" + clip_id_ + " +walk54 +[0-9.]+ +[0-9.]+ +[0-9]+-[0-9]+ ")))
       << r.out;
+}
+
+// Both seed selections and a threaded exact search answer through the CLI; the query finds
+// itself first in each. The server's range errors name the CLI's flags.
+TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--seeds", "places", "--places", "16"},
+        {"--seeds", "frames", "--neighbours", "200"},
+        {"--exact", "--threads", "2"}}) {
+    std::vector<std::string> args = {"search", "--space",         "body",  "--clip",
+                                     clip_id_, "--from",          "10",    "--to",
+                                     "40",     "--include-query", "--json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const testing::CommandResult r = Remote(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json found = nlohmann::json::parse(r.out);
+    ASSERT_FALSE(found["results"].empty()) << r.out;
+    EXPECT_EQ(found["results"][0]["start_frame"].get<int>(), 10) << extra[0] << " " << r.out;
+  }
+  const testing::CommandResult places = Remote(
+      {"search", "--space", "body", "--clip", clip_id_, "--seeds", "places", "--places", "200000"});
+  EXPECT_EQ(places.exit_code, 1);
+  EXPECT_THAT(places.err, HasSubstr("--places 200000 is out of range; expected 1..100000"));
+  const testing::CommandResult threads =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--exact", "--threads", "5000"});
+  EXPECT_EQ(threads.exit_code, 1);
+  EXPECT_THAT(threads.err, HasSubstr("--threads 5000 is out of range"));
 }
 
 TEST_F(CliServerTest, SearchLeavesOutTheQuerysOwnRangeUnlessAskedToKeepIt) {

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/index/internal/distinct_places.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -59,6 +60,13 @@ class LibraryIndex::Tree {
       result[i] = {static_cast<int64_t>(indices[i]), std::sqrt(squared[i])};
     }
     return result;
+  }
+
+  // Every row nearer than `places`' worst, offered to it (rows numbered from 0).
+  void Offer(const float* point, float epsilon, flann::ResultSet<float>& places) const {
+    flann::SearchParams params;
+    params.eps = epsilon;
+    index_.findNeighbors(places, point, params);
   }
 
   // FLANN's own count (node pool and index permutation) plus its row-pointer table.
@@ -262,10 +270,7 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
     if (allowed_clips.empty()) return TreeNearest(point, dims, k, epsilon);
     // When the filter keeps most frames, ask the tree for enough extra neighbours to cover the
     // filtered-out ones (doubling a few times), and scan only if that is not enough.
-    int64_t allowed_frames = 0;
-    for (int c = 0; c < clip_count(); ++c) {
-      if (allowed_clips[c]) allowed_frames += clips_[c].frame_count;
-    }
+    const int64_t allowed_frames = AllowedFrames(allowed_clips);
     int64_t wanted =
         k + (k * (total_frames() - allowed_frames)) / std::max<int64_t>(1, allowed_frames) + 16;
     for (int attempt = 0; allowed_frames * 2 >= total_frames() && attempt < 4; ++attempt) {
@@ -292,6 +297,39 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
   std::partial_sort(all.begin(), all.begin() + keep, all.end(), Nearer);
   all.resize(keep);
   return all;
+}
+
+int64_t LibraryIndex::AllowedFrames(const std::vector<bool>& allowed_clips) const {
+  if (allowed_clips.empty()) return total_frames_;
+  int64_t frames = 0;
+  for (int c = 0; c < clip_count(); ++c) {
+    if (allowed_clips[c]) frames += clips_[c].frame_count;
+  }
+  return frames;
+}
+
+std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims, int k,
+                                                   int64_t separation, float epsilon,
+                                                   const std::vector<bool>& allowed_clips) const {
+  const auto clip_of = [this](int64_t frame) { return Locate(frame).first; };
+  DistinctPlaces places(k, separation, clip_of, allowed_clips);
+  if (dims == options_.ann_dims && AllowedFrames(allowed_clips) * 2 >= total_frames_) {
+    for (const auto& block : blocks_) {
+      places.set_first_frame(block->first_frame);
+      block->tree->Offer(point, epsilon, places);
+    }
+    return places.Take();
+  }
+  for (int c = 0; c < clip_count(); ++c) {
+    if (!allowed_clips.empty() && !allowed_clips[c]) continue;
+    const CoordinateView view = clip_coordinates(c);
+    places.set_first_frame(clips_[c].first_frame);
+    for (int64_t f = 0; f < view.rows; ++f) {
+      const float distance = Distance(point, view.row(f), dims);
+      places.addPoint(distance * distance, static_cast<size_t>(f));
+    }
+  }
+  return places.Take();
 }
 
 int64_t LibraryIndex::coordinate_bytes() const {

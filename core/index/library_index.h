@@ -99,6 +99,16 @@ class LibraryIndex {
   std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
                                  const std::vector<bool>& allowed_clips) const;
 
+  // The k nearest *places*: frames near `point` (over its first `dims` coordinates) of which
+  // no two of one clip lie within `separation` frames, nearest first; a frame is kept unless a
+  // nearer kept frame lies within `separation`, and drops the farther ones there (so a long
+  // valley of the distance over time gives a place every `separation` frames, not one a frame).
+  // Which frames are kept can depend on the order they are met in, so the kd-tree (used when
+  // dims == ann_dims() and the allowed clips hold at least half the frames) and the linear
+  // scan may differ where such chains meet.
+  std::vector<Neighbour> NearestPlaces(const float* point, int dims, int k, int64_t separation,
+                                       float epsilon, const std::vector<bool>& allowed_clips) const;
+
   // Bytes held: the coordinate blocks and the kd-trees.
   int64_t coordinate_bytes() const;
   int64_t tree_bytes() const;
@@ -111,6 +121,8 @@ class LibraryIndex {
   // their entries.
   void AddBlock(std::vector<LibraryClip> clips, int64_t first_frame);
   void AddEntry(ClipEntry entry, int block);
+  // Frames of the allowed clips (empty: all).
+  int64_t AllowedFrames(const std::vector<bool>& allowed_clips) const;
   // The k nearest over the kd-trees of every block, merged.
   std::vector<Neighbour> TreeNearest(const float* point, int dims, int k, float epsilon) const;
 

@@ -1,10 +1,15 @@
 #include "core/search/exact_search.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <mutex>
+#include <thread>
 
+#include "absl/functional/function_ref.h"
 #include "core/search/internal/search_query.h"
 #include "util/status_macros.h"
 
@@ -35,13 +40,16 @@ class ClipScan {
   }
 
   // Runs over every column, offering each end frame's best path to `top`.
-  absl::Status Run(int clip_index, const SearchParams& params, StreamingTopResults& top,
-                   SearchStats& stats) {
+  // `bound()` is a cost that no result of other clips at or above it can rank with: paths
+  // that cannot stay below it and below the clip's own k-th best are dropped.
+  absl::Status Run(int clip_index, const SearchParams& params, absl::FunctionRef<float()> bound,
+                   StreamingTopResults& top, SearchStats& stats) {
+    const auto threshold = [&] { return std::min(top.threshold(), bound()); };
     for (int64_t j = 0; j < clip_.rows; ++j) {
       if (j % kBlock == 0) {
         if ((j / kBlock) % 256 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
         BlockLowerBound(j);
-        if (!AnyAlive() && lower_bound_[0] >= top.threshold()) {
+        if (!AnyAlive() && lower_bound_[0] >= threshold()) {
           // No path can start in this block and beat the k-th best: skip it.
           const int64_t skip = std::min(kBlock, clip_.rows - j);
           for (int64_t k = 0; k < std::min<int64_t>(skip, s_ + 1); ++k) {
@@ -52,7 +60,7 @@ class ClipScan {
           continue;
         }
       }
-      const float end_cost = FillColumn(j, top.threshold(), stats);
+      const float end_cost = FillColumn(j, threshold(), stats);
       if (end_cost < kInfinity) {
         const Warp warp{
             ring_[j % ring_.size()].best_start, j, end_cost / static_cast<double>(m_), {}};
@@ -185,6 +193,46 @@ class ClipScan {
   std::vector<float> box_low_, box_high_;
 };
 
+// The k best results of the clips scanned so far, shared by the scanning threads, and the
+// warp cost bound they set for the clips still being scanned. Thread-safe.
+//
+// Each clip is scanned with its own streaming top (its results depend on the clip alone) and
+// pruned by this bound besides. Pruning drops only paths that cost at least the bound, and the
+// bound (the k-th best of finished clips, which can only fall) is never below the final k-th
+// best: the results that rank are the same whatever the order and the number of threads.
+class FinishedClips {
+ public:
+  FinishedClips(int k, int64_t query_rows) : k_(k), query_rows_(query_rows) {}
+
+  float bound() const { return bound_.load(std::memory_order_relaxed); }
+
+  void Add(std::vector<SearchResult> results) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::move(results.begin(), results.end(), std::back_inserter(best_));
+    // Results of different clips never overlap, and one clip's never overlap each other.
+    best_ = RankResults(std::move(best_), /*max_overlap=*/1.0, k_);
+    if (static_cast<int>(best_.size()) == k_) {
+      // Loosened a little, so that float rounding never prunes a path that ties the k-th.
+      bound_.store(static_cast<float>(best_.back().score * query_rows_ * (1 + 1e-5)),
+                   std::memory_order_relaxed);
+    }
+  }
+
+  std::vector<SearchResult> Take() { return std::move(best_); }
+
+ private:
+  const int k_;
+  const int64_t query_rows_;
+  std::mutex mutex_;
+  std::vector<SearchResult> best_;
+  std::atomic<float> bound_{kInfinity};
+};
+
+int ScanThreads(const SearchParams& params, int clips) {
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::clamp(params.exact_threads > 0 ? params.exact_threads : cores, 1, clips);
+}
+
 }  // namespace
 
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
@@ -193,14 +241,38 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
   SearchResponse response;
   const auto warps = std::chrono::steady_clock::now();
-  StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
-  for (int c = 0; c < library.clip_count(); ++c) {
-    if (!allowed.empty() && !allowed[c]) continue;
-    ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
-    MOTIONDB_RETURN_IF_ERROR(scan.Run(c, params, top, response.stats));
+  FinishedClips finished(params.max_results, query.rows);
+  std::atomic<int> next_clip{0};
+  std::atomic<bool> failed{false};
+  const int threads = ScanThreads(params, library.clip_count());
+  std::vector<absl::Status> statuses(threads);
+  std::vector<SearchStats> stats(threads);
+  const auto scan_clips = [&](int thread) {
+    for (int c = next_clip++; c < library.clip_count() && !failed; c = next_clip++) {
+      if (!allowed.empty() && !allowed[c]) continue;
+      StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
+      ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
+      statuses[thread] = scan.Run(
+          c, params, [&] { return finished.bound(); }, top, stats[thread]);
+      if (!statuses[thread].ok()) {
+        failed = true;
+        return;
+      }
+      finished.Add(top.Take());
+    }
+  };
+  {
+    std::vector<std::jthread> helpers;
+    for (int t = 1; t < threads; ++t) helpers.emplace_back(scan_clips, t);
+    scan_clips(0);
+  }
+  for (int t = 0; t < threads; ++t) {
+    MOTIONDB_RETURN_IF_ERROR(statuses[t]);
+    response.stats.cells += stats[t].cells;
+    response.stats.pruned_blocks += stats[t].pruned_blocks;
   }
   response.stats.warps_ms = MillisecondsSince(warps);
-  response.results = FinishResults(library, top.Take(), params);
+  response.results = FinishResults(library, finished.Take(), params);
   response.stats.total_ms = MillisecondsSince(start);
   return response;
 }

@@ -8,7 +8,8 @@
 // (a partial path whose cost already exceeds the current k-th best total is dropped) and a
 // lower bound per block of clip frames (the distance of every query frame to the bounding box of
 // the frames a path from that block can reach; blocks whose bound exceeds the k-th best are
-// skipped). Non-overlap selection is greedy over the streamed per-end-frame optima.
+// skipped). Non-overlap selection is greedy over the streamed per-end-frame optima of each
+// clip. Clips are scanned on `exact_threads` threads; the results do not depend on how many.
 #ifndef MOTIONDB_CORE_SEARCH_EXACT_SEARCH_H_
 #define MOTIONDB_CORE_SEARCH_EXACT_SEARCH_H_
 
@@ -20,8 +21,9 @@
 
 namespace motiondb {
 
-// Uses dtw_dims, slope_limit, max_results, max_overlap, the filters and should_stop of
-// `params`; the seed parameters do not apply. Thread-safe like Search().
+// Uses dtw_dims, slope_limit, max_results, max_overlap, exact_threads, the filters and
+// should_stop (called from every scanning thread) of `params`; the seed parameters do not
+// apply. Thread-safe like Search().
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
                                            const SearchParams& params);
 

@@ -26,6 +26,12 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (params.neighbours < 1 || params.neighbours > 1'000'000) {
     return OutOfRange("neighbours", params.neighbours, "1..1000000");
   }
+  if (params.places < 1 || params.places > 100'000) {
+    return OutOfRange("places", params.places, "1..100000");
+  }
+  if (params.exact_threads < 0 || params.exact_threads > 1024) {
+    return OutOfRange("exact_threads", params.exact_threads, "0..1024 (0: one per core)");
+  }
   if (!std::isfinite(params.epsilon) || params.epsilon < 0) {
     return OutOfRange("epsilon", params.epsilon, "a finite value >= 0");
   }

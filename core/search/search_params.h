@@ -20,6 +20,18 @@ enum class NeutralPose {
   kOrigin,        // the space origin: the training set's mean pose
 };
 
+// How the fast search picks the library frames its warps are anchored at.
+enum class SeedSelection {
+  // The thesis (6.2.2-6.2.3): the `neighbours` nearest frames, clustered in time. They pile up
+  // in the instances that hold the pose longest, so recall falls as the library grows.
+  kNearestFrames,
+  // The `places` nearest places to the characteristic pose, a quarter of the query's length
+  // apart in a clip (LibraryIndex::NearestPlaces), one warp each: higher recall on large
+  // libraries for more warps (bench/RESULTS.md, issue 11: 0.78 against 0.70 at 1 h, 1.6x the
+  // time), so not yet the default.
+  kDistinctPlaces,
+};
+
 // The most results one search returns (max_results' upper bound).
 inline constexpr int kMaxSearchResults = 10'000;
 
@@ -27,7 +39,10 @@ struct SearchParams {
   // Dimensions of the nearest-neighbour seed search (the index's kd-tree dimensions: others
   // fall back to a linear scan).
   int ann_dims = kDefaultAnnDims;
-  // Seeds: nearest library frames to the characteristic pose.
+  SeedSelection seed_selection = SeedSelection::kNearestFrames;
+  // kDistinctPlaces: seeds, one warp each.
+  int places = 128;
+  // kNearestFrames: seeds, nearest library frames to the characteristic pose.
   int neighbours = 1000;
   // Approximation bound of the seed search (0 = exact).
   float epsilon = 0.0f;
@@ -49,6 +64,8 @@ struct SearchParams {
   // (core/warp_refinement.h): a warp pinned to a seed in a held pose can score far worse than
   // the best warp beside it. false runs the thesis's algorithm as is.
   bool refine = true;
+  // Exact search: threads scanning the library's clips (0: one per core).
+  int exact_threads = 0;
   // Return each result's warp path (one library frame per query frame).
   bool return_path = false;
   // Only clips with these ids (empty: all clips).

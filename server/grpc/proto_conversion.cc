@@ -26,6 +26,18 @@ absl::StatusOr<NeutralPose> FromProto(v1::NeutralPose neutral) {
   }
 }
 
+absl::StatusOr<SeedSelection> FromProto(v1::SeedSelection selection) {
+  switch (selection) {
+    case v1::SEED_SELECTION_UNSPECIFIED:
+    case v1::SEED_SELECTION_NEAREST_FRAMES:
+      return SeedSelection::kNearestFrames;
+    case v1::SEED_SELECTION_DISTINCT_PLACES:
+      return SeedSelection::kDistinctPlaces;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("seed_selection: unknown value ", selection));
+  }
+}
+
 absl::StatusOr<WeightPreset> FromProto(v1::WeightPreset preset) {
   switch (preset) {
     case v1::WEIGHT_PRESET_UNSPECIFIED:
@@ -104,7 +116,10 @@ std::optional<T> Optional(bool has, T value) {
 // Only what the request sets replaces SearchParams' defaults.
 absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
   SearchParams params;
+  MOTIONDB_ASSIGN_OR_RETURN(params.seed_selection, FromProto(request.seed_selection()));
+  if (request.has_places()) params.places = request.places();
   if (request.has_neighbours()) params.neighbours = request.neighbours();
+  if (request.has_exact_threads()) params.exact_threads = request.exact_threads();
   if (request.has_epsilon()) params.epsilon = request.epsilon();
   if (request.has_slope_limit()) params.slope_limit = request.slope_limit();
   if (request.has_max_results()) params.max_results = request.max_results();
