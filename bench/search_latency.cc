@@ -183,7 +183,23 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
       library.ann_dims(), indexed_mib, library.tree_bytes() / 1048576.0,
       library.tree_bytes() / 1048576.0 / indexed_mib, library.coordinate_bytes() / 1048576.0,
       bench.build_rss_mib);
-  MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, {}, true, exact_queries, 1));
+  // The exact search on one thread, then on two, over the same queries.
+  SearchParams one_thread, two_threads;
+  one_thread.exact_threads = 1;
+  two_threads.exact_threads = 2;
+  MOTIONDB_ASSIGN_OR_RETURN(const Run exact, RunQueries(bench, one_thread, true, exact_queries, 1));
+  MOTIONDB_ASSIGN_OR_RETURN(const Run exact2,
+                            RunQueries(bench, two_threads, true, exact_queries, 1));
+  bool same = exact.responses.size() == exact2.responses.size();
+  for (size_t q = 0; same && q < exact.responses.size(); ++q) {
+    const std::vector<SearchResult>&a = exact.responses[q].results,
+          &b = exact2.responses[q].results;
+    same = a.size() == b.size();
+    for (size_t i = 0; same && i < a.size(); ++i) {
+      same = a[i].clip_index == b[i].clip_index && a[i].first_frame == b[i].first_frame &&
+             a[i].last_frame == b[i].last_frame && a[i].score == b[i].score;
+    }
+  }
   for (const auto& [label, params] : Variants(compare)) {
     MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
     std::printf(
@@ -195,9 +211,13 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
         run.clusters, run.warps, run.results, RecallAtTen(run, exact));
     std::fflush(stdout);
   }
-  std::printf("exact: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
+  std::printf("exact, 1 thread: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
               exact.latencies.size(), exact.results);
+  std::printf("exact, 2 threads: p50 %.1f ms  p99 %.1f ms | %.2fx | results %s\n",
+              Percentile(exact2.latencies, 0.5), Percentile(exact2.latencies, 0.99),
+              Percentile(exact.latencies, 0.5) / Percentile(exact2.latencies, 0.5),
+              same ? "identical" : "DIFFER");
   std::fflush(stdout);
   return absl::OkStatus();
 }

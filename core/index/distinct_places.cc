@@ -11,7 +11,13 @@ DistinctPlaces::DistinctPlaces(int k, int64_t separation, absl::FunctionRef<int(
     : k_(k), separation_(std::max<int64_t>(1, separation)), clip_of_(clip_of), allowed_(allowed) {}
 
 float DistinctPlaces::worstDist() const {
-  return full() ? by_distance_.rbegin()->first : std::numeric_limits<float>::max();
+  if (!full()) return std::numeric_limits<float>::max();
+  PopRemoved();
+  return farthest_.top().first;
+}
+
+void DistinctPlaces::PopRemoved() const {
+  while (!farthest_.empty() && !places_[farthest_.top().second].kept) farthest_.pop();
 }
 
 void DistinctPlaces::addPoint(float squared, size_t row) {
@@ -21,39 +27,44 @@ void DistinctPlaces::addPoint(float squared, size_t row) {
   if (!allowed_.empty() && !allowed_[clip]) return;
   // Kept places within `separation` lie in this bucket or the two beside it.
   const int64_t bucket = frame / separation_;
-  std::vector<int> farther;
+  int farther[3];
+  int farther_count = 0;
   for (int64_t b = bucket - 1; b <= bucket + 1; ++b) {
     const auto it = buckets_.find(Bucket{clip, b});
     if (it == buckets_.end()) continue;
-    for (int id : it->second) {
-      const Place& place = places_[id];
-      if (std::abs(place.frame - frame) >= separation_) continue;
-      if (std::make_pair(place.squared, place.frame) <= std::make_pair(squared, frame)) return;
-      farther.push_back(id);
-    }
+    const Place& place = places_[it->second];
+    if (std::abs(place.frame - frame) >= separation_) continue;
+    if (std::make_pair(place.squared, place.frame) <= std::make_pair(squared, frame)) return;
+    farther[farther_count++] = it->second;
   }
-  for (int id : farther) Remove(id);
+  for (int i = 0; i < farther_count; ++i) Remove(farther[i]);
   const int id = static_cast<int>(places_.size());
-  places_.push_back({frame, clip, squared});
-  by_distance_.emplace(squared, id);
-  buckets_[Bucket{clip, bucket}].push_back(id);
-  if (static_cast<int>(by_distance_.size()) > k_) Remove(by_distance_.rbegin()->second);
+  places_.push_back({frame, clip, squared, true});
+  farthest_.emplace(squared, id);
+  buckets_[Bucket{clip, bucket}] = id;
+  if (++kept_ > k_) {
+    PopRemoved();
+    Remove(farthest_.top().second);
+  }
 }
 
 void DistinctPlaces::Remove(int id) {
-  const Place& place = places_[id];
-  by_distance_.erase({place.squared, id});
-  const auto it = buckets_.find(Bucket{place.clip, place.frame / separation_});
-  std::erase(it->second, id);
-  if (it->second.empty()) buckets_.erase(it);
+  Place& place = places_[id];
+  place.kept = false;
+  --kept_;
+  buckets_.erase(Bucket{place.clip, place.frame / separation_});
 }
 
 std::vector<Neighbour> DistinctPlaces::Take() const {
-  std::vector<Neighbour> nearest;
-  nearest.reserve(by_distance_.size());
-  for (const auto& [squared, id] : by_distance_) {
-    nearest.push_back({places_[id].frame, std::sqrt(squared)});
+  std::vector<std::pair<float, int64_t>> kept;
+  kept.reserve(kept_);
+  for (const Place& place : places_) {
+    if (place.kept) kept.emplace_back(place.squared, place.frame);
   }
+  std::sort(kept.begin(), kept.end());
+  std::vector<Neighbour> nearest;
+  nearest.reserve(kept.size());
+  for (const auto& [squared, frame] : kept) nearest.push_back({frame, std::sqrt(squared)});
   return nearest;
 }
 

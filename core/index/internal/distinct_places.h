@@ -9,7 +9,7 @@
 #define MOTIONDB_CORE_INDEX_INTERNAL_DISTINCT_PLACES_H_
 
 #include <cstdint>
-#include <set>
+#include <queue>
 #include <utility>
 #include <vector>
 
@@ -32,7 +32,7 @@ class DistinctPlaces final : public flann::ResultSet<float> {
   void set_first_frame(int64_t first_frame) { first_frame_ = first_frame; }
 
   // flann::ResultSet: distances are squared; `row` is relative to set_first_frame().
-  bool full() const override { return static_cast<int>(by_distance_.size()) == k_; }
+  bool full() const override { return kept_ == k_; }
   float worstDist() const override;
   void addPoint(float squared, size_t row) override;
 
@@ -44,9 +44,12 @@ class DistinctPlaces final : public flann::ResultSet<float> {
     int64_t frame;
     int clip;
     float squared;
+    bool kept;
   };
   using Bucket = std::pair<int, int64_t>;  // (clip, frame / separation)
 
+  // Drops kept places from the top of the heap.
+  void PopRemoved() const;
   void Remove(int id);
 
   int k_;
@@ -54,9 +57,13 @@ class DistinctPlaces final : public flann::ResultSet<float> {
   absl::FunctionRef<int(int64_t)> clip_of_;
   const std::vector<bool>& allowed_;
   int64_t first_frame_ = 0;
-  std::vector<Place> places_;                              // by id; removed ones stay, unlisted
-  std::set<std::pair<float, int>> by_distance_;            // (squared, id) of the kept places
-  absl::flat_hash_map<Bucket, std::vector<int>> buckets_;  // kept ids by time bucket
+  int kept_ = 0;
+  std::vector<Place> places_;  // by id; removed ones stay, marked
+  // (squared, id), farthest on top; removed places leave lazily.
+  mutable std::priority_queue<std::pair<float, int>> farthest_;
+  // The kept place of each time bucket: frames of one bucket are closer than `separation`, so
+  // a bucket holds one at most.
+  absl::flat_hash_map<Bucket, int> buckets_;
 };
 
 }  // namespace motiondb
