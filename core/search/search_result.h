@@ -26,10 +26,12 @@ struct SearchResult {
 struct SearchStats {
   int characteristic_frame = -1;  // query frame at the space rate
   int64_t seeds = 0;
-  int64_t clusters = 0;       // cluster representatives, each the anchor of one warp
-  int64_t warps = 0;          // warps completed (inside their clip, not abandoned)
-  int64_t cells = 0;          // exact mode: DTW cells evaluated
-  int64_t pruned_blocks = 0;  // exact mode: column blocks skipped by the lower bound
+  int64_t clusters = 0;  // cluster representatives, each the anchor of one warp
+  int64_t warps = 0;     // warps completed (inside their clip, not abandoned)
+  // Exact mode: DTW cells evaluated and column blocks skipped by the lower bound; on several
+  // threads they depend on which clips finish first.
+  int64_t cells = 0;
+  int64_t pruned_blocks = 0;
   // Milliseconds per stage; the exact mode has one stage, its warps, and leaves the others 0.
   double characteristic_ms = 0;
   double seeds_ms = 0;
