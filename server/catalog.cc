@@ -114,7 +114,8 @@ absl::Status Catalog::IndexIngested(
 }
 
 absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& record,
-                                                 const Clip& clip, OnConflict on_conflict) {
+                                                 const Clip& clip, OnConflict on_conflict,
+                                                 const std::function<bool()>& should_stop) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   // Decided before the projections are computed, which a skip or a refusal does not need. The
   // database checks the name again in the insert's transaction.
@@ -139,8 +140,9 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
   }
   storage::InsertClipOptions options;
   if (replaced) options.replace_clip_id = replaced->clip_id;
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t clip_id,
-                            database_.InsertClip(record, clip, projections, options));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const int64_t clip_id,
+      database_.InsertClip(record, clip, projections, options, {.should_stop = should_stop}));
   IngestedClip ingested;
   MOTIONDB_ASSIGN_OR_RETURN(ingested.record, database_.GetClipRecord(clip_id));
   if (replaced) {
@@ -162,19 +164,21 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
   return ingested;
 }
 
-absl::Status Catalog::DeleteClip(int64_t clip_id) {
+absl::Status Catalog::DeleteClip(int64_t clip_id, const std::function<bool()>& should_stop) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record, database_.GetClipRecord(clip_id));
-  MOTIONDB_RETURN_IF_ERROR(database_.DeleteClip(clip_id));
+  MOTIONDB_RETURN_IF_ERROR(database_.DeleteClip(clip_id, {.should_stop = should_stop}));
   return ChangeIndices(record.skeleton_id, [&](const SpaceSnapshot& space) {
     return SnapshotWithoutClip(space, clip_id);
   });
 }
 
 absl::StatusOr<storage::ClipRecord> Catalog::UpdateClip(int64_t clip_id,
-                                                        const storage::ClipUpdate& update) {
+                                                        const storage::ClipUpdate& update,
+                                                        const std::function<bool()>& should_stop) {
   std::lock_guard<std::mutex> lock(write_mutex_);
-  MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record, database_.UpdateClip(clip_id, update));
+  MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record,
+                            database_.UpdateClip(clip_id, update, {.should_stop = should_stop}));
   MOTIONDB_RETURN_IF_ERROR(ChangeIndices(record.skeleton_id, [&](const SpaceSnapshot& space) {
     return SnapshotWithClipInfo(space, clip_id, record.name, record.tags);
   }));
@@ -195,8 +199,9 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::CreateSpace(
   for (IndexedClip& clip : built.clips) {
     projections.push_back({clip.clip.clip_id, std::move(clip.clip.coordinates)});
   }
-  MOTIONDB_ASSIGN_OR_RETURN(built.record.space_id,
-                            database_.InsertSpace(built.record, *built.space, projections));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      built.record.space_id,
+      database_.InsertSpace(built.record, *built.space, projections, {.should_stop = should_stop}));
   for (size_t i = 0; i < built.clips.size(); ++i) {
     built.clips[i].clip.coordinates = std::move(projections[i].coordinates);
   }
@@ -213,9 +218,10 @@ absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::CreateSpace(
   return *std::move(snapshot);
 }
 
-absl::Status Catalog::DeleteSpace(const std::string& name) {
+absl::Status Catalog::DeleteSpace(const std::string& name,
+                                  const std::function<bool()>& should_stop) {
   std::lock_guard<std::mutex> lock(write_mutex_);
-  MOTIONDB_RETURN_IF_ERROR(database_.DeleteSpace(name));
+  MOTIONDB_RETURN_IF_ERROR(database_.DeleteSpace(name, {.should_stop = should_stop}));
   registry_.Remove(name);
   return absl::OkStatus();
 }

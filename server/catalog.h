@@ -6,6 +6,10 @@
 //
 // Writes are serialised by one mutex: an ingest must see every space of its skeleton, and a new
 // space must see every clip, so they cannot interleave. Reads do not take it.
+//
+// Every write takes a `should_stop` (the call's deadline or cancellation, server/grpc's
+// StopWhenCallEnds), asked just before the database commits: true rolls the write back and
+// returns CANCELLED, with the database and the indices as they were.
 #ifndef MOTIONDB_SERVER_CATALOG_H_
 #define MOTIONDB_SERVER_CATALOG_H_
 
@@ -68,17 +72,18 @@ class Catalog {
   // database and in every resident index. The database assigns the clip's id, skeleton,
   // creation time and content hash.
   absl::StatusOr<IngestedClip> IngestClip(const storage::ClipRecord& record, const Clip& clip,
-                                          OnConflict on_conflict = OnConflict::kSkipIdentical);
-  absl::Status DeleteClip(int64_t clip_id);
+                                          OnConflict on_conflict = OnConflict::kSkipIdentical,
+                                          const std::function<bool()>& should_stop = {});
+  absl::Status DeleteClip(int64_t clip_id, const std::function<bool()>& should_stop = {});
   // Renames and re-tags a clip (storage::Database::UpdateClip's rules and errors), and gives
   // every space of its skeleton a snapshot that shows the new name and tags.
-  absl::StatusOr<storage::ClipRecord> UpdateClip(int64_t clip_id,
-                                                 const storage::ClipUpdate& update);
+  absl::StatusOr<storage::ClipRecord> UpdateClip(int64_t clip_id, const storage::ClipUpdate& update,
+                                                 const std::function<bool()>& should_stop = {});
 
-  // `should_stop` is polled between clips while the space is built (CANCELLED).
+  // `should_stop` is also polled between clips while the space is built.
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> CreateSpace(
       const SpaceRequest& request, const std::function<bool()>& should_stop);
-  absl::Status DeleteSpace(const std::string& name);
+  absl::Status DeleteSpace(const std::string& name, const std::function<bool()>& should_stop = {});
 
  private:
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> LoadSpace(

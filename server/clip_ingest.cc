@@ -22,14 +22,16 @@ absl::StatusOr<std::string> ClipName(const IngestRequest& request) {
 }
 
 absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
-                                           absl::string_view bvh, const UploadLimits& limits) {
+                                           absl::string_view bvh, const UploadLimits& limits,
+                                           const std::function<bool()>& should_stop) {
   storage::ClipRecord record;
   MOTIONDB_ASSIGN_OR_RETURN(record.name, ClipName(request));
   record.source_file = request.file_name;
   record.tags = request.tags;
   MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
-  MOTIONDB_ASSIGN_OR_RETURN(IngestedClip ingested,
-                            catalog.IngestClip(record, read.clip, request.on_conflict));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      IngestedClip ingested,
+      catalog.IngestClip(record, read.clip, request.on_conflict, should_stop));
   IngestOutcome outcome;
   outcome.clip = std::move(ingested.record);
   outcome.result = ingested.result;

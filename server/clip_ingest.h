@@ -3,6 +3,7 @@
 #ifndef MOTIONDB_SERVER_CLIP_INGEST_H_
 #define MOTIONDB_SERVER_CLIP_INGEST_H_
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,9 +40,11 @@ struct IngestOutcome {
 // leaves no name. Lengths and characters of names and tags are the database's to check.
 absl::StatusOr<std::string> ClipName(const IngestRequest& request);
 
-// Parses, stores and indexes one uploaded file, or skips it (Catalog::IngestClip).
+// Parses, stores and indexes one uploaded file, or skips it (Catalog::IngestClip, which asks
+// `should_stop` before it commits).
 absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
-                                           absl::string_view bvh, const UploadLimits& limits);
+                                           absl::string_view bvh, const UploadLimits& limits,
+                                           const std::function<bool()>& should_stop = {});
 
 }  // namespace motiondb::server
 

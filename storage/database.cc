@@ -101,7 +101,8 @@ Database::Impl::Impl(const std::string& path, int busy_timeout_ms,
                      std::unique_ptr<SqliteConnection> writer)
     : writer_(std::move(writer)), readers_(path, busy_timeout_ms, kMaxIdleReaders) {}
 
-absl::Status Database::Impl::Write(const std::function<absl::Status(SqliteConnection&)>& body) {
+absl::Status Database::Impl::Write(const WriteOptions& write,
+                                   const std::function<absl::Status(SqliteConnection&)>& body) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   absl::StatusOr<SqliteTransaction> transaction =
       SqliteTransaction::Begin(*writer_, SqliteTransaction::Kind::kWrite);
@@ -112,6 +113,10 @@ absl::Status Database::Impl::Write(const std::function<absl::Status(SqliteConnec
   }
   if (!transaction.ok()) return transaction.status();
   MOTIONDB_RETURN_IF_ERROR(body(*writer_));
+  // Asked as late as possible: the call may end while the write waited for the lock or ran.
+  if (write.should_stop && write.should_stop()) {
+    return absl::CancelledError("the call ended before the write committed; nothing was written");
+  }
   return transaction->Commit();
 }
 

@@ -3,7 +3,8 @@
 // (serialised), each clip's cached projection per space, and labels.
 //
 // Every multi-row write is one transaction: a crash at any point loses no acknowledged write
-// and leaves no half-written clip or space. Open() runs an integrity check.
+// and leaves no half-written clip or space. Every write takes WriteOptions, whose should_stop
+// rolls it back when asked just before the commit. Open() runs an integrity check.
 //
 // Thread-safe: methods may be called from any thread; writes are serialised, reads run
 // concurrently on their own connections. One writer connection behind a mutex runs every write
@@ -19,6 +20,7 @@
 #define MOTIONDB_STORAGE_DATABASE_H_
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -59,6 +61,13 @@ struct ClipRecord {
   std::string content_hash;
 };
 
+// What every write may be told. A write is checked once its transaction is ready to commit, so
+// that a call that ended first (its deadline passed, its client gone) changes nothing.
+struct WriteOptions {
+  // True rolls the write back: CANCELLED, nothing written. Empty: never.
+  std::function<bool()> should_stop;
+};
+
 struct InsertClipOptions {
   // A clip that the new one replaces: it is deleted, with its projections and labels, in the
   // insert's transaction, so that a crash leaves the old clip or the new one, never neither.
@@ -68,11 +77,11 @@ struct InsertClipOptions {
 
 // What UpdateClip changes; what is left unset or empty stays.
 struct ClipUpdate {
-  std::optional<std::string> name;
-  std::vector<std::string> add_tags;
+  std::optional<std::string> name{};
+  std::vector<std::string> add_tags{};
   // Tags the clip lacks are ignored. Only required to be non-empty, so that a tag stored before
   // the character rules can still be removed.
-  std::vector<std::string> remove_tags;
+  std::vector<std::string> remove_tags{};
 };
 
 struct StoredClip {
@@ -149,7 +158,8 @@ class Database {
   // its space. Projection::clip_id is ignored here.
   absl::StatusOr<int64_t> InsertClip(const ClipRecord& record, const Clip& clip,
                                      const std::vector<std::pair<int64_t, Projection>>& projections,
-                                     const InsertClipOptions& options = {});
+                                     const InsertClipOptions& options = {},
+                                     const WriteOptions& write = {});
   // The skeleton id a clip of this topology has or would get (-1 when none is stored yet).
   absl::StatusOr<int64_t> FindSkeleton(const Skeleton& skeleton);
   absl::StatusOr<StoredClip> GetClip(int64_t clip_id);  // NOT_FOUND
@@ -162,7 +172,8 @@ class Database {
   // for an unknown clip; ALREADY_EXISTS when another clip has the name; INVALID_ARGUMENT naming
   // the field for a name or added tag that InsertClip would refuse, an empty removed tag, a tag
   // both added and removed, or more than 64 tags in the end. Nothing changes on error.
-  absl::StatusOr<ClipRecord> UpdateClip(int64_t clip_id, const ClipUpdate& update);
+  absl::StatusOr<ClipRecord> UpdateClip(int64_t clip_id, const ClipUpdate& update,
+                                        const WriteOptions& write = {});
   // Clips in id order; optionally only those carrying `tag`. page_size 0 means 100; outside
   // 0-1000, or a malformed page_token: INVALID_ARGUMENT.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const std::string& tag = "");
@@ -171,18 +182,20 @@ class Database {
   // order is INVALID_ARGUMENT.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const ClipFilter& filter);
   // Deletes the clip, its projections and labels. NOT_FOUND when absent.
-  absl::Status DeleteClip(int64_t clip_id);
+  absl::Status DeleteClip(int64_t clip_id, const WriteOptions& write = {});
 
   // Stores a space built on `skeleton_id` with the projections of every clip of that skeleton,
   // in one transaction. ALREADY_EXISTS when a space of that name exists; NOT_FOUND for an
   // unknown skeleton or clip; FAILED_PRECONDITION when the space's topology is not the
   // skeleton's, or `projections` misses a clip of the skeleton or names one of another.
   absl::StatusOr<int64_t> InsertSpace(const SpaceRecord& record, const MotionSpace& space,
-                                      const std::vector<Projection>& projections);
+                                      const std::vector<Projection>& projections,
+                                      const WriteOptions& write = {});
   absl::StatusOr<SpaceRecord> GetSpaceRecord(const std::string& name);  // NOT_FOUND
   absl::StatusOr<MotionSpace> GetSpace(int64_t space_id);
   absl::StatusOr<std::vector<SpaceRecord>> ListSpaces();
-  absl::Status DeleteSpace(const std::string& name);  // and its projections
+  // And its projections. NOT_FOUND when absent.
+  absl::Status DeleteSpace(const std::string& name, const WriteOptions& write = {});
   // Every cached projection of a space, in clip id order (loaded at start, not recomputed).
   absl::StatusOr<std::vector<Projection>> LoadProjections(int64_t space_id);
   // Ids of the clips of a skeleton, in id order.

@@ -199,7 +199,7 @@ absl::Status InsertProjectionsOfClip(
 absl::StatusOr<int64_t> Database::InsertClip(
     const ClipRecord& record, const Clip& clip,
     const std::vector<std::pair<int64_t, Projection>>& projections,
-    const InsertClipOptions& options) {
+    const InsertClipOptions& options, const WriteOptions& write) {
   MOTIONDB_RETURN_IF_ERROR(CheckClipName(record.name));
   MOTIONDB_RETURN_IF_ERROR(
       CheckName("source file name", record.source_file, kMaxNameBytes, /*may_be_empty=*/true));
@@ -225,7 +225,7 @@ absl::StatusOr<int64_t> Database::InsertClip(
   const int64_t now = CreationTime(record.created_unix_ms);
 
   int64_t clip_id = 0;
-  MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+  MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     if (options.replace_clip_id != 0) {
       MOTIONDB_RETURN_IF_ERROR(
           DeleteClipRow(db, options.replace_clip_id,
@@ -350,10 +350,11 @@ absl::StatusOr<std::vector<ClipRecord>> Database::FindClipsByContentHash(
   return records;
 }
 
-absl::StatusOr<ClipRecord> Database::UpdateClip(int64_t clip_id, const ClipUpdate& update) {
+absl::StatusOr<ClipRecord> Database::UpdateClip(int64_t clip_id, const ClipUpdate& update,
+                                                const WriteOptions& write) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> add_tags, CheckClipUpdate(update));
   ClipRecord updated;
-  MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+  MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(const ClipRecord current, ClipRecordById(db, clip_id));
     if (update.name && *update.name != current.name) {
       MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "clips", "clip", *update.name));
@@ -435,8 +436,8 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter&
   return result;
 }
 
-absl::Status Database::DeleteClip(int64_t clip_id) {
-  return impl_->Write([&](SqliteConnection& db) -> absl::Status {
+absl::Status Database::DeleteClip(int64_t clip_id, const WriteOptions& write) {
+  return impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     return DeleteClipRow(db, clip_id, absl::StrCat("clip ", clip_id, " not found"));
   });
 }

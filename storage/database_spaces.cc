@@ -72,7 +72,8 @@ absl::Status InsertProjectionsOfSpace(SqliteConnection& db, int64_t space_id, in
 }  // namespace
 
 absl::StatusOr<int64_t> Database::InsertSpace(const SpaceRecord& record, const MotionSpace& space,
-                                              const std::vector<Projection>& projections) {
+                                              const std::vector<Projection>& projections,
+                                              const WriteOptions& write) {
   MOTIONDB_RETURN_IF_ERROR(CheckName("space name", record.name, kMaxNameBytes));
   if (record.version < 1) {
     return absl::InvalidArgumentError(
@@ -93,7 +94,7 @@ absl::StatusOr<int64_t> Database::InsertSpace(const SpaceRecord& record, const M
   const int64_t now = CreationTime(record.created_unix_ms);
 
   int64_t space_id = 0;
-  MOTIONDB_RETURN_IF_ERROR(impl_->Write([&](SqliteConnection& db) -> absl::Status {
+  MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "spaces", "space", record.name));
     MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id,
                               SkeletonOfSpace(db, record.skeleton_id, space, key, now));
@@ -163,8 +164,8 @@ absl::StatusOr<std::vector<SpaceRecord>> Database::ListSpaces() {
   return records;
 }
 
-absl::Status Database::DeleteSpace(const std::string& name) {
-  return impl_->Write([&](SqliteConnection& db) -> absl::Status {
+absl::Status Database::DeleteSpace(const std::string& name, const WriteOptions& write) {
+  return impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement erase,
                               db.Prepare("DELETE FROM spaces WHERE name = ?"));
     return DeleteRow(db, erase.BindText(1, name), absl::StrCat("space '", name, "' not found"));

@@ -221,6 +221,14 @@ std::vector<MalformedCase> MalformedCases() {
        Replace(minimal, "1.0 90.0", "1.0 -inf"),
        absl::StatusCode::kInvalidArgument,
        {"line 19", "value 2 is -inf"}},
+      {"HugeRotation",
+       Replace(minimal, "50.0", "1e308"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 19", "value 8 (Chest Yrotation) is 1e308 degrees", "beyond +-100000"}},
+      {"RotationJustBeyondTheBound",
+       Replace(minimal, "10.0 20.0", "-100000.5 20.0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 19", "value 4 (Hips Zrotation) is -100000.5"}},
       {"NaNOffset",
        Replace(minimal, "0.0 5.5 0.0", "0.0 NaN 0.0"),
        absl::StatusCode::kInvalidArgument,
@@ -322,6 +330,25 @@ TEST(BvhReaderLimits, MoreRowsThanTheFrameLimitAreRefused) {
   absl::StatusOr<BvhReadResult> result = Read(Replace(kMinimal, "Frames: 2", "Frames: 1"), options);
   EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
   EXPECT_THAT(std::string(result.status().message()), HasSubstr("line 20"));
+}
+
+// Many turns within the bound keep their meaning: 270 + 138 x 720 degrees is 270 degrees (an even
+// number of turns, so the same quaternion, not its negation).
+TEST(BvhReaderLimits, RotationsWithinTheBoundKeepTheirAngle) {
+  absl::StatusOr<BvhReadResult> wound = Read(Replace(kMinimal, "10.0 20.0", "99630.0 20.0"));
+  absl::StatusOr<BvhReadResult> plain = Read(Replace(kMinimal, "10.0 20.0", "270.0 20.0"));
+  ASSERT_TRUE(wound.ok()) << wound.status();
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_TRUE(wound->clip.rotations().isApprox(plain->clip.rotations(), 1e-9));
+}
+
+TEST(BvhReaderLimits, TheRotationBoundIsAnOption) {
+  BvhReadOptions options;
+  options.max_abs_rotation_degrees = 45;
+  absl::StatusOr<BvhReadResult> result = Read(kMinimal, options);
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(result.status().message()),
+              HasSubstr("line 19: value 8 (Chest Yrotation) is 50.0"));
 }
 
 TEST(BvhReaderLimits, TooManyJointsAreRefused) {

@@ -1425,6 +1425,83 @@ TEST_F(ServerTest, DeadlineStopsALongExactSearch) {
   EXPECT_LT(std::stod(line[1]), deadline.count() + (full_ms - deadline.count()) / 2);
 }
 
+// The server's log once it holds `count` lines of `method` (waiting up to 30 s for a call that
+// outlives its client's deadline).
+std::string LogWithCalls(const ServerProcess& server, const std::string& method, int count) {
+  std::string log;
+  for (int i = 0; i < 1500; ++i) {
+    log = server.Log();
+    int found = 0;
+    for (size_t at = log.find(method + " "); at != std::string::npos;
+         at = log.find(method + " ", at + 1)) {
+      ++found;
+    }
+    if (found >= count) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return log;
+}
+
+int64_t ClipCount(Client& client) {
+  v1::ListClipsResponse page;
+  const grpc::Status status =
+      client.clips().ListClips(client.Context().get(), v1::ListClipsRequest(), &page);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  return page.clips_size();
+}
+
+// A write whose call ends before it commits is rolled back; it used to be stored, so that a
+// client told DEADLINE_EXCEEDED retried into ALREADY_EXISTS.
+TEST_F(ServerTest, WritesPastTheirDeadlineAreRolledBack) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  // 20'000 frames (2.6 MB): parsing alone outlasts a 1 ms deadline.
+  const std::string bvh = BvhText(testing::MakeClip(
+      testing::ChainSkeleton(), 20'000, 1.0 / 30,
+      [](int f, int j) {
+        return Quat(Eigen::AngleAxisd(0.01 * f * (j + 1), Eigen::Vector3d::UnitY()));
+      },
+      [](int f, int) { return Eigen::Vector3d(0.1 * f, 90, 0); }));
+  v1::IngestClipRequest request;
+  request.set_file_name("long.bvh");
+  request.set_bvh(bvh);
+  constexpr int kAttempts = 3;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    v1::IngestClipResponse response;
+    const grpc::Status status = client.clips().IngestClip(
+        client.Context(std::chrono::milliseconds(1)).get(), request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  }
+  // Some of these reach their handler (which then parses for about 20 ms and rolls back), some
+  // end in transfer; which ones is not known here, so there is nothing to wait for but the
+  // stream below, which takes 1.5 s. A late commit could only make the test pass wrongly.
+
+  // A stream whose client stops before its last chunk, the file whole so far: the deadline ends
+  // the stream, which must not be taken for the end of the file.
+  auto context = client.Context(std::chrono::milliseconds(1000));
+  v1::IngestClipResponse streamed;
+  auto writer = client.clips().IngestClipStream(context.get(), &streamed);
+  v1::IngestClipStreamRequest whole;
+  whole.set_file_name("cut.bvh");
+  whole.set_chunk(bvh);
+  ASSERT_TRUE(writer->Write(whole));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(writer->Finish().error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  // The server may see the client's cancellation (sent when the client's timer fires) before
+  // its own deadline passes: CANCELLED or DEADLINE_EXCEEDED.
+  const std::string log = LogWithCalls(*server, "/motiondb.v1.ClipService/IngestClipStream", 1);
+  EXPECT_THAT(log, ::testing::ContainsRegex(
+                       "/motiondb.v1.ClipService/IngestClipStream (CANCELLED|DEADLINE_EXCEEDED)"));
+
+  EXPECT_EQ(ClipCount(client), 0) << log;
+  // The retry a client makes stores the clip, as new.
+  v1::IngestClipResponse stored;
+  ASSERT_TRUE(client.clips().IngestClip(client.Context().get(), request, &stored).ok());
+  EXPECT_EQ(stored.result(), v1::INGEST_RESULT_STORED);
+  EXPECT_EQ(ClipCount(client), 1);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Crash safety.
 

@@ -612,6 +612,53 @@ TEST_F(StorageSpaceTest, RejectedWritesChangeNothing) {
   EXPECT_EQ(testing::ReadFileOrDie(path_), file_before);
 }
 
+// A call that ended (deadline, cancellation) before its write committed: every write is rolled
+// back whole, the replaced clip of a replacing insert included, and the file is unchanged.
+TEST_F(StorageSpaceTest, WritesStoppedBeforeTheCommitChangeNothing) {
+  const int64_t walk = Insert(Named("walk", {"a"}), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  ASSERT_TRUE(
+      Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)}).ok());
+  const Counts before = CountsNow();
+  Close();
+  const std::string file_before = testing::ReadFileOrDie(path_);
+
+  int asked = 0;
+  const WriteOptions stop{.should_stop = [&asked] {
+    ++asked;
+    return true;
+  }};
+  const std::vector<std::pair<int64_t, Projection>> walk_projection = {
+      {Db().GetSpaceRecord("body")->space_id, ProjectionOf(0, walk_)}};
+  const std::vector<absl::Status> stopped = {
+      Db().InsertClip(Named("walk2"), walk_, walk_projection, {}, stop).status(),
+      Db().InsertClip(Named("walk"), walk_, walk_projection, {.replace_clip_id = walk}, stop)
+          .status(),
+      Db().UpdateClip(walk, {.name = "renamed", .add_tags = {"b"}}, stop).status(),
+      Db().DeleteClip(walk, stop),
+      Db().InsertSpace(SpaceNamed("body2", skeleton), space_, {ProjectionOf(walk, walk_)}, stop)
+          .status(),
+      Db().DeleteSpace("body", stop)};
+  for (const absl::Status& status : stopped) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kCancelled) << status;
+    EXPECT_THAT(std::string(status.message()), HasSubstr("nothing was written"));
+  }
+  EXPECT_EQ(asked, static_cast<int>(stopped.size()));
+  // A refused write is refused for its own reason; the stop is asked only of a write that would
+  // commit.
+  EXPECT_EQ(Db().DeleteClip(4242, stop).code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(asked, static_cast<int>(stopped.size()));
+
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  EXPECT_EQ(Db().GetClipRecord(walk)->name, "walk");
+  Close();
+  EXPECT_EQ(testing::ReadFileOrDie(path_), file_before);
+  // Not stopped: the same writes commit.
+  const WriteOptions go{.should_stop = [] { return false; }};
+  EXPECT_TRUE(Db().UpdateClip(walk, {.name = "renamed"}, go).ok());
+  EXPECT_TRUE(Db().DeleteSpace("body", go).ok());
+}
+
 TEST_F(StorageTest, ClipNamesMayBeRelativePaths) {
   const Clip clip = Motion(testing::ChainSkeleton(), 4);
   const int64_t first = Insert(Named("session1/take_001"), clip);

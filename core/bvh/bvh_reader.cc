@@ -247,6 +247,11 @@ struct RowLayout {
     std::array<int, 3> position_channel{};  // value index of x, y, z
   };
   std::vector<JointLayout> joints;
+  struct Value {
+    int joint;
+    Channel channel;
+  };
+  std::vector<Value> value_channels;  // what each value of a row is, in file order
 
   explicit RowLayout(const Skeleton& skeleton) {
     int value = 0;
@@ -257,6 +262,7 @@ struct RowLayout {
       layout.position_slot = skeleton.position_slot(j);
       int rotations = 0;
       for (Channel c : skeleton.joint(j).channels) {
+        value_channels.push_back({j, c});
         const int axis = static_cast<int>(c) % 3;
         if (c >= Channel::kXrotation) {
           layout.rotation_channel[rotations++] = value;
@@ -373,6 +379,14 @@ absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scann
       if (count == channels) {
         return absl::InvalidArgumentError(
             absl::StrCat("line ", line, ": expected ", channels, " values, found more"));
+      }
+      if (const RowLayout::Value what = layout.value_channels[count];
+          what.channel >= Channel::kXrotation &&
+          std::abs(value) > options.max_abs_rotation_degrees) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "line ", line, ": value ", count + 1, " (", skeleton->joint(what.joint).name, " ",
+            ChannelName(what.channel), ") is ", absl::string_view(start, next - start),
+            " degrees; rotations beyond +-", options.max_abs_rotation_degrees, " are refused"));
       }
       values[count++] = value;
       p = next;

@@ -22,6 +22,10 @@ struct BvhReadOptions {
   int64_t max_frames = 10'000'000;
   // Hierarchies with more joints than this are refused.
   int max_joints = 1000;
+  // Rotation values beyond +-this many degrees are refused with their line: capture stays
+  // within a few turns, and an angle such as 1e308 keeps none of its digits through the sine
+  // and cosine (it would be stored, and exported, as some other angle).
+  double max_abs_rotation_degrees = 1e5;
 };
 
 struct BvhReadResult {

@@ -5,6 +5,7 @@
 
 #include "server/clip_export.h"
 #include "server/clip_ingest.h"
+#include "server/grpc/call_context.h"
 #include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
 #include "server/listing.h"
@@ -19,14 +20,15 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
     const absl::StatusOr<IngestRequest> ingest = FromProto(*request);
     if (!ingest.ok()) return ToGrpcStatus(ingest.status());
     const absl::StatusOr<IngestOutcome> outcome =
-        IngestUpload(catalog_, *ingest, request->bvh(), limits_);
-    if (!outcome.ok()) return ToGrpcStatus(outcome.status());
+        IngestUpload(catalog_, *ingest, request->bvh(), limits_, StopWhenCallEnds(context));
+    if (!outcome.ok()) return ToGrpcStatus(ExplainStop(outcome.status(), context));
     ToProto(*outcome, response);
     return grpc::Status::OK;
   });
 }
 
-absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+absl::Status ClipServiceImpl::ReadStream(const grpc::ServerContext* context,
+                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                                          v1::IngestClipResponse* response) {
   v1::IngestClipStreamRequest message;
   if (!reader->Read(&message)) {
@@ -41,8 +43,12 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStream
         CheckUploadSize(static_cast<int64_t>(bvh.size() + message.chunk().size()), limits_));
     bvh += message.chunk();
   } while (reader->Read(&message));
+  // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
+  // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
+  const std::function<bool()> should_stop = StopWhenCallEnds(context);
+  if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
   MOTIONDB_ASSIGN_OR_RETURN(const IngestOutcome outcome,
-                            IngestUpload(catalog_, request, bvh, limits_));
+                            IngestUpload(catalog_, request, bvh, limits_, should_stop));
   ToProto(outcome, response);
   return absl::OkStatus();
 }
@@ -50,8 +56,9 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerReader<v1::IngestClipStream
 grpc::Status ClipServiceImpl::IngestClipStream(
     grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
     v1::IngestClipResponse* response) {
-  return gate_.Run(context,
-                   [&]() -> grpc::Status { return ToGrpcStatus(ReadStream(reader, response)); });
+  return gate_.Run(context, [&]() -> grpc::Status {
+    return ToGrpcStatus(ExplainStop(ReadStream(context, reader, response), context));
+  });
 }
 
 grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
@@ -98,7 +105,8 @@ grpc::Status ClipServiceImpl::DeleteClip(grpc::ServerContext* context,
                                          const v1::DeleteClipRequest* request,
                                          v1::DeleteClipResponse* /*response*/) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    return ToGrpcStatus(catalog_.DeleteClip(request->clip_id()));
+    return ToGrpcStatus(
+        ExplainStop(catalog_.DeleteClip(request->clip_id(), StopWhenCallEnds(context)), context));
   });
 }
 
@@ -106,8 +114,8 @@ grpc::Status ClipServiceImpl::UpdateClip(grpc::ServerContext* context,
                                          const v1::UpdateClipRequest* request, v1::Clip* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::ClipRecord> updated =
-        catalog_.UpdateClip(request->clip_id(), FromProto(*request));
-    if (!updated.ok()) return ToGrpcStatus(updated.status());
+        catalog_.UpdateClip(request->clip_id(), FromProto(*request), StopWhenCallEnds(context));
+    if (!updated.ok()) return ToGrpcStatus(ExplainStop(updated.status(), context));
     ToProto(*updated, response);
     return grpc::Status::OK;
   });

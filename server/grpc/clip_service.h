@@ -36,7 +36,8 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                              v1::ListSkeletonsResponse* response) override;
 
  private:
-  absl::Status ReadStream(grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+  absl::Status ReadStream(const grpc::ServerContext* context,
+                          grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                           v1::IngestClipResponse* response);
 
   storage::Database& database_;

@@ -51,7 +51,8 @@ grpc::Status SpaceServiceImpl::DeleteSpace(grpc::ServerContext* context,
                                            const v1::DeleteSpaceRequest* request,
                                            v1::DeleteSpaceResponse* /*response*/) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    return ToGrpcStatus(catalog_.DeleteSpace(request->name()));
+    return ToGrpcStatus(
+        ExplainStop(catalog_.DeleteSpace(request->name(), StopWhenCallEnds(context)), context));
   });
 }
 

@@ -24,9 +24,11 @@ class Database::Impl {
   // `writer`: an open read-write connection to `path`, its file prepared (schema and pragmas).
   Impl(const std::string& path, int busy_timeout_ms, std::unique_ptr<SqliteConnection> writer);
 
-  // Runs `body` in one write transaction, committed when it succeeds and rolled back otherwise.
-  // UNAVAILABLE when another connection holds the write lock past the busy timeout.
-  absl::Status Write(const std::function<absl::Status(SqliteConnection&)>& body);
+  // Runs `body` in one write transaction, committed when it succeeds and `write.should_stop`
+  // does not say stop (CANCELLED), rolled back otherwise. UNAVAILABLE when another connection
+  // holds the write lock past the busy timeout.
+  absl::Status Write(const WriteOptions& write,
+                     const std::function<absl::Status(SqliteConnection&)>& body);
 
   // Runs `body` on a read connection, in one snapshot.
   absl::Status Read(const std::function<absl::Status(SqliteConnection&)>& body);
