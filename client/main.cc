@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   motiondb::cli::AddRemoteSpace(commands, space);
   motiondb::cli::AddSearch(commands);
   motiondb::cli::AddInfo(commands);
+  motiondb::cli::AddBackup(commands);
   commands.AddHelp();
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;

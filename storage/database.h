@@ -206,6 +206,13 @@ class Database {
 
   absl::StatusOr<Counts> GetCounts();
 
+  // Writes a consistent copy of the database to `path` (missing or empty; ALREADY_EXISTS
+  // otherwise) while writers go on: the copy is of one snapshot, taken during the call, so it
+  // holds every write acknowledged before the call began. Readers and writers do not wait for
+  // it (WAL); the log grows until the copy ends. The copy is a database file of its own, in WAL
+  // mode, which Open() opens. RESOURCE_EXHAUSTED when its disk is full; a failed copy is removed.
+  absl::Status Backup(const std::string& path);
+
  private:
   class Impl;
   explicit Database(std::unique_ptr<Impl> impl);

@@ -342,6 +342,33 @@ TEST_F(CliServerTest, OutOfRangeFramesAreToldInTheFlagsThatSetThem) {
   EXPECT_THAT(dims.err, Not(HasSubstr("ann_dims")));
 }
 
+// backup writes the copy under its name only when it is whole, refuses to overwrite without
+// --force, and a server started on the copy lists the same clip.
+TEST_F(CliServerTest, BackupWritesACopyAServerStartsOn) {
+  const std::string copy = (dir_ / "copy.sqlite").string();
+  const testing::CommandResult r = Remote({"backup", copy});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("1 clips (54 frames), 1 spaces"));
+  EXPECT_FALSE(std::filesystem::exists(copy + ".part"));
+  const std::string first = testing::ReadFileOrDie(copy);
+
+  const testing::CommandResult again = Remote({"backup", copy});
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_THAT(again.err, HasSubstr("exists; pass --force"));
+  EXPECT_EQ(testing::ReadFileOrDie(copy), first);
+  const testing::CommandResult forced = Remote({"backup", copy, "--force", "--json"});
+  ASSERT_EQ(forced.exit_code, 0) << forced.err;
+  const nlohmann::json summary = nlohmann::json::parse(forced.out);
+  EXPECT_EQ(summary["clips"], 1);
+  EXPECT_EQ(summary["bytes"], std::filesystem::file_size(copy));
+
+  testing::ServerProcess restored;
+  ASSERT_TRUE(StartServer(&restored, {"--db", copy}, ""));
+  const testing::CommandResult clips = RunCli({"clips", "--json", "--server", restored.address()});
+  ASSERT_EQ(clips.exit_code, 0) << clips.err;
+  EXPECT_THAT(clips.out, HasSubstr("walk54"));
+}
+
 TEST_F(CliServerTest, SearchRowsShowTheClipId) {
   const testing::CommandResult r = Remote({"search", "--space", "body", "--clip", clip_id_,
                                            "--from", "10", "--to", "40", "--include-query"});

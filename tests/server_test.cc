@@ -24,6 +24,7 @@
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "storage/sqlite_connection.h"
 #include "testing/server_process.h"
 #include "testing/synthetic_corpus.h"
 #include "tests/clip_builder.h"
@@ -172,10 +173,13 @@ class ServerTest : public ::testing::Test {
     std::filesystem::remove_all(dir_);
   }
 
-  // Starts a server on the test's database with `args`; null after a failed assertion.
+  // Starts a server with `args`, on the test's database unless they give --db; null after a
+  // failed assertion.
   ServerProcess* StartServer(std::vector<std::string> args = {}, const std::string& token = "",
                              bool tls = false) {
-    args.insert(args.begin(), {"--db", db_});
+    if (std::find(args.begin(), args.end(), "--db") == args.end()) {
+      args.insert(args.begin(), {"--db", db_});
+    }
     auto server = std::make_unique<ServerProcess>();
     std::string error;
     if (!server->Start(args, &error)) {
@@ -1500,6 +1504,83 @@ TEST_F(ServerTest, WritesPastTheirDeadlineAreRolledBack) {
   ASSERT_TRUE(client.clips().IngestClip(client.Context().get(), request, &stored).ok());
   EXPECT_EQ(stored.result(), v1::INGEST_RESULT_STORED);
   EXPECT_EQ(ClipCount(client), 1);
+}
+
+// A backup taken while a client ingests: the copy passes integrity_check, holds every clip
+// acknowledged before the backup began, and a server started on it serves the same searches.
+TEST_F(ServerTest, BackupWhileIngestingServesTheSameSearches) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  const SyntheticSegment& raise = FirstRaise();
+  const v1::SearchRequest query =
+      ClipQuery("body", ids[raise.clip], raise.first_frame, raise.last_frame);
+  v1::SearchResponse live;
+  ASSERT_TRUE(client.Search(query, &live).ok());
+
+  std::atomic<int64_t> acknowledged = static_cast<int64_t>(ids.size());
+  std::atomic<bool> stop = false;
+  std::thread ingester([&] {
+    Client own(testing::InsecureChannel(server->address()));
+    for (int i = 0; !stop; ++i) {
+      v1::IngestClipResponse response;
+      if (own.Ingest("chain_" + std::to_string(i) + ".bvh", BvhText(ChainClip(0.01 * (i + 1))),
+                     &response)
+              .ok()) {
+        ++acknowledged;
+      }
+    }
+  });
+  while (acknowledged < static_cast<int64_t>(ids.size()) + 5) std::this_thread::yield();
+  const int64_t before = acknowledged;
+  const std::string copy = (dir_ / "copy.sqlite").string();
+  {
+    auto context = client.Context();
+    auto reader = client.server().CreateBackup(context.get(), v1::CreateBackupRequest());
+    std::ofstream file(copy, std::ios::binary);
+    v1::BackupChunk chunk;
+    int64_t total = -1, received = 0;
+    while (reader->Read(&chunk)) {
+      if (total < 0) {
+        total = chunk.total_bytes();
+        EXPECT_GE(chunk.counts().clips(), before);
+      }
+      file << chunk.data();
+      received += static_cast<int64_t>(chunk.data().size());
+    }
+    const grpc::Status status = reader->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(received, total);
+  }
+  stop = true;
+  ingester.join();
+  // Nothing is left beside the live database.
+  for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+    EXPECT_THAT(entry.path().filename().string(), ::testing::Not(HasSubstr("backup"))) << entry;
+  }
+
+  ServerProcess* restored = StartServer({"--db", copy});
+  ASSERT_NE(restored, nullptr);
+  Client copy_client(testing::InsecureChannel(restored->address()));
+  v1::ListClipsRequest all;
+  all.set_page_size(1000);
+  v1::ListClipsResponse page;
+  ASSERT_TRUE(copy_client.clips().ListClips(copy_client.Context().get(), all, &page).ok());
+  EXPECT_GE(page.clips_size(), before);
+  v1::SearchResponse restored_found;
+  ASSERT_TRUE(copy_client.Search(query, &restored_found).ok());
+  ASSERT_EQ(restored_found.results_size(), live.results_size());
+  for (int i = 0; i < live.results_size(); ++i) {
+    EXPECT_EQ(restored_found.results(i).clip_id(), live.results(i).clip_id());
+    EXPECT_EQ(restored_found.results(i).start_frame(), live.results(i).start_frame());
+    EXPECT_EQ(restored_found.results(i).score(), live.results(i).score());
+  }
+  restored->Stop(SIGTERM);
+  std::unique_ptr<storage::SqliteConnection> raw =
+      *storage::SqliteConnection::Open(copy, storage::SqliteConnection::Mode::kReadOnly, 1000);
+  EXPECT_EQ(*raw->QueryText("PRAGMA integrity_check"), "ok");
 }
 
 // ---------------------------------------------------------------------------------------------

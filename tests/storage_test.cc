@@ -1053,6 +1053,70 @@ TEST_F(StorageTest, LockedDatabaseIsUnavailableToWritersOnly) {
   EXPECT_TRUE((*db)->InsertClip(Named("run"), Motion(testing::ChainSkeleton(), 3), {}).ok());
 }
 
+// A backup taken while a writer inserts clip after clip: the copy opens, passes integrity_check,
+// holds every clip acknowledged before the backup began whole, and the writer never failed.
+TEST_F(StorageSpaceTest, BackupIsAConsistentCopyWhileWritesGoOn) {
+  const int64_t walk = Insert(Named("walk"), walk_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  ASSERT_TRUE(
+      Db().InsertSpace(SpaceNamed("body", skeleton), space_, {ProjectionOf(walk, walk_)}).ok());
+  const int64_t space_id = Db().GetSpaceRecord("body")->space_id;
+  std::atomic<int64_t> acknowledged = 1;  // clips whose insert returned
+  std::atomic<bool> stop = false;
+  std::atomic<int> failures = 0;
+  std::thread writer([&] {
+    for (int i = 0; !stop; ++i) {
+      const absl::StatusOr<int64_t> id = Db().InsertClip(Named(absl::StrCat("take_", i)), walk_,
+                                                         {{space_id, ProjectionOf(0, walk_)}});
+      if (id.ok()) {
+        ++acknowledged;
+      } else {
+        ++failures;
+      }
+    }
+  });
+  while (acknowledged < 20) std::this_thread::yield();
+  const std::string copy = (dir_ / "copy.sqlite").string();
+  const int64_t before = acknowledged;
+  const absl::Status backup = Db().Backup(copy);
+  const int64_t after = acknowledged;
+  stop = true;
+  writer.join();
+  ASSERT_TRUE(backup.ok()) << backup;
+  EXPECT_EQ(failures, 0);
+
+  std::unique_ptr<SqliteConnection> raw =
+      *SqliteConnection::Open(copy, SqliteConnection::Mode::kReadOnly, 1000);
+  EXPECT_EQ(*raw->QueryText("PRAGMA integrity_check"), "ok");
+  raw.reset();
+  absl::StatusOr<std::unique_ptr<Database>> copied =
+      Database::Open(copy, {.create_if_missing = false});
+  ASSERT_TRUE(copied.ok()) << copied.status();
+  const Counts counts = *(*copied)->GetCounts();
+  EXPECT_GE(counts.clips, before);
+  // At most the inserts that returned during the backup (and the one in flight as it ended).
+  EXPECT_LE(counts.clips, after + 1);
+  EXPECT_EQ(counts.projections, counts.clips);
+  // Every clip of the copy is whole, frames and projection.
+  const absl::StatusOr<std::vector<Projection>> projections = (*copied)->LoadProjections(space_id);
+  ASSERT_TRUE(projections.ok()) << projections.status();
+  for (const Projection& projection : *projections) {
+    const absl::StatusOr<StoredClip> stored = (*copied)->GetClip(projection.clip_id);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+    ExpectSameFrames(walk_, stored->clip);
+  }
+
+  // A second backup to the same file: refused, the first copy untouched.
+  const std::string first_copy = testing::ReadFileOrDie(copy);
+  copied->reset();
+  EXPECT_EQ(Db().Backup(copy).code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(testing::ReadFileOrDie(copy), first_copy);
+  // A target that cannot be written: an error, and no file.
+  const std::string unwritable = (dir_ / "missing_dir" / "copy.sqlite").string();
+  EXPECT_FALSE(Db().Backup(unwritable).ok());
+  EXPECT_FALSE(std::filesystem::exists(unwritable));
+}
+
 TEST_F(StorageTest, ReadersRunBesideAWriter) {
   const Clip clip = Motion(testing::ChainSkeleton(), 30);
   const int64_t first = Insert(Named("seed", {"t"}), clip);

@@ -237,6 +237,15 @@ void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton) {
   skeleton->set_root_joint(summary.root_joint);
 }
 
+void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out) {
+  out->set_skeletons(counts.skeletons);
+  out->set_clips(counts.clips);
+  out->set_frames(counts.frames);
+  out->set_spaces(counts.spaces);
+  out->set_projections(counts.projections);
+  out->set_labels(counts.labels);
+}
+
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
   ToProto(outcome.clip, response->mutable_clip());
   for (const std::string& warning : outcome.warnings) response->add_warnings(warning);

@@ -8,6 +8,7 @@
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
 #include "motiondb/v1/search_service.pb.h"
+#include "motiondb/v1/server_service.pb.h"
 #include "motiondb/v1/space_service.pb.h"
 #include "server/clip_export.h"
 #include "server/clip_ingest.h"
@@ -34,6 +35,7 @@ CurveRequest FromProto(const v1::GetCurveRequest& request);
 // Results.
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
 void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton);
+void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
 void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response);
 void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response);

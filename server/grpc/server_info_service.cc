@@ -1,5 +1,6 @@
 #include "server/grpc/server_info_service.h"
 
+#include "server/database_backup.h"
 #include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
 
@@ -18,13 +19,7 @@ grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* context,
     response->set_version(MOTIONDB_VERSION);
     response->set_uptime_s(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
-    v1::DatabaseCounts* out = response->mutable_counts();
-    out->set_skeletons(counts->skeletons);
-    out->set_clips(counts->clips);
-    out->set_frames(counts->frames);
-    out->set_spaces(counts->spaces);
-    out->set_projections(counts->projections);
-    out->set_labels(counts->labels);
+    ToProto(*counts, response->mutable_counts());
     int64_t index_bytes = 0;
     for (const auto& snapshot : registry_.All()) {
       v1::SpaceIndexInfo* info = response->add_indices();
@@ -38,6 +33,33 @@ grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* context,
     response->set_auth_required(!options_.auth_token.empty());
     response->set_tls(!options_.tls_cert_pem.empty());
     return grpc::Status::OK;
+  });
+}
+
+grpc::Status ServerInfoServiceImpl::CreateBackup(grpc::ServerContext* context,
+                                                 const v1::CreateBackupRequest* /*request*/,
+                                                 grpc::ServerWriter<v1::BackupChunk>* writer) {
+  // Large enough that per-message costs vanish, far below any message limit.
+  constexpr size_t kChunkBytes = size_t{1} << 20;
+  return gate_.Run(context, [&]() -> grpc::Status {
+    absl::StatusOr<DatabaseBackup> backup = DatabaseBackup::Create(database_, options_.db_path);
+    if (!backup.ok()) return ToGrpcStatus(backup.status());
+    // A database file is never empty, so the first chunk carries the size and counts.
+    for (bool first = true;; first = false) {
+      absl::StatusOr<std::string> data = backup->ReadChunk(kChunkBytes);
+      if (!data.ok()) return ToGrpcStatus(data.status());
+      if (data->empty()) return grpc::Status::OK;
+      v1::BackupChunk chunk;
+      if (first) {
+        chunk.set_total_bytes(backup->size_bytes());
+        ToProto(backup->counts(), chunk.mutable_counts());
+      }
+      chunk.set_data(*std::move(data));
+      // False once the client has gone: the copy is dropped with `backup`.
+      if (!writer->Write(chunk)) {
+        return grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading the backup");
+      }
+    }
   });
 }
 

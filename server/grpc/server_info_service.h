@@ -1,5 +1,5 @@
 // motiondb.v1.ServerService: the server's version, the database's counts and the memory of the
-// resident indices.
+// resident indices; online backups.
 #ifndef MOTIONDB_SERVER_GRPC_SERVER_INFO_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_SERVER_INFO_SERVICE_H_
 
@@ -25,6 +25,8 @@ class ServerInfoServiceImpl final : public v1::ServerService::Service {
 
   grpc::Status GetServerInfo(grpc::ServerContext* context, const v1::GetServerInfoRequest* request,
                              v1::ServerInfo* response) override;
+  grpc::Status CreateBackup(grpc::ServerContext* context, const v1::CreateBackupRequest* request,
+                            grpc::ServerWriter<v1::BackupChunk>* writer) override;
 
  private:
   storage::Database& database_;
