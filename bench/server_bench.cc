@@ -12,7 +12,9 @@
 //  4. the server's resident memory (VmRSS and its peak, VmHWM);
 //  5. start to serving with hours of cached projections (synthetic clips at 30 Hz, stored
 //     through the server's own library code): from exec to the first SERVING health answer,
-//     and the server's resident memory then; then ingest over gRPC into that library.
+//     and the server's resident memory then; then ingest over gRPC into that library, and a
+//     backup of it while a client ingests (its rate, and the ingest latency during it beside
+//     the latency just before).
 //
 // usage: server_bench [--folder DIR] [--seconds S] [--hours H]
 #include <signal.h>
@@ -23,6 +25,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <thread>
@@ -36,6 +39,7 @@
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "server/catalog.h"
 #include "server/index_registry.h"
@@ -355,6 +359,55 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
 
 // Stores `hours` of synthetic clips at 30 Hz and a space over them through the server's own
 // library code, then times the server from exec to serving.
+struct BackupRun {
+  double mib = 0;
+  double seconds = 0;
+  std::vector<double> ingest_ms;  // of each clip ingested while the backup ran
+};
+
+// A backup streamed to a file under `work` while another thread ingests `texts` again and
+// again through `ingest` (returning each call's latency), which shows what the backup costs
+// writers.
+template <typename Ingest>
+absl::StatusOr<BackupRun> BackupDuringIngest(const std::string& address,
+                                             const std::filesystem::path& work,
+                                             const std::vector<std::string>& texts,
+                                             const Ingest& ingest) {
+  BackupRun run;
+  std::atomic<bool> done = false;
+  absl::Status ingest_status;
+  std::thread writer([&] {
+    // At least one clip lands inside the backup, however short it is.
+    for (size_t i = 0; ingest_status.ok() && (i == 0 || !done); ++i) {
+      absl::StatusOr<double> ms = ingest(absl::StrCat("during_", i), texts[i % texts.size()]);
+      if (ms.ok()) {
+        run.ingest_ms.push_back(*ms);
+      } else {
+        ingest_status = ms.status();
+      }
+    }
+  });
+  const std::filesystem::path copy = work / "backup.sqlite";
+  auto stub = v1::ServerService::NewStub(OwnConnection(address));
+  grpc::ClientContext context;
+  const Clock::time_point start = Clock::now();
+  auto reader = stub->CreateBackup(&context, v1::CreateBackupRequest());
+  {
+    std::ofstream file(copy, std::ios::binary);
+    v1::BackupChunk chunk;
+    while (reader->Read(&chunk)) file << chunk.data();
+  }
+  const grpc::Status status = reader->Finish();
+  run.seconds = SecondsSince(start);
+  done = true;
+  writer.join();
+  MOTIONDB_RETURN_IF_ERROR(FromGrpc(status, "CreateBackup"));
+  MOTIONDB_RETURN_IF_ERROR(ingest_status);
+  run.mib = std::filesystem::file_size(copy) / 1048576.0;
+  std::filesystem::remove(copy);
+  return run;
+}
+
 absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const std::string db = (work / "synthetic.sqlite").string();
   Clock::time_point start = Clock::now();
@@ -413,17 +466,27 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
     more_frames += clip.frame_count();
   }
   auto clips = v1::ClipService::NewStub(OwnConnection(server.address()));
-  start = Clock::now();
-  for (size_t c = 0; c < texts.size(); ++c) {
+  // One clip ingested as `name`; its latency in ms.
+  const auto ingest = [&clips](const std::string& name,
+                               const std::string& text) -> absl::StatusOr<double> {
     v1::IngestClipRequest request;
-    request.set_file_name(absl::StrCat("extra_", c, ".bvh"));
-    request.set_bvh(texts[c]);
+    request.set_file_name(name + ".bvh");
+    request.set_bvh(text);
     v1::IngestClipResponse response;
     grpc::ClientContext context;
+    const Clock::time_point sent = Clock::now();
     MOTIONDB_RETURN_IF_ERROR(
         FromGrpc(clips->IngestClip(&context, request, &response), "IngestClip"));
+    return 1000 * SecondsSince(sent);
+  };
+  std::vector<double> alone_ms;
+  start = Clock::now();
+  for (size_t c = 0; c < texts.size(); ++c) {
+    MOTIONDB_ASSIGN_OR_RETURN(alone_ms.emplace_back(), ingest(absl::StrCat("extra_", c), texts[c]));
   }
   const double ingest_s = SecondsSince(start);
+  MOTIONDB_ASSIGN_OR_RETURN(const BackupRun backup,
+                            BackupDuringIngest(server.address(), work, texts, ingest));
   server.Stop(SIGTERM);
   std::smatch loaded;
   const std::string load_line =
@@ -440,6 +503,13 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
       "%.2f s = %.0f frames/s, %.0f ms per clip\n",
       texts.size(), static_cast<long long>(more_frames), ingest_s, more_frames / ingest_s,
       1000 * ingest_s / texts.size());
+  std::printf(
+      "backup (CreateBackup to a file) while one client ingests: %.0f MiB in %.2f s = %.0f "
+      "MiB/s; ingest latency per clip during it p50 %.1f ms, max %.1f ms (%zu clips), beside "
+      "%.1f ms, max %.1f ms just before without a backup\n",
+      backup.mib, backup.seconds, backup.mib / backup.seconds, Percentile(backup.ingest_ms, 0.5),
+      *std::max_element(backup.ingest_ms.begin(), backup.ingest_ms.end()), backup.ingest_ms.size(),
+      Percentile(alone_ms, 0.5), *std::max_element(alone_ms.begin(), alone_ms.end()));
   return absl::OkStatus();
 }
 

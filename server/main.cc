@@ -36,6 +36,7 @@ constexpr std::chrono::seconds kShutdownGrace(10);
 // What the flags name: the secret files read, the sizes converted.
 struct ServerFlags {
   int max_bvh_mb = 0;
+  int max_upload_buffer_mb = 0;
   std::string auth_token_file, tls_cert, tls_key;
   bool quiet = false;
 };
@@ -64,6 +65,13 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   flags->max_bvh_mb = static_cast<int>(options->uploads.max_bvh_bytes >> 20);
   number("--max-bvh-mb", flags->max_bvh_mb, "largest BVH upload, streamed or not, in MiB", "MB", 1,
          1 << 20);
+  number("--max-uploads", options->uploads.max_uploads, "most ingests in progress at once", "N", 1,
+         1 << 16);
+  flags->max_upload_buffer_mb = static_cast<int>(options->uploads.max_buffered_bytes >> 20);
+  number("--max-upload-buffer-mb", flags->max_upload_buffer_mb,
+         "most bytes the ingests in progress hold together, in MiB", "MB", 1, 1 << 20);
+  number("--stream-idle-timeout-s", options->stream_idle_timeout_s,
+         "end a client stream silent for this long (0: never)", "S", 0, 1 << 20);
   app.add_option("--auth-token-file", flags->auth_token_file,
                  "require 'authorization: Bearer <FILE's contents>'")
       ->type_name("FILE")
@@ -86,6 +94,7 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
 // Reads the files the flags name into `options`.
 absl::Status ReadFlagFiles(const ServerFlags& flags, motiondb::server::ServerOptions* options) {
   options->uploads.max_bvh_bytes = int64_t{flags.max_bvh_mb} << 20;
+  options->uploads.max_buffered_bytes = int64_t{flags.max_upload_buffer_mb} << 20;
   if (!flags.auth_token_file.empty()) {
     MOTIONDB_ASSIGN_OR_RETURN(options->auth_token, motiondb::ReadTokenFile(flags.auth_token_file));
   }

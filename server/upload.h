@@ -16,6 +16,13 @@ struct UploadLimits {
   // Largest BVH file, in bytes, whether sent whole or streamed (--max-bvh-mb): larger ones fail
   // with RESOURCE_EXHAUSTED before they are parsed.
   int64_t max_bvh_bytes = int64_t{1} << 30;
+  // Ingests (unary or streamed) in progress at once (--max-uploads); one more is refused with
+  // RESOURCE_EXHAUSTED before it is read.
+  int max_uploads = 32;
+  // Bytes the ingests in progress may hold together (--max-upload-buffer-mb); a message or
+  // chunk beyond fails its upload with RESOURCE_EXHAUSTED. An upload peaks at a few times its
+  // size while parsed, so this is what bounds the server's memory under many large uploads.
+  int64_t max_buffered_bytes = int64_t{2} << 30;
 };
 
 // RESOURCE_EXHAUSTED when `bytes` (an upload's size, or a stream's so far) exceeds the limit;

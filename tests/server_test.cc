@@ -1083,6 +1083,90 @@ TEST_F(ServerTest, OversizeRequestsAreResourceExhausted) {
   EXPECT_TRUE(client.Ingest("small.bvh", BvhText(ChainClip()), &ingested).ok());
 }
 
+// Idle ingest streams hold a thread and, with --threads, a call slot each. With the watchdog off
+// two of them lock a --threads 2 server out; with it on they are ended after a second and the
+// waiting call runs.
+TEST_F(ServerTest, IdleStreamsAreEndedAndReleaseTheirThreads) {
+  for (const bool watched : {false, true}) {
+    SCOPED_TRACE(watched ? "watched" : "unwatched");
+    ServerProcess* server =
+        StartServer({"--threads", "2", "--stream-idle-timeout-s", watched ? "1" : "0"});
+    ASSERT_NE(server, nullptr);
+    Client client(testing::InsecureChannel(server->address()));
+    std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+    std::vector<v1::IngestClipResponse> responses(2);
+    std::vector<std::unique_ptr<grpc::ClientWriter<v1::IngestClipStreamRequest>>> idle;
+    v1::IngestClipStreamRequest header;
+    header.set_file_name("idle.bvh");
+    for (int i = 0; i < 2; ++i) {
+      contexts.push_back(client.Context());
+      idle.push_back(client.clips().IngestClipStream(contexts.back().get(), &responses[i]));
+      ASSERT_TRUE(idle.back()->Write(header));
+    }
+    v1::ServerInfo info;
+    const grpc::Status status = client.server().GetServerInfo(
+        client.Context(std::chrono::milliseconds(watched ? 20000 : 3000)).get(),
+        v1::GetServerInfoRequest(), &info);
+    if (watched) {
+      EXPECT_TRUE(status.ok()) << status.error_message();
+      for (auto& writer : idle) EXPECT_FALSE(writer->Finish().ok());
+      EXPECT_THAT(server->Log(), HasSubstr("ended an idle stream from ipv4:127.0.0.1:"));
+    } else {
+      EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+      for (auto& context : contexts) context->TryCancel();
+      for (auto& writer : idle) writer->Finish();
+    }
+  }
+}
+
+// --max-uploads bounds the ingests in progress, --max-upload-buffer-mb the bytes they hold.
+TEST_F(ServerTest, UploadsInProgressAreBounded) {
+  ServerProcess* server =
+      StartServer({"--max-uploads", "1", "--max-upload-buffer-mb", "1", "--max-bvh-mb", "8"});
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::string bvh = BvhText(ChainClip());
+  // An upload in progress: its first chunk sent, its last not yet.
+  auto context = client.Context();
+  v1::IngestClipResponse streamed;
+  auto writer = client.clips().IngestClipStream(context.get(), &streamed);
+  v1::IngestClipStreamRequest first;
+  first.set_file_name("streamed.bvh");
+  first.set_chunk(bvh.substr(0, 100));
+  ASSERT_TRUE(writer->Write(first));
+  // A second upload is refused once the first is under way (the first tries may come before the
+  // server has begun the stream).
+  grpc::Status refused;
+  for (int i = 0; i < 500 && refused.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED; ++i) {
+    v1::IngestClipResponse response;
+    refused = client.Ingest("unary.bvh", bvh, &response);
+    if (refused.ok()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("(--max-uploads)"));
+  v1::IngestClipStreamRequest rest;
+  rest.set_chunk(bvh.substr(100));
+  ASSERT_TRUE(writer->Write(rest));
+  writer->WritesDone();
+  const grpc::Status done = writer->Finish();
+  EXPECT_TRUE(done.ok()) << done.error_message();
+  v1::IngestClipResponse again;
+  EXPECT_TRUE(client.Ingest("unary2.bvh", bvh, &again).ok());
+
+  // 2 MB in chunks: under --max-bvh-mb, over what uploads may hold together.
+  auto big_context = client.Context();
+  v1::IngestClipResponse big;
+  auto big_writer = client.clips().IngestClipStream(big_context.get(), &big);
+  v1::IngestClipStreamRequest chunk;
+  chunk.set_file_name("big.bvh");
+  chunk.set_chunk(std::string(256 * 1024, ' '));
+  for (int i = 0; i < 8 && big_writer->Write(chunk); ++i) chunk.clear_file_name();
+  big_writer->WritesDone();
+  const grpc::Status over = big_writer->Finish();
+  EXPECT_EQ(over.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(over.error_message(), HasSubstr("(--max-upload-buffer-mb)"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Authentication, TLS, reflection.
 

@@ -19,6 +19,12 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<IngestRequest> ingest = FromProto(*request);
     if (!ingest.ok()) return ToGrpcStatus(ingest.status());
+    absl::StatusOr<UploadBudget::Ticket> ticket = budget_.Admit();
+    if (!ticket.ok()) return ToGrpcStatus(ticket.status());
+    if (const absl::Status reserved = ticket->Reserve(static_cast<int64_t>(request->bvh().size()));
+        !reserved.ok()) {
+      return ToGrpcStatus(reserved);
+    }
     const absl::StatusOr<IngestOutcome> outcome =
         IngestUpload(catalog_, *ingest, request->bvh(), limits_, StopWhenCallEnds(context));
     if (!outcome.ok()) return ToGrpcStatus(ExplainStop(outcome.status(), context));
@@ -27,28 +33,45 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
   });
 }
 
-absl::Status ClipServiceImpl::ReadStream(const grpc::ServerContext* context,
-                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
-                                         v1::IngestClipResponse* response) {
+absl::StatusOr<ClipServiceImpl::ReceivedUpload> ClipServiceImpl::Receive(
+    grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+    UploadBudget::Ticket& ticket) {
+  // Only while reading: the parse that follows may take long without a byte arriving.
+  StreamWatchdog::Watch watch = watchdog_.Start(context);
   v1::IngestClipStreamRequest message;
   if (!reader->Read(&message)) {
+    MOTIONDB_RETURN_IF_ERROR(watch.Status());
     return absl::InvalidArgumentError("the stream is empty: the first message needs file_name");
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const IngestRequest request, FromProto(message));
+  ReceivedUpload upload;
+  MOTIONDB_ASSIGN_OR_RETURN(upload.request, FromProto(message));
   // Refused before the upload is read: a stream without a file name would be read in vain.
-  MOTIONDB_RETURN_IF_ERROR(ClipName(request).status());
-  std::string bvh;
+  MOTIONDB_RETURN_IF_ERROR(ClipName(upload.request).status());
   do {
+    watch.Touch();
     MOTIONDB_RETURN_IF_ERROR(
-        CheckUploadSize(static_cast<int64_t>(bvh.size() + message.chunk().size()), limits_));
-    bvh += message.chunk();
+        CheckUploadSize(static_cast<int64_t>(upload.bvh.size() + message.chunk().size()), limits_));
+    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(message.chunk().size())));
+    upload.bvh += message.chunk();
   } while (reader->Read(&message));
+  MOTIONDB_RETURN_IF_ERROR(watch.Status());
+  return upload;
+}
+
+absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
+                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+                                         v1::IngestClipResponse* response) {
+  // Admitted before the first message, which an idle client may never send: the watchdog ends
+  // such a stream and frees its place.
+  MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
+  MOTIONDB_ASSIGN_OR_RETURN(const ReceivedUpload upload, Receive(context, reader, ticket));
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
   const std::function<bool()> should_stop = StopWhenCallEnds(context);
   if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
-  MOTIONDB_ASSIGN_OR_RETURN(const IngestOutcome outcome,
-                            IngestUpload(catalog_, request, bvh, limits_, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const IngestOutcome outcome,
+      IngestUpload(catalog_, upload.request, upload.bvh, limits_, should_stop));
   ToProto(outcome, response);
   return absl::OkStatus();
 }

@@ -2,20 +2,33 @@
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
+#include <string>
+
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/catalog.h"
+#include "server/clip_ingest.h"
 #include "server/grpc/call_gate.h"
+#include "server/grpc/stream_watchdog.h"
 #include "server/upload.h"
+#include "server/upload_budget.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
 class ClipServiceImpl final : public v1::ClipService::Service {
  public:
+  // `budget` and `watchdog` bound the ingests in progress (server/upload_budget.h,
+  // server/grpc/stream_watchdog.h).
   ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits,
-                  CallGate& gate)
-      : database_(database), catalog_(catalog), limits_(limits), gate_(gate) {}
+                  UploadBudget& budget, StreamWatchdog& watchdog, CallGate& gate)
+      : database_(database),
+        catalog_(catalog),
+        limits_(limits),
+        budget_(budget),
+        watchdog_(watchdog),
+        gate_(gate) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
@@ -36,13 +49,24 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                              v1::ListSkeletonsResponse* response) override;
 
  private:
-  absl::Status ReadStream(const grpc::ServerContext* context,
+  struct ReceivedUpload {
+    IngestRequest request;
+    std::string bvh;
+  };
+  // The stream's messages until the client's last, each chunk counted in `ticket`;
+  // DEADLINE_EXCEEDED when the client goes quiet for longer than the watchdog waits.
+  absl::StatusOr<ReceivedUpload> Receive(grpc::ServerContext* context,
+                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+                                         UploadBudget::Ticket& ticket);
+  absl::Status ReadStream(grpc::ServerContext* context,
                           grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                           v1::IngestClipResponse* response);
 
   storage::Database& database_;
   Catalog& catalog_;
   UploadLimits limits_;
+  UploadBudget& budget_;
+  StreamWatchdog& watchdog_;
   CallGate& gate_;
 };
 

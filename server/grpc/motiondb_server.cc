@@ -32,6 +32,8 @@ struct MotionDbServer::State {
   std::unique_ptr<Catalog> catalog;
   std::unique_ptr<SearchRunner> runner;
   std::unique_ptr<CallGate> gate;
+  std::unique_ptr<UploadBudget> uploads;
+  std::unique_ptr<StreamWatchdog> watchdog;
   std::unique_ptr<ClipServiceImpl> clips;
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
@@ -75,7 +77,11 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
-  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.gate);
+  s.uploads = std::make_unique<UploadBudget>(options.uploads);
+  s.watchdog =
+      std::make_unique<StreamWatchdog>(std::chrono::seconds(options.stream_idle_timeout_s));
+  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.uploads,
+                                              *s.watchdog, *s.gate);
   s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);

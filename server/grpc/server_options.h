@@ -26,6 +26,9 @@ struct ServerOptions {
   // Largest BVH file accepted by IngestClip, IngestClipStream (all chunks together) and BVH
   // queries (--max-bvh-mb, in MiB).
   UploadLimits uploads;
+  // A client stream (IngestClipStream) that sends nothing for this long is ended, releasing
+  // its thread (--stream-idle-timeout-s); 0: never.
+  int stream_idle_timeout_s = 30;
   // When non-empty, every call must carry the metadata "authorization: Bearer <token>"
   // (read from --auth-token-file).
   std::string auth_token;
