@@ -47,7 +47,7 @@ absl::StatusOr<storage::Counts> CheckCopy(const std::string& path) {
 absl::StatusOr<DatabaseBackup> DatabaseBackup::Create(storage::Database& database,
                                                       const std::string& database_path) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::string path, MakeTargetFile(database_path));
-  absl::Status copied = database.Backup(path);
+  absl::Status copied = database.Backup(path, {.durable = false});
   absl::StatusOr<storage::Counts> counts =
       copied.ok() ? CheckCopy(path) : absl::StatusOr<storage::Counts>(copied);
   std::ifstream file;

@@ -206,12 +206,18 @@ class Database {
 
   absl::StatusOr<Counts> GetCounts();
 
+  struct BackupOptions {
+    // Flushed to disk before Backup returns, as a copy to keep must be. Off for a copy read back
+    // and removed (CreateBackup's): its flush competes with the live database's commits for the
+    // disk.
+    bool durable = true;
+  };
   // Writes a consistent copy of the database to `path` (missing or empty; ALREADY_EXISTS
   // otherwise) while writers go on: the copy is of one snapshot, taken during the call, so it
   // holds every write acknowledged before the call began. Readers and writers do not wait for
   // it (WAL); the log grows until the copy ends. The copy is a database file of its own, in WAL
   // mode, which Open() opens. RESOURCE_EXHAUSTED when its disk is full; a failed copy is removed.
-  absl::Status Backup(const std::string& path);
+  absl::Status Backup(const std::string& path, const BackupOptions& options);
 
  private:
   class Impl;

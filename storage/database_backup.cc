@@ -13,7 +13,7 @@
 
 namespace motiondb::storage {
 
-absl::Status Database::Backup(const std::string& path) {
+absl::Status Database::Backup(const std::string& path, const BackupOptions& options) {
   std::error_code error;
   if (std::filesystem::exists(path, error) && std::filesystem::file_size(path, error) != 0) {
     return absl::AlreadyExistsError(
@@ -22,6 +22,7 @@ absl::Status Database::Backup(const std::string& path) {
   MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<SqliteConnection> target,
                             SqliteConnection::Open(path, SqliteConnection::Mode::kReadWriteCreate,
                                                    /*busy_timeout_ms=*/0));
+  if (!options.durable) MOTIONDB_RETURN_IF_ERROR(target->Execute("PRAGMA synchronous = OFF"));
   const absl::Status copied = impl_->Read([&](SqliteConnection& source) -> absl::Status {
     sqlite3_backup* backup = sqlite3_backup_init(target->handle(), "main", source.handle(), "main");
     if (backup == nullptr) {

@@ -1078,7 +1078,7 @@ TEST_F(StorageSpaceTest, BackupIsAConsistentCopyWhileWritesGoOn) {
   while (acknowledged < 20) std::this_thread::yield();
   const std::string copy = (dir_ / "copy.sqlite").string();
   const int64_t before = acknowledged;
-  const absl::Status backup = Db().Backup(copy);
+  const absl::Status backup = Db().Backup(copy, {});
   const int64_t after = acknowledged;
   stop = true;
   writer.join();
@@ -1109,11 +1109,11 @@ TEST_F(StorageSpaceTest, BackupIsAConsistentCopyWhileWritesGoOn) {
   // A second backup to the same file: refused, the first copy untouched.
   const std::string first_copy = testing::ReadFileOrDie(copy);
   copied->reset();
-  EXPECT_EQ(Db().Backup(copy).code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(Db().Backup(copy, {}).code(), absl::StatusCode::kAlreadyExists);
   EXPECT_EQ(testing::ReadFileOrDie(copy), first_copy);
   // A target that cannot be written: an error, and no file.
   const std::string unwritable = (dir_ / "missing_dir" / "copy.sqlite").string();
-  EXPECT_FALSE(Db().Backup(unwritable).ok());
+  EXPECT_FALSE(Db().Backup(unwritable, {}).ok());
   EXPECT_FALSE(std::filesystem::exists(unwritable));
 }
 
