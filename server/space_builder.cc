@@ -115,7 +115,6 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   std::map<int64_t, storage::StoredClip> loaded;
   std::vector<TrainingClip> training;
   std::vector<TrainingReport> used;
-  int64_t training_frames = 0;
   for (size_t i = 0; i < ranges.size(); ++i) {
     MOTIONDB_RETURN_IF_ERROR(check_stop());
     auto it = loaded.find(ranges[i].clip_id);
@@ -129,11 +128,15 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
         ResolveFrameRange(ranges[i], clip.frame_count(), absl::StrCat("training[", i, "]")));
     training.push_back({it->second.record.name, clip, frames});
     used.push_back({ranges[i].clip_id, frames});
-    training_frames +=
-        ResampledFrameCount(frames.size(), clip.frame_time(), request.options.sample_rate);
   }
 
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built, MotionSpace::Build(training, request.options));
+  // Counted once Build has checked the sample rate (a rate of 1e295 overflowed the count).
+  int64_t training_frames = 0;
+  for (const TrainingClip& clip : training) {
+    training_frames +=
+        ResampledFrameCount(clip.frames->size(), clip.clip.frame_time(), built.sample_rate());
+  }
   auto space = std::make_shared<const MotionSpace>(std::move(built));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
                             space->RepresentationalError(training));

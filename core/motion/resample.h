@@ -16,7 +16,7 @@ namespace motiondb {
 absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps);
 
 // The number of frames Resample() makes of `frame_count` frames `frame_time` apart (without its
-// limit on the output's size).
+// limit on the output's size). `target_fps` must be in Resample's range, (0, 10000].
 int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fps);
 
 }  // namespace motiondb

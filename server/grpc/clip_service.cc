@@ -8,6 +8,7 @@
 #include "server/grpc/call_context.h"
 #include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
+#include "server/grpc/stream_upload.h"
 #include "server/listing.h"
 #include "util/status_macros.h"
 
@@ -33,38 +34,19 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
   });
 }
 
-absl::StatusOr<ClipServiceImpl::ReceivedUpload> ClipServiceImpl::Receive(
-    grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
-    UploadBudget::Ticket& ticket) {
-  // Only while reading: the parse that follows may take long without a byte arriving.
-  StreamWatchdog::Watch watch = watchdog_.Start(context);
-  v1::IngestClipStreamRequest message;
-  if (!reader->Read(&message)) {
-    MOTIONDB_RETURN_IF_ERROR(watch.Status());
-    return absl::InvalidArgumentError("the stream is empty: the first message needs file_name");
-  }
-  ReceivedUpload upload;
-  MOTIONDB_ASSIGN_OR_RETURN(upload.request, FromProto(message));
-  // Refused before the upload is read: a stream without a file name would be read in vain.
-  MOTIONDB_RETURN_IF_ERROR(ClipName(upload.request).status());
-  do {
-    watch.Touch();
-    MOTIONDB_RETURN_IF_ERROR(
-        CheckUploadSize(static_cast<int64_t>(upload.bvh.size() + message.chunk().size()), limits_));
-    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(message.chunk().size())));
-    upload.bvh += message.chunk();
-  } while (reader->Read(&message));
-  MOTIONDB_RETURN_IF_ERROR(watch.Status());
-  return upload;
-}
-
 absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
                                          grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                                          v1::IngestClipResponse* response) {
   // Admitted before the first message, which an idle client may never send: the watchdog ends
   // such a stream and frees its place.
   MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
-  MOTIONDB_ASSIGN_OR_RETURN(const ReceivedUpload upload, Receive(context, reader, ticket));
+  absl::StatusOr<ReceivedUpload> received;
+  {
+    // Only while reading: the parse that follows may take long without a byte arriving.
+    StreamWatchdog::Watch watch = watchdog_.Start(context);
+    received = ReceiveUpload(*reader, watch, limits_, ticket);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const ReceivedUpload upload, std::move(received));
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
   const std::function<bool()> should_stop = StopWhenCallEnds(context);

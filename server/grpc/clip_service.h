@@ -49,15 +49,6 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                              v1::ListSkeletonsResponse* response) override;
 
  private:
-  struct ReceivedUpload {
-    IngestRequest request;
-    std::string bvh;
-  };
-  // The stream's messages until the client's last, each chunk counted in `ticket`;
-  // DEADLINE_EXCEEDED when the client goes quiet for longer than the watchdog waits.
-  absl::StatusOr<ReceivedUpload> Receive(grpc::ServerContext* context,
-                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
-                                         UploadBudget::Ticket& ticket);
   absl::Status ReadStream(grpc::ServerContext* context,
                           grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
                           v1::IngestClipResponse* response);

@@ -12,7 +12,7 @@ using Clock = std::chrono::steady_clock;
 
 struct StreamWatchdog::Entry {
   grpc::ServerContext* context;
-  std::string peer;  // read at the start: a cancelled call's peer is "unknown"
+  std::string peer;                    // read at the start: a cancelled call's peer is "unknown"
   std::atomic<Clock::rep> last_touch;  // Clock ticks
   std::atomic<bool> ended = false;
 };

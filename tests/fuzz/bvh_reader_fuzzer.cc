@@ -32,7 +32,7 @@ constexpr double kMaxAngleError = 1e-6;
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Small limits keep each execution fast and memory-bounded, so the fuzzer spends its time on
   // parser paths rather than on huge allocations; the frame and joint limits are low enough for
-  // 64 KiB inputs (scripts/fuzz-bvh.sh's -max_len) to reach and exercise them.
+  // 64 KiB inputs (scripts/fuzz.sh's -max_len) to reach and exercise them.
   motiondb::BvhReadOptions options;
   options.max_bytes = int64_t{1} << 20;
   options.max_frames = 10'000;

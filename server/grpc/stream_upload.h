@@ -1,0 +1,55 @@
+// The messages of an IngestClipStream assembled into the upload they carry: the first names the
+// file (checked before more is read), and every message may carry a chunk, counted against the
+// file's limit and the budget of all uploads as it arrives.
+//
+// `Reader`: anything with bool Read(v1::IngestClipStreamRequest*) (grpc::ServerReader, or a
+// fuzzer's messages). `Activity`: Touch() as each message arrives and Status() once reading
+// stops (StreamWatchdog::Watch, whose status says when the watchdog ended the stream).
+#ifndef MOTIONDB_SERVER_GRPC_STREAM_UPLOAD_H_
+#define MOTIONDB_SERVER_GRPC_STREAM_UPLOAD_H_
+
+#include <cstdint>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "motiondb/v1/clip_service.pb.h"
+#include "server/clip_ingest.h"
+#include "server/grpc/proto_conversion.h"
+#include "server/upload.h"
+#include "server/upload_budget.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+struct ReceivedUpload {
+  IngestRequest request;
+  std::string bvh;
+};
+
+template <typename Reader, typename Activity>
+absl::StatusOr<ReceivedUpload> ReceiveUpload(Reader& reader, Activity& activity,
+                                             const UploadLimits& limits,
+                                             UploadBudget::Ticket& ticket) {
+  v1::IngestClipStreamRequest message;
+  if (!reader.Read(&message)) {
+    MOTIONDB_RETURN_IF_ERROR(activity.Status());
+    return absl::InvalidArgumentError("the stream is empty: the first message needs file_name");
+  }
+  ReceivedUpload upload;
+  MOTIONDB_ASSIGN_OR_RETURN(upload.request, FromProto(message));
+  // Refused before the upload is read: a stream without a file name would be read in vain.
+  MOTIONDB_RETURN_IF_ERROR(ClipName(upload.request).status());
+  do {
+    activity.Touch();
+    MOTIONDB_RETURN_IF_ERROR(
+        CheckUploadSize(static_cast<int64_t>(upload.bvh.size() + message.chunk().size()), limits));
+    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(message.chunk().size())));
+    upload.bvh += message.chunk();
+  } while (reader.Read(&message));
+  MOTIONDB_RETURN_IF_ERROR(activity.Status());
+  return upload;
+}
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_GRPC_STREAM_UPLOAD_H_

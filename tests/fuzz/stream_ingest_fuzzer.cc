@@ -1,0 +1,78 @@
+// libFuzzer target: IngestClipStream's assembly of an upload from its messages
+// (server/grpc/stream_upload.h) and the parse of what it assembled: the input is split into
+// serialised messages (the first may lack a file name or be missing altogether), chunks split
+// anywhere, under small file and buffer limits. Nothing may crash, trip a sanitizer, or
+// answer INTERNAL, and no chunk may be counted past the limits.
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "server/grpc/stream_upload.h"
+#include "tests/fuzz/fuzz_library.h"
+
+namespace {
+
+using motiondb::v1::IngestClipStreamRequest;
+
+struct Messages {
+  std::vector<IngestClipStreamRequest> list;
+  size_t next = 0;
+  bool Read(IngestClipStreamRequest* message) {
+    if (next == list.size()) return false;
+    *message = list[next++];
+    return true;
+  }
+};
+
+struct NoWatch {
+  void Touch() {}
+  absl::Status Status() const { return absl::OkStatus(); }
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace motiondb;
+  FuzzedDataProvider input(data, size);
+  server::UploadLimits limits;
+  limits.max_bvh_bytes = input.ConsumeIntegralInRange<int64_t>(1, 1 << 16);
+  limits.max_buffered_bytes = input.ConsumeIntegralInRange<int64_t>(1, 1 << 16);
+  Messages messages;
+  while (input.remaining_bytes() > 0 && messages.list.size() < 64) {
+    IngestClipStreamRequest message;
+    if (input.ConsumeBool()) {
+      // Raw bytes: whatever a client's serialiser might send.
+      const std::string bytes = input.ConsumeRandomLengthString(4096);
+      if (!message.ParseFromString(bytes)) continue;
+    } else {
+      if (messages.list.empty()) message.set_file_name(input.ConsumeRandomLengthString(32));
+      message.set_chunk(input.ConsumeRandomLengthString(8192));
+    }
+    messages.list.push_back(std::move(message));
+  }
+  server::UploadBudget budget(limits);
+  absl::StatusOr<server::UploadBudget::Ticket> ticket = budget.Admit();
+  if (!ticket.ok()) std::abort();
+  NoWatch watch;
+  const absl::StatusOr<server::ReceivedUpload> upload =
+      server::ReceiveUpload(messages, watch, limits, *ticket);
+  if (budget.buffered_bytes() > limits.max_buffered_bytes) {
+    std::fprintf(stderr, "the budget counted %lld bytes over its limit %lld\n",
+                 static_cast<long long>(budget.buffered_bytes()),
+                 static_cast<long long>(limits.max_buffered_bytes));
+    std::abort();
+  }
+  if (!upload.ok()) {
+    fuzz::CheckNotInternal(upload.status(), "ReceiveUpload");
+    return 0;
+  }
+  if (static_cast<int64_t>(upload->bvh.size()) > limits.max_bvh_bytes) std::abort();
+  fuzz::CheckNotInternal(
+      server::ReadUpload(upload->bvh, upload->request.file_name, limits).status(), "ReadUpload");
+  return 0;
+}
