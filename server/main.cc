@@ -7,11 +7,15 @@
 // (`--help` lists them with their defaults; they are parsed with CLI11.)
 // Runs until SIGTERM or SIGINT, then stops accepting calls, lets running ones finish (up to 10 s)
 // and exits 0.
+#include <malloc.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -119,6 +123,18 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);  // a vanished client must not kill the server
+#ifdef __GLIBC__
+  // glibc's defaults keep the memory a growing library frees: each thread that contends for
+  // malloc gets an arena of its own (up to 8 a core), every arena keeps what it frees, and
+  // after the first large free glibc raises its mmap threshold (up to 32 MiB), so that upload
+  // buffers and index copies come from the arenas too. One arena a core, and blocks from 1 MiB
+  // always mapped (returned when freed), with index_registry.cc's trimming: bench/RESULTS.md,
+  // issue 15. MALLOC_ARENA_MAX and MALLOC_MMAP_THRESHOLD_ in the environment still rule.
+  if (std::getenv("MALLOC_ARENA_MAX") == nullptr) {
+    mallopt(M_ARENA_MAX, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  }
+  if (std::getenv("MALLOC_MMAP_THRESHOLD_") == nullptr) mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
 
   CLI::App app(
       "motiondb-server: the networked motion-search database. Runs until SIGTERM or SIGINT, then\n"
