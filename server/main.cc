@@ -88,6 +88,8 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
                          ->check(existing_file);
   cert->needs(key);
   key->needs(cert);
+  app.add_flag("--health-needs-token", options->health_needs_token,
+               "with a token file: the health service needs the token too");
   app.add_flag("--quiet", flags->quiet, "no per-request log lines");
   app.footer(
       "With --threads, further calls wait their turn (first come, first served, until their\n"

@@ -1277,17 +1277,28 @@ TEST_F(ServerTest, BearerTokenIsRequiredOnEveryCall) {
   Client good(channel, "s3cret-token");
   ASSERT_TRUE(good.server().GetServerInfo(good.Context().get(), request, &info).ok());
   EXPECT_TRUE(info.auth_required());
-  // Health and reflection too.
+  // Reflection too; the health service answers probes without the token.
   auto health = grpc::health::v1::Health::NewStub(channel);
   grpc::ClientContext context;
   grpc::health::v1::HealthCheckResponse serving;
-  EXPECT_EQ(health->Check(&context, grpc::health::v1::HealthCheckRequest(), &serving).error_code(),
-            grpc::StatusCode::UNAUTHENTICATED);
+  ASSERT_TRUE(health->Check(&context, grpc::health::v1::HealthCheckRequest(), &serving).ok());
+  EXPECT_EQ(serving.status(), grpc::health::v1::HealthCheckResponse::SERVING);
   std::string response;
   EXPECT_EQ(Reflect(channel, "", StringField(7, "*"), &response).error_code(),
             grpc::StatusCode::UNAUTHENTICATED);
   EXPECT_TRUE(Reflect(channel, "s3cret-token", StringField(7, "*"), &response).ok());
   EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ServerService/GetServerInfo UNAUTHENTICATED"));
+
+  // --health-needs-token: probes need it too.
+  ServerProcess* strict =
+      StartServer({"--auth-token-file", token_file, "--health-needs-token"}, "s3cret-token");
+  ASSERT_NE(strict, nullptr);
+  auto strict_health =
+      grpc::health::v1::Health::NewStub(testing::InsecureChannel(strict->address()));
+  grpc::ClientContext strict_context;
+  EXPECT_EQ(strict_health->Check(&strict_context, grpc::health::v1::HealthCheckRequest(), &serving)
+                .error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
 }
 
 TEST_F(ServerTest, ServesTls) {

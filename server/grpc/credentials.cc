@@ -15,6 +15,7 @@ absl::string_view SliceView(const grpc_slice& slice) {
 
 struct TokenCheck {
   std::string token;
+  bool health_needs_token;
 
   // grpc_auth_metadata_processor::process. Runs on a gRPC thread for each new call; it does not
   // block, so it answers at once (the core allows calling `done` synchronously).
@@ -31,6 +32,9 @@ struct TokenCheck {
       if (key == "authorization") {
         authorized |= BearerTokenMatches(SliceView(metadata[i].value), check->token);
       }
+    }
+    if (!check->health_needs_token && absl::StartsWith(method, "/grpc.health.v1.Health/")) {
+      authorized = true;
     }
     if (authorized) {
       done(user_data, nullptr, 0, nullptr, 0, GRPC_STATUS_OK, nullptr);
@@ -58,11 +62,11 @@ class CoreServerCredentials : public grpc::ServerCredentials {
     // Not used: the token check is attached in C (RequireBearerToken).
   }
 
-  void RequireBearerToken(const std::string& token) {
+  void RequireBearerToken(const std::string& token, bool health_needs_token) {
     grpc_auth_metadata_processor processor{};
     processor.process = &TokenCheck::Process;
     processor.destroy = &TokenCheck::Destroy;
-    processor.state = new TokenCheck{token};
+    processor.state = new TokenCheck{token, health_needs_token};
     grpc_server_credentials_set_auth_metadata_processor(credentials_, processor);
   }
 
@@ -95,7 +99,7 @@ bool BearerTokenMatches(absl::string_view header, absl::string_view token) {
 
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     const std::string& tls_cert_pem, const std::string& tls_key_pem,
-    const std::string& bearer_token) {
+    const std::string& bearer_token, bool health_needs_token) {
   if (tls_cert_pem.empty() != tls_key_pem.empty()) {
     return absl::InvalidArgumentError(
         "TLS needs both a certificate and a private key (--tls-cert and --tls-key)");
@@ -113,7 +117,7 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     }
   }
   auto credentials = std::make_shared<CoreServerCredentials>(core);
-  if (!bearer_token.empty()) credentials->RequireBearerToken(bearer_token);
+  if (!bearer_token.empty()) credentials->RequireBearerToken(bearer_token, health_needs_token);
   return credentials;
 }
 

@@ -21,10 +21,12 @@
 namespace motiondb::server {
 
 // TLS when both PEM strings are given, plain text when neither (INVALID_ARGUMENT for one
-// alone); `bearer_token` empty means no authentication.
+// alone); `bearer_token` empty means no authentication. With a token, the health service
+// (grpc.health.v1.Health) answers without one unless `health_needs_token`: probes
+// (Kubernetes', load balancers') carry no credentials, and health says nothing about the data.
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     const std::string& tls_cert_pem, const std::string& tls_key_pem,
-    const std::string& bearer_token);
+    const std::string& bearer_token, bool health_needs_token);
 
 // True when `header` is "Bearer <token>" (scheme case-insensitive, RFC 6750). Takes the same
 // time for every header of a given length, so that the comparison does not leak the token.

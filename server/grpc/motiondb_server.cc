@@ -86,9 +86,9 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
 
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const std::shared_ptr<grpc::ServerCredentials> credentials,
-      MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem, options.auth_token));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<grpc::ServerCredentials> credentials,
+                            MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem,
+                                                  options.auth_token, options.health_needs_token));
   // Reflection describes services from the generated descriptor pool, which holds health.proto
   // only if its generated code is linked in; naming a message of it makes sure it is.
   (void)grpc::health::v1::HealthCheckRequest::descriptor();

@@ -32,6 +32,9 @@ struct ServerOptions {
   // When non-empty, every call must carry the metadata "authorization: Bearer <token>"
   // (read from --auth-token-file).
   std::string auth_token;
+  // With a token: the health service needs it too (--health-needs-token); by default probes
+  // answer without one.
+  bool health_needs_token = false;
   // PEM certificate chain and private key: both serve TLS, neither plain text (read from
   // --tls-cert and --tls-key).
   std::string tls_cert_pem;
