@@ -51,7 +51,7 @@ constexpr Parameter kParameters[] = {
      &SearchFlags::places, &v1::SearchRequest::set_places},
     {"--neighbours", "neighbours", "K", "1000", "--seeds frames: nearest frames, clustered",
      &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours},
-    {"--ann-dims", "ann_dims", "N", "10", "dimensions of the seed search", &SearchFlags::ann_dims,
+    {"--ann-dims", "ann_dims", "N", "5", "dimensions of the seed search", &SearchFlags::ann_dims,
      &v1::SearchRequest::set_ann_dims},
     {"--dtw-dims", "dtw_dims", "N", "5", "dimensions of the time warp's pose distance",
      &SearchFlags::dtw_dims, &v1::SearchRequest::set_dtw_dims},

@@ -176,7 +176,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--places N=128",
                              "--neighbours K=1000",
                              "--threads N=0 = one per core",
-                             "--ann-dims N=10",
+                             "--ann-dims N=5",
                              "--dtw-dims N=5",
                              "--slope S=2",
                              "--max N=20",

@@ -82,9 +82,11 @@ const float* FrameRow(const LibraryIndex& library, int64_t frame) {
   return library.clip_coordinates(clip).row(local);
 }
 
-// The k nearest frames over 10 dims, nearest first, by brute force, and as the index finds them
-// (kd-tree, kd-tree with a filter, linear scan).
+// The k nearest frames over the tree's dims, nearest first, by brute force, and as the index
+// finds them (kd-tree, kd-tree with a filter: its frames only; linear scan: every frame). The
+// library is one block, so the tree's frames are the multiples of tree_every().
 void ExpectNearestAgreesWithBruteForce(const LibraryIndex& library, int clips) {
+  const int dims = library.ann_dims();
   std::mt19937 rng(3);
   for (int trial = 0; trial < 20; ++trial) {
     const float* point = FrameRow(library, rng() % library.total_frames());
@@ -92,32 +94,59 @@ void ExpectNearestAgreesWithBruteForce(const LibraryIndex& library, int clips) {
     std::vector<bool> all_but_one(clips, true), one(clips, false);
     all_but_one[1] = false;
     one[1] = true;
-    for (const std::vector<bool>& allowed : {std::vector<bool>(), all_but_one, one}) {
+    const std::vector<bool> filters[] = {std::vector<bool>(), all_but_one, one};
+    for (const std::vector<bool>& allowed : filters) {
+      // One clip of three is answered by a scan, the others by the tree.
+      const int every = &allowed == &filters[2] ? 1 : library.tree_every();
       std::vector<float> expected;
-      for (int64_t f = 0; f < library.total_frames(); ++f) {
+      for (int64_t f = 0; f < library.total_frames(); f += every) {
         if (allowed.empty() || allowed[library.Locate(f).first]) {
-          expected.push_back(Distance(point, FrameRow(library, f), 10));
+          expected.push_back(Distance(point, FrameRow(library, f), dims));
         }
       }
       std::sort(expected.begin(), expected.end());
-      const std::vector<Neighbour> found = library.Nearest(point, 10, 50, 0.0f, allowed);
+      const std::vector<Neighbour> found = library.Nearest(point, dims, 50, 0.0f, allowed);
       ASSERT_EQ(found.size(), 50u);
       for (size_t i = 0; i < found.size(); ++i) {
+        EXPECT_EQ(found[i].frame % every, 0) << i;
         EXPECT_NEAR(found[i].distance, expected[i], 1e-4) << i;
-        EXPECT_NEAR(found[i].distance, Distance(point, FrameRow(library, found[i].frame), 10),
+        EXPECT_NEAR(found[i].distance, Distance(point, FrameRow(library, found[i].frame), dims),
                     1e-4);
         if (!allowed.empty()) {
           EXPECT_TRUE(allowed[library.Locate(found[i].frame).first]);
         }
       }
     }
-    // Other dimensions than the tree's are answered by a scan.
+    // Other dimensions than the tree's are answered by a scan of every frame.
     const std::vector<Neighbour> six = library.Nearest(point, 6, 5, 0.0f, {});
     EXPECT_EQ(six[0].distance, 0.0f);
   }
 }
 
 TEST_F(SearchTest, NearestAgreesWithBruteForce) { ExpectNearestAgreesWithBruteForce(*library_, 3); }
+
+// The kd-tree holds about 15 frames a second (every eighth at 120 Hz), an eighth of the tree
+// for the same clips; the linear scan still sees every frame.
+TEST(LibraryIndexCoarseTree, HoldsAbout15FramesASecond) {
+  const auto build = [](double rate, bool coarse) {
+    std::vector<LibraryClip> clips;
+    for (int c = 0; c < 3; ++c) {
+      clips.push_back({c, "noise", {}, testing::SmoothNoise(1200, kDims, 60 + c)});
+    }
+    LibraryIndexOptions options;
+    options.coarse_tree = coarse;
+    return *LibraryIndex::Build(std::move(clips), rate, options);
+  };
+  const std::unique_ptr<LibraryIndex> coarse = build(120.0, true);
+  EXPECT_EQ(coarse->tree_every(), 8);
+  EXPECT_EQ(build(22.0, true)->tree_every(), 1);
+  EXPECT_EQ(build(30.0, true)->tree_every(), 2);
+  const std::unique_ptr<LibraryIndex> full = build(120.0, false);
+  EXPECT_EQ(full->tree_every(), 1);
+  EXPECT_LT(coarse->tree_bytes() * 6, full->tree_bytes());
+  ExpectNearestAgreesWithBruteForce(*coarse, 3);
+  ExpectNearestAgreesWithBruteForce(*full, 3);
+}
 
 // Clips added one at a time go into a second block beside the first; the index answers exactly
 // as one built from all the clips at once, until the additions grow past a sixteenth of the
@@ -461,29 +490,48 @@ TEST_F(SearchTest, ExactSearchTimesItsWarpsInsideTheTotal) {
 
 TEST(SearchRecall, FastSearchFindsWhatExactSearchFinds) {
   // Eight copies of the pattern at speeds 0.75x to 1.4x among noise: exact search ranks them
-  // first, and the fast search must find every one of them.
-  std::vector<LibraryClip> clips;
-  std::vector<Planted> planted;
-  const std::vector<int> lengths = {30, 34, 38, 40, 44, 48, 52, 56};
-  for (int c = 0; c < 4; ++c) {
-    RowMatrixXf curve = testing::SmoothNoise(900, kDims, 70 + c);
-    for (int k = 0; k < 2; ++k) {
-      const int frames = lengths[2 * c + k];
-      testing::Plant(curve, testing::Pattern(frames, kDims), 150 + 400 * k);
-      planted.push_back({c, 150 + 400 * k, 150 + 400 * k + frames - 1});
+  // first, and the fast search must find every one of them; at 30 Hz, and at 120 Hz (the same
+  // motion four times as finely sampled), where the seeds and warps run at 30 Hz and the results
+  // are settled at the full rate: whole warps of the model, with the scores they report.
+  for (const int scale : {1, 4}) {
+    SCOPED_TRACE(scale);
+    std::vector<LibraryClip> clips;
+    std::vector<Planted> planted;
+    const std::vector<int> lengths = {30, 34, 38, 40, 44, 48, 52, 56};
+    for (int c = 0; c < 4; ++c) {
+      RowMatrixXf curve = testing::SmoothNoise(900 * scale, kDims, 70 + c);
+      for (int k = 0; k < 2; ++k) {
+        const int frames = lengths[2 * c + k] * scale, at = (150 + 400 * k) * scale;
+        testing::Plant(curve, testing::Pattern(frames, kDims), at);
+        planted.push_back({c, at, at + frames - 1});
+      }
+      clips.push_back({c, "clip", {}, std::move(curve)});
     }
-    clips.push_back({c, "clip", {}, std::move(curve)});
-  }
-  const std::unique_ptr<LibraryIndex> library = *LibraryIndex::Build(std::move(clips), 30, {});
-  const RowMatrixXf query = testing::Pattern(40, kDims);
-  SearchParams params;
-  params.max_results = 8;
-  const SearchResponse exact = *ExactSearch(*library, CoordinateView::Of(query), params);
-  const SearchResponse fast = *Search(*library, CoordinateView::Of(query), params);
-  ASSERT_EQ(exact.results.size(), 8u);
-  for (const Planted& p : planted) {
-    EXPECT_TRUE(SearchTest::Found(exact.results, p)) << p.clip << ":" << p.first;
-    EXPECT_TRUE(SearchTest::Found(fast.results, p)) << p.clip << ":" << p.first;
+    const std::unique_ptr<LibraryIndex> library =
+        *LibraryIndex::Build(std::move(clips), 30 * scale, {});
+    const RowMatrixXf query = testing::Pattern(40 * scale, kDims);
+    SearchParams params;
+    params.max_results = 8;
+    params.return_path = true;
+    const SearchResponse exact = *ExactSearch(*library, CoordinateView::Of(query), params);
+    const SearchResponse fast = *Search(*library, CoordinateView::Of(query), params);
+    ASSERT_EQ(exact.results.size(), 8u);
+    for (const Planted& p : planted) {
+      EXPECT_TRUE(SearchTest::Found(exact.results, p)) << p.clip << ":" << p.first;
+      EXPECT_TRUE(SearchTest::Found(fast.results, p)) << p.clip << ":" << p.first;
+    }
+    for (const SearchResult& r : fast.results) {
+      ASSERT_EQ(r.path.size(), static_cast<size_t>(query.rows()));
+      EXPECT_EQ(r.path.front(), r.first_frame);
+      EXPECT_EQ(r.path.back(), r.last_frame);
+      for (size_t i = 1; i < r.path.size(); ++i) {
+        EXPECT_GE(r.path[i] - r.path[i - 1], 0);
+        EXPECT_LE(r.path[i] - r.path[i - 1], params.slope_limit);
+      }
+      EXPECT_NEAR(testing::MeanPathDistance(query, library->CopyClipCoordinates(r.clip_index),
+                                            r.path, params.dtw_dims),
+                  r.score, 1e-5);
+    }
   }
 }
 

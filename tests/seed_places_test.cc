@@ -23,17 +23,19 @@ const float* FrameRow(const LibraryIndex& library, int64_t frame) {
   return library.clip_coordinates(clip).row(local);
 }
 
-// By definition: every frame of the allowed clips by distance to `point` (ties to the earlier
-// frame), each kept unless a kept one of its clip lies within `separation` - 1 frames, the
-// first k kept.
+// By definition: every frame of the allowed clips (of a one-block library's kd-tree: every
+// `every`-th) by distance to `point` (ties to the earlier frame), each kept unless a kept one of
+// its clip lies within `separation` - 1 frames, the first k kept.
 std::vector<int64_t> BruteForcePlaces(const LibraryIndex& library, const float* point, int dims,
-                                      int k, int64_t separation, const std::vector<bool>& allowed) {
+                                      int k, int64_t separation, const std::vector<bool>& allowed,
+                                      int every = 1) {
   std::vector<std::pair<float, int64_t>> frames;
   for (int c = 0; c < library.clip_count(); ++c) {
     if (!allowed.empty() && !allowed[c]) continue;
     const CoordinateView clip = library.clip_coordinates(c);
     for (int64_t f = 0; f < clip.rows; ++f) {
-      frames.emplace_back(Distance(point, clip.row(f), dims), library.clip(c).first_frame + f);
+      const int64_t frame = library.clip(c).first_frame + f;
+      if (frame % every == 0) frames.emplace_back(Distance(point, clip.row(f), dims), frame);
     }
   }
   std::sort(frames.begin(), frames.end());
@@ -92,7 +94,8 @@ std::unique_ptr<LibraryIndex> WellLibrary(const std::vector<float>& centre, int6
     clips.push_back({c, "wells", {}, std::move(coordinates)});
     first_frame += frames;
   }
-  return *LibraryIndex::Build(std::move(clips), 30.0, {});
+  // Every frame in the tree: the wells' bottoms lie on any frame.
+  return *LibraryIndex::Build(std::move(clips), 30.0, {kTreeDims, 32, /*coarse_tree=*/false});
 }
 
 TEST(NearestPlaces, AreTheBottomsOfTheWellsFirstAsBruteForceFindsThem) {
@@ -143,40 +146,50 @@ TEST(NearestPlaces, AreTheBottomsOfTheWellsFirstAsBruteForceFindsThem) {
 // and most of brute force's places are found (720 of 800 here: where the places' neighbourhoods
 // chain, which are kept depends on the order the kd-tree meets the frames in).
 TEST(NearestPlaces, OnNoiseAreSeparatedAndAgreeWithBruteForce) {
-  std::vector<LibraryClip> clips;
-  for (int c = 0; c < 4; ++c) {
-    clips.push_back({c, "noise", {}, testing::SmoothNoise(1500, kDims, 40 + c)});
-  }
-  const std::unique_ptr<LibraryIndex> library = *LibraryIndex::Build(std::move(clips), 30.0, {});
-  std::mt19937 rng(8);
-  int found_total = 0, expected_total = 0;
-  for (int trial = 0; trial < 20; ++trial) {
-    const float* point = FrameRow(*library, rng() % library->total_frames());
-    const int64_t separation = 5 + trial % 4 * 10;
-    // 40 places of the 6,000 frames at most 35 apart: there are always enough.
-    const std::vector<Neighbour> found =
-        library->NearestPlaces(point, kTreeDims, 40, separation, 0.0f, {});
-    ASSERT_EQ(found.size(), 40u);
-    EXPECT_EQ(found[0].distance, 0.0f);
-    for (size_t i = 0; i < found.size(); ++i) {
-      if (i > 0) {
-        EXPECT_LE(found[i - 1].distance, found[i].distance);
-      }
-      for (size_t j = 0; j < i; ++j) {
-        const auto [ci, fi] = library->Locate(found[i].frame);
-        const auto [cj, fj] = library->Locate(found[j].frame);
-        EXPECT_TRUE(ci != cj || std::abs(fi - fj) >= separation) << found[i].frame;
-      }
+  // A tree of every frame, and one of every eighth (seeds at about 15 Hz from 120 Hz).
+  for (const bool coarse : {false, true}) {
+    SCOPED_TRACE(coarse);
+    std::vector<LibraryClip> clips;
+    for (int c = 0; c < 4; ++c) {
+      clips.push_back({c, "noise", {}, testing::SmoothNoise(1500, kDims, 40 + c)});
     }
-    const std::vector<int64_t> expected =
-        BruteForcePlaces(*library, point, kTreeDims, 40, separation, {});
-    const std::vector<int64_t> frames = Frames(found);
-    for (int64_t frame : expected) {
-      found_total += std::find(frames.begin(), frames.end(), frame) != frames.end();
+    const std::unique_ptr<LibraryIndex> library =
+        *LibraryIndex::Build(std::move(clips), 120.0, {kTreeDims, 32, coarse});
+    const int every = library->tree_every();
+    ASSERT_EQ(every, coarse ? 8 : 1);
+    std::mt19937 rng(8);
+    int found_total = 0, expected_total = 0;
+    for (int trial = 0; trial < 20; ++trial) {
+      const float* point = FrameRow(*library, rng() % library->total_frames());
+      const int64_t separation = 5 + trial % 4 * 10;
+      // 40 places of the 6,000 frames at most 35 apart: there are always enough.
+      const std::vector<Neighbour> found =
+          library->NearestPlaces(point, kTreeDims, 40, separation, 0.0f, {});
+      ASSERT_EQ(found.size(), 40u);
+      if (every == 1) {
+        EXPECT_EQ(found[0].distance, 0.0f);
+      }
+      for (size_t i = 0; i < found.size(); ++i) {
+        EXPECT_EQ(found[i].frame % every, 0);
+        if (i > 0) {
+          EXPECT_LE(found[i - 1].distance, found[i].distance);
+        }
+        for (size_t j = 0; j < i; ++j) {
+          const auto [ci, fi] = library->Locate(found[i].frame);
+          const auto [cj, fj] = library->Locate(found[j].frame);
+          EXPECT_TRUE(ci != cj || std::abs(fi - fj) >= separation) << found[i].frame;
+        }
+      }
+      const std::vector<int64_t> expected =
+          BruteForcePlaces(*library, point, kTreeDims, 40, separation, {}, every);
+      const std::vector<int64_t> frames = Frames(found);
+      for (int64_t frame : expected) {
+        found_total += std::find(frames.begin(), frames.end(), frame) != frames.end();
+      }
+      expected_total += static_cast<int>(expected.size());
     }
-    expected_total += static_cast<int>(expected.size());
+    EXPECT_GE(found_total, 0.85 * expected_total) << found_total << " of " << expected_total;
   }
-  EXPECT_GE(found_total, 0.85 * expected_total) << found_total << " of " << expected_total;
 }
 
 // Twelve clips of noise with the pattern planted in some, at several speeds.

@@ -7,6 +7,15 @@
 namespace motiondb {
 namespace {
 
+// The first five columns of a view's rows.
+RowMatrixXf CopyRows(CoordinateView view) {
+  RowMatrixXf copy(view.rows, 5);
+  for (int64_t r = 0; r < view.rows; ++r) {
+    for (int k = 0; k < 5; ++k) copy(r, k) = view.row(r)[k];
+  }
+  return copy;
+}
+
 // A candidate matching query frame i to clip frame first + i, with its score.
 SearchResult DiagonalCandidate(const RowMatrixXf& query, const RowMatrixXf& clip, int64_t first,
                                int anchor) {
@@ -21,25 +30,56 @@ SearchResult DiagonalCandidate(const RowMatrixXf& query, const RowMatrixXf& clip
 }
 
 // A candidate that found the right motion 40 frames late (one frame per query frame): refinement
-// must move it onto the planted copy, at the coarse-to-fine rates (120 Hz: a 30 Hz pass, then a
-// full-rate one) and at 30 Hz (full rate only), both further than one band reaches.
+// must move it onto the planted copy, further than one band reaches: in one pass at one rate, and
+// as the fast search does it, from a candidate found at a quarter of the rate (every fourth frame
+// of query and clip) settled there, then at the full rate.
 TEST(RefineCandidate, MovesALateCandidateOntoTheMatch) {
-  for (const double rate : {120.0, 30.0}) {
-    SCOPED_TRACE(rate);
+  for (const int factor : {4, 1}) {
+    SCOPED_TRACE(factor);
     const RowMatrixXf query = testing::Pattern(200, 5);
     RowMatrixXf clip = testing::SmoothNoise(1200, 5, 21);
     testing::Plant(clip, query, 400);
-    SearchResult candidate = DiagonalCandidate(query, clip, 440, 100);
+    const CoordinateView coarse_query = CoarseView(CoordinateView::Of(query), factor);
+    const CoordinateView coarse_clip = CoarseView(CoordinateView::Of(clip), factor);
+    const RowMatrixXf q = CopyRows(coarse_query), c = CopyRows(coarse_clip);
+    SearchResult candidate = DiagonalCandidate(q, c, 440 / factor, 100 / factor);
     const double before = candidate.score;
     BandWorkspace workspace;
-    RefineCandidate(CoordinateView::Of(query), CoordinateView::Of(clip), 100, rate, {2, 5},
-                    workspace, candidate);
+    RefineCandidate(coarse_query, coarse_clip, 100 / factor, 120.0 / factor, {2, 5}, workspace,
+                    candidate);
     EXPECT_LT(candidate.score, 1e-6) << "from " << before;
+    if (factor > 1) {
+      ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 100, factor,
+                                   {2, 5}, workspace, candidate));
+    }
+    EXPECT_LT(candidate.score, 1e-6);
     EXPECT_EQ(candidate.first_frame, 400);
     EXPECT_EQ(candidate.last_frame, 599);
     EXPECT_EQ(candidate.seed_frame, 500);
     EXPECT_NEAR(testing::MeanPathDistance(query, clip, candidate.path, 5), candidate.score, 1e-6);
   }
+}
+
+// From a coarse candidate some way off, the full-rate settling takes the best warp in its narrow
+// band whatever the coarse score was: never one that the model forbids.
+TEST(RefineFromCoarse, GivesAFullRateWarpOfTheModel) {
+  const RowMatrixXf query = testing::Pattern(120, 5);
+  RowMatrixXf clip = testing::SmoothNoise(900, 5, 23);
+  testing::Plant(clip, query, 300);
+  const RowMatrixXf q = CopyRows(CoarseView(CoordinateView::Of(query), 4));
+  const RowMatrixXf c = CopyRows(CoarseView(CoordinateView::Of(clip), 4));
+  SearchResult candidate = DiagonalCandidate(q, c, 77, 15);  // 8 full-rate frames late
+  BandWorkspace workspace;
+  ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
+                               workspace, candidate));
+  ASSERT_EQ(candidate.path.size(), 120u);
+  EXPECT_EQ(candidate.seed_frame, candidate.path[60]);
+  for (size_t i = 1; i < candidate.path.size(); ++i) {
+    EXPECT_GE(candidate.path[i] - candidate.path[i - 1], 0);
+    EXPECT_LE(candidate.path[i] - candidate.path[i - 1], 2);
+  }
+  EXPECT_NEAR(testing::MeanPathDistance(query, clip, candidate.path, 5), candidate.score, 1e-6);
+  EXPECT_LT(candidate.score, 0.05);
 }
 
 TEST(RefineCandidate, KeepsACandidateNothingNearBeats) {

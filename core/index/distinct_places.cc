@@ -22,7 +22,7 @@ void DistinctPlaces::PopRemoved() const {
 
 void DistinctPlaces::addPoint(float squared, size_t row) {
   if (k_ < 1 || (full() && squared >= worstDist())) return;
-  const int64_t frame = first_frame_ + static_cast<int64_t>(row);
+  const int64_t frame = first_frame_ + static_cast<int64_t>(row) * every_;
   const int clip = clip_of_(frame);
   if (!allowed_.empty() && !allowed_[clip]) return;
   // Kept places within `separation` lie in this bucket or the two beside it.

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/index/coarse_rate.h"
 #include "core/index/internal/distinct_places.h"
 #include "util/status_macros.h"
 
@@ -23,15 +24,21 @@ bool Nearer(const Neighbour& a, const Neighbour& b) {
 }  // namespace
 
 // A single kd-tree (exact, and the fastest FLANN index at ~10 dimensions) over the first
-// ann_dims columns of the coordinate block, read in place through the row stride.
+// ann_dims columns of every `every`-th row of the coordinate block, read in place through the
+// row stride. Its point i is the block's row i * every.
 class LibraryIndex::Tree {
  public:
-  Tree(const RowMatrixXf& coordinates, int ann_dims, int leaf_size)
-      : index_(flann::Matrix<float>(const_cast<float*>(coordinates.data()), coordinates.rows(),
-                                    ann_dims, coordinates.cols() * sizeof(float)),
-               flann::KDTreeSingleIndexParams(leaf_size, /*reorder=*/false)) {
+  Tree(const RowMatrixXf& coordinates, int ann_dims, int leaf_size, int every)
+      : index_(flann::Matrix<float>(const_cast<float*>(coordinates.data()),
+                                    (coordinates.rows() + every - 1) / every, ann_dims,
+                                    every * coordinates.cols() * sizeof(float)),
+               flann::KDTreeSingleIndexParams(leaf_size, /*reorder=*/false)),
+        every_(every) {
     index_.buildIndex();
   }
+
+  int every() const { return every_; }
+  int64_t points() const { return static_cast<int64_t>(index_.size()); }
 
   // The k nearest, or of those within `within`, as many as there are up to k.
   std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
@@ -57,12 +64,12 @@ class LibraryIndex::Tree {
     }
     std::vector<Neighbour> result(found);
     for (int i = 0; i < found; ++i) {
-      result[i] = {static_cast<int64_t>(indices[i]), std::sqrt(squared[i])};
+      result[i] = {static_cast<int64_t>(indices[i]) * every_, std::sqrt(squared[i])};
     }
     return result;
   }
 
-  // Every row nearer than `places`' worst, offered to it (rows numbered from 0).
+  // Every point nearer than `places`' worst, offered to it (numbered from 0: row / every()).
   void Offer(const float* point, float epsilon, flann::ResultSet<float>& places) const {
     flann::SearchParams params;
     params.eps = epsilon;
@@ -77,6 +84,7 @@ class LibraryIndex::Tree {
 
  private:
   flann::KDTreeSingleIndex<flann::L2<float>> index_;
+  int every_;
 };
 
 struct LibraryIndex::Block {
@@ -202,7 +210,8 @@ void LibraryIndex::AddBlock(std::vector<LibraryClip> clips, int64_t first_frame)
     next += clip.coordinates.rows();
     clip.coordinates = RowMatrixXf();  // release each copy as soon as it is in the block
   }
-  block->tree = std::make_unique<Tree>(block->coordinates, options_.ann_dims, options_.leaf_size);
+  block->tree = std::make_unique<Tree>(block->coordinates, options_.ann_dims, options_.leaf_size,
+                                       tree_every());
   blocks_.push_back(std::move(block));
   total_frames_ += rows;
 }
@@ -224,16 +233,20 @@ RowMatrixXf LibraryIndex::CopyClipCoordinates(int index) const {
 
 std::vector<Neighbour> LibraryIndex::TreeNearest(const float* point, int dims, int k,
                                                  float epsilon) const {
-  if (blocks_.size() == 1) return blocks_[0]->tree->Nearest(point, dims, k, epsilon);
+  const Tree& base = *blocks_[0]->tree;
+  if (blocks_.size() == 1) {
+    return base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())),
+                        epsilon);
+  }
   // The recent additions' tree is asked only for frames nearer than the base's k-th nearest:
   // with k in the thousands, that is most of the cost of a second tree saved.
-  std::vector<Neighbour> all = blocks_[0]->tree->Nearest(
-      point, dims, static_cast<int>(std::min<int64_t>(k, blocks_[0]->coordinates.rows())), epsilon);
+  std::vector<Neighbour> all =
+      base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())), epsilon);
   const float within = static_cast<int>(all.size()) == k ? all.back().distance
                                                          : std::numeric_limits<float>::infinity();
   const Block& recent = *blocks_[1];
   for (Neighbour n : recent.tree->Nearest(
-           point, dims, static_cast<int>(std::min<int64_t>(k, recent.coordinates.rows())), epsilon,
+           point, dims, static_cast<int>(std::min<int64_t>(k, recent.tree->points())), epsilon,
            within)) {
     n.frame += recent.first_frame;
     all.push_back(n);
@@ -263,10 +276,14 @@ std::pair<int, int64_t> LibraryIndex::Locate(int64_t global_frame) const {
   return {clip, global_frame - clips_[clip].first_frame};
 }
 
+int LibraryIndex::tree_every() const { return options_.coarse_tree ? CoarseFactor(rate_) : 1; }
+
 std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k, float epsilon,
                                              const std::vector<bool>& allowed_clips) const {
   k = static_cast<int>(std::min<int64_t>(k, total_frames()));
   if (dims == options_.ann_dims) {
+    int64_t tree_points = 0;
+    for (const auto& block : blocks_) tree_points += block->tree->points();
     if (allowed_clips.empty()) return TreeNearest(point, dims, k, epsilon);
     // When the filter keeps most frames, ask the tree for enough extra neighbours to cover the
     // filtered-out ones (doubling a few times), and scan only if that is not enough.
@@ -274,11 +291,11 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
     int64_t wanted =
         k + (k * (total_frames() - allowed_frames)) / std::max<int64_t>(1, allowed_frames) + 16;
     for (int attempt = 0; allowed_frames * 2 >= total_frames() && attempt < 4; ++attempt) {
-      wanted = std::min(wanted, total_frames());
+      wanted = std::min(wanted, tree_points);
       std::vector<Neighbour> found = TreeNearest(point, dims, static_cast<int>(wanted), epsilon);
       std::erase_if(found,
                     [&](const Neighbour& n) { return !allowed_clips[Locate(n.frame).first]; });
-      if (static_cast<int64_t>(found.size()) >= k || wanted == total_frames()) {
+      if (static_cast<int64_t>(found.size()) >= k || wanted == tree_points) {
         found.resize(std::min<size_t>(found.size(), k));
         return found;
       }
@@ -315,7 +332,7 @@ std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims,
   DistinctPlaces places(k, separation, clip_of, allowed_clips);
   if (dims == options_.ann_dims && AllowedFrames(allowed_clips) * 2 >= total_frames_) {
     for (const auto& block : blocks_) {
-      places.set_first_frame(block->first_frame);
+      places.set_rows(block->first_frame, block->tree->every());
       block->tree->Offer(point, epsilon, places);
     }
     return places.Take();
@@ -323,7 +340,7 @@ std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims,
   for (int c = 0; c < clip_count(); ++c) {
     if (!allowed_clips.empty() && !allowed_clips[c]) continue;
     const CoordinateView view = clip_coordinates(c);
-    places.set_first_frame(clips_[c].first_frame);
+    places.set_rows(clips_[c].first_frame, 1);
     for (int64_t f = 0; f < view.rows; ++f) {
       const float distance = Distance(point, view.row(f), dims);
       places.addPoint(distance * distance, static_cast<size_t>(f));

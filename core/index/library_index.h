@@ -32,15 +32,23 @@ struct LibraryClip {
   RowMatrixXf coordinates;
 };
 
-// The seed search's dimensions unless a search says otherwise (thesis Table 6.2): the kd-tree's
-// default dimensions too, since a search over other dimensions cannot use the tree.
-inline constexpr int kDefaultAnnDims = 10;
+// The seed search's dimensions unless a search says otherwise: the kd-tree's default dimensions
+// too, since a search over other dimensions cannot use the tree. The thesis's 10 (Table 6.2)
+// ranks seeds by dimensions the warp (5 by default) does not score: on 10 h of synthetic
+// capture the exact search's ten best lay up to 1,759th among distinct places by the
+// 10-dimensional pose distance and at most 170th by the 5-dimensional one (bench/RESULTS.md,
+// issue 11).
+inline constexpr int kDefaultAnnDims = 5;
 
 struct LibraryIndexOptions {
   // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
   int ann_dims = kDefaultAnnDims;
   // Points per kd-tree leaf.
   int leaf_size = 32;
+  // The kd-tree holds every n-th frame, n = CoarseFactor(rate) (core/index/coarse_rate.h: 2 at
+  // 30 Hz, 8 at 120 Hz): seeds at about 15 Hz, a tree 1/n the size, built n times faster.
+  // false: every frame.
+  bool coarse_tree = true;
 };
 
 struct Neighbour {
@@ -80,6 +88,8 @@ class LibraryIndex {
   double rate() const { return rate_; }
   int dims() const { return dims_; }
   int ann_dims() const { return options_.ann_dims; }
+  // The kd-tree holds every tree_every()-th frame of each block.
+  int tree_every() const;
   int64_t total_frames() const { return total_frames_; }
   int clip_count() const { return static_cast<int>(clips_.size()); }
   // 1 after a full build; 2 while recent additions are kept apart.
@@ -94,8 +104,9 @@ class LibraryIndex {
   RowMatrixXf CopyClipCoordinates(int index) const;
 
   // The k frames nearest to `point` over its first `dims` coordinates, nearest first. Uses the
-  // kd-tree when dims == ann_dims() and every clip is allowed; otherwise an exact linear scan
-  // over the allowed clips (`allowed_clips` empty: all).
+  // kd-tree, and so only its frames (every tree_every()-th), when dims == ann_dims() and every
+  // clip is allowed (or nearly); otherwise an exact linear scan over every frame of the allowed
+  // clips (`allowed_clips` empty: all).
   std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
                                  const std::vector<bool>& allowed_clips) const;
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "core/search/internal/search_query.h"
 #include "core/search/warp/time_warp.h"
@@ -14,8 +15,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Refinement lowers scores, so it considers this many candidates per result returned.
-constexpr int kRefinePoolFactor = 2;
+// Refinement lowers scores, so it considers this many candidates per result returned: a warp
+// pinned to a seed in a held pose can rank far below where its refined warp lands, and more
+// seeds then crowd it out of a small pool. Measured (bench/RESULTS.md, issue 11; recall@10
+// against the exact search, 10 h at 30 Hz): 2 gave 0.66, 4 gave 0.92 and 8 gave 0.95 for
+// 0.3 ms more.
+constexpr int kRefinePoolFactor = 8;
+// This many candidates per result returned, the best after the coarse refinement, are settled
+// at the full rate: 2 gave recall@10 0.92 at 10 h / 30 Hz, 4 gave 0.95 (coarse scores at 15 Hz
+// order nearly equal matches less surely).
+constexpr int kFinePoolFactor = 4;
 
 struct Seed {
   int clip;
@@ -60,6 +69,41 @@ std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t sep
 // few anchors inside one long instance for the warp to find its best alignment).
 int64_t PlaceSeparation(int64_t gap, int64_t query_rows) {
   return std::max<int64_t>(gap + 1, query_rows / 4);
+}
+
+// The pool's candidates (warps at 1 / `factor` of the library's rate, with their paths) moved to
+// the best warps near them; from a coarse rate, the best of them are then settled at the full
+// rate.
+absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
+                                                 int anchor, int coarse_anchor, int factor,
+                                                 const WarpConstraints& constraints,
+                                                 const SearchParams& params,
+                                                 std::vector<SearchResult> candidates) {
+  BandWorkspace workspace;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
+    SearchResult& candidate = candidates[i];
+    RefineCandidate(CoarseView(query, factor),
+                    CoarseView(library.clip_coordinates(candidate.clip_index), factor),
+                    coarse_anchor, library.rate() / factor, constraints, workspace, candidate);
+  }
+  if (factor > 1) {
+    candidates = RankResults(std::move(candidates), params.max_overlap,
+                             params.max_results * kFinePoolFactor);
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
+      SearchResult& candidate = candidates[i];
+      if (!RefineFromCoarse(query, library.clip_coordinates(candidate.clip_index), anchor, factor,
+                            constraints, workspace, candidate)) {
+        candidate.score = std::numeric_limits<double>::infinity();
+      }
+    }
+    std::erase_if(candidates, [](const SearchResult& c) { return std::isinf(c.score); });
+  }
+  if (!params.return_path) {
+    for (SearchResult& candidate : candidates) candidate.path = {};
+  }
+  return candidates;
 }
 
 }  // namespace
@@ -130,6 +174,15 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stats.clusters = static_cast<int64_t>(order.size());
   stats.clusters_ms = MillisecondsSince(stage);
 
+  // With refinement to follow, the warps run at about 15 Hz (core/index/coarse_rate.h).
+  const int factor = params.refine ? CoarseFactor(library.rate()) : 1;
+  const CoordinateView warp_query = CoarseView(query, factor);
+  const int warp_anchor = static_cast<int>(
+      std::min<int64_t>(std::lround(anchor / static_cast<double>(factor)), warp_query.rows - 1));
+  const auto warp_clip = [&](int clip) {
+    return CoarseView(library.clip_coordinates(clip), factor);
+  };
+
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
   std::sort(order.begin(), order.end(),
@@ -137,12 +190,15 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
   WarpWorkspace workspace;
   const int pool = params.refine ? params.max_results * kRefinePoolFactor : params.max_results;
-  StreamingTopResults top(pool, params.max_overlap, query.rows);
+  StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
     if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     const Seed& seed = order[i];
+    const CoordinateView clip = warp_clip(seed.clip);
+    const int64_t seed_frame =
+        std::min<int64_t>(std::llround(seed.frame / static_cast<double>(factor)), clip.rows - 1);
     std::optional<Warp> warp =
-        AnchoredWarp(query, library.clip_coordinates(seed.clip), anchor, seed.frame, constraints,
+        AnchoredWarp(warp_query, clip, warp_anchor, seed_frame, constraints,
                      params.return_path || params.refine, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
@@ -153,14 +209,8 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stage = Clock::now();
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
-    BandWorkspace band_workspace;
-    for (size_t i = 0; i < candidates.size(); ++i) {
-      if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
-      SearchResult& candidate = candidates[i];
-      RefineCandidate(query, library.clip_coordinates(candidate.clip_index), anchor, library.rate(),
-                      constraints, band_workspace, candidate);
-      if (!params.return_path) candidate.path = {};
-    }
+    MOTIONDB_ASSIGN_OR_RETURN(candidates, Refine(library, query, anchor, warp_anchor, factor,
+                                                 constraints, params, std::move(candidates)));
   }
   stats.refine_ms = MillisecondsSince(stage);
 

@@ -8,8 +8,6 @@
 namespace motiondb {
 namespace {
 
-// The coarse pass runs at rate / n for the n that brings it nearest this (none below 45 Hz).
-constexpr double kCoarseRate = 30.0;
 // The band's half-width while it moves: measured on the synthetic set, a seed in a held pose can
 // sit 0.8 s from where the best warp passes the characteristic frame, so the band is wide and may
 // move several times.
@@ -51,44 +49,38 @@ std::vector<int64_t> Upsample(const std::vector<int64_t>& coarse, int factor, in
   return fine;
 }
 
+void Adopt(Warp warp, int anchor, SearchResult& candidate) {
+  candidate.first_frame = warp.first;
+  candidate.last_frame = warp.last;
+  candidate.score = warp.score;
+  candidate.seed_frame = warp.path[anchor];
+  candidate.path = std::move(warp.path);
+}
+
 }  // namespace
 
 void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, double rate,
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate) {
-  const int factor = std::max(1, static_cast<int>(std::lround(rate / kCoarseRate)));
-  const auto radius_at = [](double r) {
-    return std::max(kMinRadius, static_cast<int>(std::lround(kMovingRadiusS * r)));
-  };
-  std::optional<Warp> warp;
-  if (factor > 1) {
-    const CoordinateView coarse_query{query.data, (query.rows - 1) / factor + 1,
-                                      query.stride * factor};
-    const CoordinateView coarse_clip{clip.data, (clip.rows - 1) / factor + 1, clip.stride * factor};
-    std::vector<int64_t> coarse_centre(coarse_query.rows);
-    for (int64_t j = 0; j < coarse_query.rows; ++j) {
-      coarse_centre[j] = candidate.path[j * factor] / factor;
-    }
-    const std::optional<Warp> coarse =
-        Settle(coarse_query, coarse_clip, std::move(coarse_centre), radius_at(rate / factor),
-               std::numeric_limits<double>::infinity(), constraints, workspace);
-    // The coarse path is within about `factor` frames of the best warp near it. When nothing
-    // there beats the candidate, neither did a wide full-rate band around the candidate itself
-    // (0 of 228 such candidates at 120 Hz), so the candidate stays as it is.
-    if (coarse) {
-      warp = Settle(query, clip, Upsample(coarse->path, factor, query.rows, clip.rows),
-                    std::max(kMinRadius, 2 * factor), candidate.score, constraints, workspace);
-    }
-  } else {
-    warp = Settle(query, clip, candidate.path, radius_at(rate), candidate.score, constraints,
-                  workspace);
-  }
-  if (!warp) return;
-  candidate.first_frame = warp->first;
-  candidate.last_frame = warp->last;
-  candidate.score = warp->score;
-  candidate.seed_frame = warp->path[anchor];
-  candidate.path = std::move(warp->path);
+  const int radius = std::max(kMinRadius, static_cast<int>(std::lround(kMovingRadiusS * rate)));
+  std::optional<Warp> warp =
+      Settle(query, clip, candidate.path, radius, candidate.score, constraints, workspace);
+  if (warp) Adopt(*std::move(warp), anchor, candidate);
+}
+
+bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
+                      const WarpConstraints& constraints, BandWorkspace& workspace,
+                      SearchResult& candidate) {
+  // The coarse path is within about `factor` frames of the best warp near it; a band that
+  // narrow re-centres when the best path touches its edge (2 * factor: the same results at
+  // 10 h / 120 Hz, a third more time).
+  std::optional<Warp> warp =
+      Settle(query, clip, Upsample(candidate.path, factor, query.rows, clip.rows),
+             std::max(kMinRadius, factor), std::numeric_limits<double>::infinity(), constraints,
+             workspace);
+  if (!warp) return false;
+  Adopt(*std::move(warp), anchor, candidate);
+  return true;
 }
 
 }  // namespace motiondb

@@ -2,16 +2,17 @@
 // seed can score far worse than the best warp beside it (a seed anywhere in a held pose pins the
 // warp there), enough to reorder nearly equal matches. The candidate is replaced by the best
 // warp near it, found by banded warps (core/band_warp.h) re-centred on their own best path while
-// that improves and touches the band's edge. From 45 Hz the band first moves at about 30 Hz
-// (every n-th frame of query and clip, n = round(rate / 30): 1/n^2 of the cells), then settles
-// at the full rate in a narrow band around where the coarse pass ended. A local search: scores
-// only fall, but the best warp farther away than the band reaches is not found.
+// that improves and touches the band's edge. The fast search warps and refines at about 15 Hz
+// first (CoarseView: 1/n^2 of the cells) and settles at the full rate in a narrow band around
+// the coarse path (RefineFromCoarse). A local search: scores only fall, but the best warp
+// farther away than the band reaches is not found.
 #ifndef MOTIONDB_CORE_SEARCH_WARP_REFINEMENT_H_
 #define MOTIONDB_CORE_SEARCH_WARP_REFINEMENT_H_
 
 #include <cstdint>
 #include <vector>
 
+#include "core/index/coarse_rate.h"
 #include "core/index/coordinate_view.h"
 #include "core/search/search_result.h"
 #include "core/search/warp/band_warp.h"
@@ -19,12 +20,25 @@
 
 namespace motiondb {
 
-// `candidate` (a result with its path) becomes the refined warp when that scores better: its
-// range, score, path, and as seed_frame the clip frame it matches to `anchor`. `rate`: the
-// frames per second of query and clip. `workspace`: one per thread.
+// Every `factor`-th row of `view`, from row 0, read in place.
+inline CoordinateView CoarseView(CoordinateView view, int factor) {
+  return {view.data, (view.rows - 1) / factor + 1, view.stride * factor};
+}
+
+// `candidate` (a result with its path) becomes the best warp near it when that scores better:
+// its range, score, path, and as seed_frame the clip frame it matches to `anchor`. `rate`: the
+// frames per second of query and clip, which sets the band's width. `workspace`: one per thread.
 void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, double rate,
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate);
+
+// `candidate`, a warp of CoarseView(query, factor) onto CoarseView(clip, factor) with its path,
+// becomes the best full-rate warp in a narrow band around it (whatever its score: coarse and
+// full-rate scores are not comparable), in full-rate frames; false when the band holds no warp
+// within the constraints (the candidate is then unchanged).
+bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
+                      const WarpConstraints& constraints, BandWorkspace& workspace,
+                      SearchResult& candidate);
 
 }  // namespace motiondb
 

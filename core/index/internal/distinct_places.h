@@ -28,10 +28,13 @@ class DistinctPlaces final : public flann::ResultSet<float> {
   DistinctPlaces(int k, int64_t separation, absl::FunctionRef<int(int64_t)> clip_of,
                  const std::vector<bool>& allowed);
 
-  // The global frame number of the rows the next addPoint() calls name (a tree's block).
-  void set_first_frame(int64_t first_frame) { first_frame_ = first_frame; }
+  // The rows the next addPoint() calls name: row r is global frame first_frame + r * every.
+  void set_rows(int64_t first_frame, int every) {
+    first_frame_ = first_frame;
+    every_ = every;
+  }
 
-  // flann::ResultSet: distances are squared; `row` is relative to set_first_frame().
+  // flann::ResultSet: distances are squared; `row` as set_rows() says.
   bool full() const override { return kept_ == k_; }
   float worstDist() const override;
   void addPoint(float squared, size_t row) override;
@@ -57,6 +60,7 @@ class DistinctPlaces final : public flann::ResultSet<float> {
   absl::FunctionRef<int(int64_t)> clip_of_;
   const std::vector<bool>& allowed_;
   int64_t first_frame_ = 0;
+  int every_ = 1;
   int kept_ = 0;
   std::vector<Place> places_;  // by id; removed ones stay, marked
   // (squared, id), farthest on top; removed places leave lazily.
