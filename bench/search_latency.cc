@@ -5,21 +5,26 @@
 // anchored at the action's peak (the thesis's manual characteristic point).
 //
 // usage: search_latency [--scenario 70s120|1h30|10h30|10h120|100h30|sweeps|all] [--queries N]
-//          [--exact-queries N] [--places N ...]
+//          [--exact-queries N] [--places N ...] [--neighbours N ...]
+// real10h30: real capture from ../shared/mocap grown to 10 h by perturbed copies, real queries.
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <random>
 #include <string>
 
 #include "absl/strings/str_cat.h"
 #include "bench/measure.h"
+#include "core/bvh/bvh_reader.h"
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
 #include "core/space/search_coordinates.h"
+#include "testing/perturbed_copy.h"
 #include "testing/synthetic_corpus.h"
 #include "util/cli_conventions.h"
 #include "util/status_macros.h"
@@ -28,6 +33,7 @@ namespace motiondb {
 namespace {
 
 using bench::Clock;
+using bench::MocapRoot;
 using bench::Percentile;
 using bench::SecondsSince;
 using bench::StatusMiB;
@@ -43,6 +49,16 @@ struct Bench {
   std::vector<Query> queries;
   double generate_s = 0, project_s = 0, build_s = 0, build_rss_mib = 0;
 };
+
+// bench.library over `clips`, timing the build and measuring the memory it takes.
+absl::Status BuildIndex(std::vector<LibraryClip> clips, double rate, Bench& bench) {
+  const double rss_before = StatusMiB(getpid(), "VmRSS");
+  const Clock::time_point start = Clock::now();
+  MOTIONDB_ASSIGN_OR_RETURN(bench.library, LibraryIndex::Build(std::move(clips), rate, {}));
+  bench.build_s = SecondsSince(start);
+  bench.build_rss_mib = StatusMiB(getpid(), "VmRSS") - rss_before;
+  return absl::OkStatus();
+}
 
 // A synthetic library of `duration_s` at `rate` Hz (the space rate too), projected to `dims`
 // dimensions (-1: all), and queries of 2.8 s around its first actions.
@@ -82,12 +98,56 @@ absl::StatusOr<Bench> Prepare(double duration_s, double rate, int dims, int quer
   }
   generated = SyntheticCorpus();  // the joint rotations are not needed any more
   bench.project_s = SecondsSince(start);
+  MOTIONDB_RETURN_IF_ERROR(BuildIndex(std::move(clips), rate, bench));
+  return bench;
+}
 
-  const double rss_before = StatusMiB(getpid(), "VmRSS");
+// Real capture grown to `duration_s` (issue 11, item 4): every clip of the Bandai folders (one
+// skeleton), then perturbed copies of them in turn (testing/perturbed_copy.h), in a space trained
+// on the originals at 30 Hz. Queries: whole bandai2-normal clips, spread over its contents, with
+// the characteristic frame found automatically as a user's query would have it.
+absl::StatusOr<Bench> PrepareReal(double duration_s, int query_count) {
+  const double rate = 30;
+  Bench bench;
+  Clock::time_point start = Clock::now();
+  std::vector<TrainingClip> originals;
+  std::vector<size_t> query_clips;
+  for (const char* folder : {"bandai2-normal", "bandai1"}) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(MocapRoot() / folder)) {
+      if (entry.path().extension() == ".bvh") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const std::filesystem::path& path : files) {
+      MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
+      originals.push_back({path.stem().string(), std::move(read.clip), std::nullopt});
+    }
+    if (query_clips.empty()) {
+      for (int q = 0; q < query_count; ++q) query_clips.push_back(q * files.size() / query_count);
+    }
+  }
+  bench.generate_s = SecondsSince(start);
   start = Clock::now();
-  MOTIONDB_ASSIGN_OR_RETURN(bench.library, LibraryIndex::Build(std::move(clips), rate, {}));
-  bench.build_s = SecondsSince(start);
-  bench.build_rss_mib = StatusMiB(getpid(), "VmRSS") - rss_before;
+  SpaceOptions space_options;
+  space_options.sample_rate = rate;
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, MotionSpace::Build(originals, space_options));
+  bench.space = std::make_unique<MotionSpace>(std::move(space));
+  std::vector<LibraryClip> clips;
+  int64_t frames = 0;
+  std::mt19937_64 rng(11);
+  for (size_t i = 0; frames < duration_s * rate; ++i) {
+    const TrainingClip& original = originals[i % originals.size()];
+    Clip copy = original.clip;
+    if (i >= originals.size()) {
+      MOTIONDB_ASSIGN_OR_RETURN(copy, testing::PerturbedCopy(original.clip, {}, rng));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*bench.space, copy, 16));
+    frames += coordinates.rows();
+    clips.push_back({static_cast<int64_t>(i), original.source, {}, std::move(coordinates)});
+  }
+  for (size_t q : query_clips) bench.queries.push_back({clips[q].coordinates, -1});
+  bench.project_s = SecondsSince(start);
+  MOTIONDB_RETURN_IF_ERROR(BuildIndex(std::move(clips), rate, bench));
   return bench;
 }
 
@@ -149,12 +209,19 @@ double RecallAtTen(const Run& fast, const Run& exact) {
 }
 
 // The fast search as configured by default (the thesis's seeds, refined), without
-// refinement, and with distinct places as seeds: 128 of them and the --places values.
-std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int>& compare) {
+// refinement, with the --neighbours values, and with distinct places as seeds: 128 of them and
+// the --places values.
+std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int>& compare,
+                                                           const std::vector<int>& neighbours) {
   SearchParams unrefined;
   unrefined.refine = false;
   std::vector<std::pair<std::string, SearchParams>> variants = {{"fast", {}},
                                                                 {"fast, no refinement", unrefined}};
+  for (int count : neighbours) {
+    SearchParams params;
+    params.neighbours = count;
+    variants.emplace_back(absl::StrCat("fast, ", count, " neighbours"), params);
+  }
   std::vector<int> places = {SearchParams().places};
   places.insert(places.end(), compare.begin(), compare.end());
   for (int count : places) {
@@ -167,8 +234,10 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int
 }
 
 absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
-                      int exact_queries, const std::vector<int>& compare) {
-  MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, Prepare(duration_s, rate, 16, queries));
+                      int exact_queries, const std::vector<int>& compare,
+                      const std::vector<int>& neighbours, bool real = false) {
+  MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, real ? PrepareReal(duration_s, queries)
+                                                    : Prepare(duration_s, rate, 16, queries));
   const LibraryIndex& library = *bench.library;
   const double indexed_mib = library.total_frames() * library.ann_dims() * 4 / 1048576.0;
   std::printf("\n## %s: %.0f s at %.0f Hz = %lld frames (%d clips), %zu queries of %lld frames\n",
@@ -200,7 +269,7 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
              a[i].last_frame == b[i].last_frame && a[i].score == b[i].score;
     }
   }
-  for (const auto& [label, params] : Variants(compare)) {
+  for (const auto& [label, params] : Variants(compare, neighbours)) {
     MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
     std::printf(
         "%s: p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f refine %.3f "
@@ -256,15 +325,25 @@ absl::Status Sweeps(int queries) {
   return absl::OkStatus();
 }
 
-absl::Status Main(const std::string& scenario, int q, int e, const std::vector<int>& p) {
+absl::Status Main(const std::string& scenario, int q, int e, const std::vector<int>& p,
+                  const std::vector<int>& n) {
   const auto wants = [&](const char* name) { return scenario == "all" || scenario == name; };
-  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e, p));
-  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e, p));
-  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e, p));
-  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e, p));
+  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e, p, n));
+  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e, p, n));
+  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e, p, n));
+  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e, p, n));
+  // Not in "all": it needs ../shared/mocap and takes minutes.
+  if (scenario == "real10h30") {
+    if (!std::filesystem::is_directory(MocapRoot() / "bandai1")) {
+      std::printf("search_latency: %s is absent; real10h30 not measured\n", MocapRoot().c_str());
+    } else {
+      MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz of real capture and perturbed copies", 36000,
+                                        30, q, e, p, n, /*real=*/true));
+    }
+  }
   // Not in "all": it takes minutes and about 3 GB.
   if (scenario == "100h30") {
-    MOTIONDB_RETURN_IF_ERROR(Scenario("100 h at 30 Hz", 360000, 30, q, e, p));
+    MOTIONDB_RETURN_IF_ERROR(Scenario("100 h at 30 Hz", 360000, 30, q, e, p, n));
   }
   if (wants("sweeps")) MOTIONDB_RETURN_IF_ERROR(Sweeps(q));
   return absl::OkStatus();
@@ -280,7 +359,7 @@ int main(int argc, char** argv) {
   int queries = 20, exact_queries = 5;
   motiondb::cli::OneOf(
       app.add_option("--scenario", scenario, "the library to measure, or the sweeps, or all"),
-      {"70s120", "1h30", "10h30", "10h120", "100h30", "sweeps", "all"})
+      {"70s120", "1h30", "10h30", "10h120", "100h30", "real10h30", "sweeps", "all"})
       ->capture_default_str();
   app.add_option("--queries", queries, "fast-search queries per scenario")
       ->type_name("N")
@@ -294,10 +373,16 @@ int main(int argc, char** argv) {
   app.add_option("--places", places, "also measure the fast search with these numbers of places")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
+  std::vector<int> neighbour_counts;
+  app.add_option("--neighbours", neighbour_counts,
+                 "also measure the fast search with these numbers of nearest-frame seeds")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
-  const absl::Status status = motiondb::Main(scenario, queries, exact_queries, places);
+  const absl::Status status =
+      motiondb::Main(scenario, queries, exact_queries, places, neighbour_counts);
   if (!status.ok()) {
     std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());
     return 1;

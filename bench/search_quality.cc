@@ -29,6 +29,7 @@ struct QualityFlags {
   std::string weights = "mass";
   std::string neutral = "mean";
   bool keep_heading = false, no_refine = false;
+  int places = 0;
   SpaceOptions space;
   RetrievalOptions retrieval;
 };
@@ -54,6 +55,7 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
   SearchParams& params = flags->retrieval.params;
   for (auto [name, field, what, min] :
        {std::tuple{"--neighbours", &params.neighbours, "seeds", 1},
+        {"--places", &flags->places, "distinct places as seeds (0: the nearest frames)", 0},
         {"--ann-dims", &params.ann_dims, "seed search dimensions", 1},
         {"--dtw-dims", &params.dtw_dims, "time-warp dimensions", 1},
         {"--slope", &params.slope_limit, "the warp's slope limit", 1},
@@ -89,6 +91,10 @@ absl::Status Run(QualityFlags& flags) {
                    : neutral == "boundary" ? NeutralPose::kBoundaryMean
                                            : NeutralPose::kQueryMean;
   params.refine = !flags.no_refine;
+  if (flags.places > 0) {
+    params.seed_selection = SeedSelection::kDistinctPlaces;
+    params.places = flags.places;
+  }
 
   const bench::Clock::time_point start = bench::Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledIndex library,
@@ -102,10 +108,12 @@ absl::Status Run(QualityFlags& flags) {
               static_cast<long long>(library.index->total_frames()), library.space->sample_rate(),
               library.space->dims(), setup_s);
   std::printf(
-      "metric %s, weights %s, neighbours %d, ann_dims %d, dtw_dims %d, slope %d, "
+      "metric %s, weights %s, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
       "neutral %s%s%s\n",
       metric.c_str(), std::string(WeightPresetName(space_options.weights.preset)).c_str(),
-      params.neighbours, params.ann_dims, params.dtw_dims, params.slope_limit, neutral.c_str(),
+      flags.places > 0 ? "distinct places" : "neighbours",
+      flags.places > 0 ? flags.places : params.neighbours, params.ann_dims, params.dtw_dims,
+      params.slope_limit, neutral.c_str(),
       space_options.pose.remove_heading ? "" : ", heading kept",
       params.refine ? "" : ", no refinement");
   std::printf("fast:  precision@%d %.3f over %d queries, latency p50 %.2f ms p99 %.2f ms\n",
