@@ -150,8 +150,9 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
   EXPECT_GE(found, 45) << found << " of " << total;
 }
 
-// Each clip as a query against all the others: precision@5 of the content class >= 0.8 and the
-// fast search's recall@10 against exact search >= 0.9, with the default (unit) metric.
+// Each clip as a query against all the others: precision@5 of the content class >= 0.98 (0.988
+// measured) and the fast search's recall@10 against exact search >= 0.95 (0.977 measured), with
+// the default (unit) metric.
 TEST(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
   MOTIONDB_REQUIRE_MOCAP(mocap);
   absl::StatusOr<testing::LabelledIndex> library =
@@ -163,9 +164,9 @@ TEST(BandaiQuality, LeaveOneOutPrecisionAndRecall) {
   absl::StatusOr<RetrievalReport> report =
       EvaluateLeaveOneOut(*library->index, library->labels, options);
   ASSERT_TRUE(report.ok()) << report.status();
-  EXPECT_GE(report->precision, 0.8);
+  EXPECT_GE(report->precision, 0.98);
   EXPECT_GE(report->exact_precision, 0.8);
-  EXPECT_GE(report->recall, 0.9);
+  EXPECT_GE(report->recall, 0.95);
   for (const auto& [label, precision] : report->precision_by_label) {
     EXPECT_GE(precision, 0.6) << label;
   }
