@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   motiondb::cli::AddSpaceBuild(commands, space);
   motiondb::cli::AddRemoteSpace(commands, space);
   motiondb::cli::AddSearch(commands);
+  motiondb::cli::AddLabelCommands(commands);
   motiondb::cli::AddInfo(commands);
   motiondb::cli::AddBackup(commands);
   commands.AddHelp();

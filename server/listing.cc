@@ -27,11 +27,16 @@ absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort) {
 
 }  // namespace
 
-absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
-                                            const ClipListRequest& request) {
+absl::StatusOr<storage::Page> StoragePage(const PageRequest& page) {
   storage::Page stored;
   MOTIONDB_ASSIGN_OR_RETURN(stored.page_size, ResolvePageSize(page.page_size));
   stored.page_token = page.page_token;
+  return stored;
+}
+
+absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
+                                            const ClipListRequest& request) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
   storage::ClipFilter filter{.tag = request.tag, .name_contains = request.name_contains};
   MOTIONDB_ASSIGN_OR_RETURN(filter.order, ClipOrderOf(request.sort));
   return database.ListClips(stored, filter);

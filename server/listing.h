@@ -19,6 +19,9 @@ struct PageRequest {
   std::string page_token;  // empty for the first page
 };
 
+// `page` as storage::Database's listings take it: the size resolved as above.
+absl::StatusOr<storage::Page> StoragePage(const PageRequest& page);
+
 // A clip listing's filters and order as the API gives them: sort is "id" (or empty), "name" or
 // "created"; another is INVALID_ARGUMENT naming `sort`.
 struct ClipListRequest {

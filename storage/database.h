@@ -31,6 +31,7 @@
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
 #include "core/space/motion_space.h"
+#include "storage/label_record.h"
 
 namespace motiondb::storage {
 
@@ -200,6 +201,33 @@ class Database {
   absl::StatusOr<std::vector<Projection>> LoadProjections(int64_t space_id);
   // Ids of the clips of a skeleton, in id order.
   absl::StatusOr<std::vector<int64_t>> ClipsOfSkeleton(int64_t skeleton_id);
+
+  // Labels (storage/label_record.h). AddLabels stores the batch in one transaction, all or
+  // nothing, and returns the new ids in its order. Errors name the item and field
+  // ("labels[3].value: 1.5 is outside [0, 1]"): NOT_FOUND for an unknown clip (or source label
+  // or space of a propagated label); INVALID_ARGUMENT for an empty batch, a range outside the
+  // clip's frames or reversed, a value not in [0, 1] (NaN included), a descriptor that is empty,
+  // over kMaxDescriptorBytes or holds a control character, or a manual label carrying the
+  // fields of a propagated one.
+  absl::StatusOr<std::vector<int64_t>> AddLabels(const std::vector<LabelRecord>& labels,
+                                                 const WriteOptions& write = {});
+  // Labels matching `filter`, in label id order; Page as ListClips takes it (its token is the
+  // last label id).
+  absl::StatusOr<LabelPage> ListLabels(const Page& page, const LabelFilter& filter);
+  // Labels of `query.descriptor` with a value of at least `query.min_value`, strongest first,
+  // then by clip and first frame. INVALID_ARGUMENT for an empty descriptor or a min_value
+  // outside [0, 1].
+  absl::StatusOr<LabelPage> FindLabels(const Page& page, const LabelQuery& query);
+  // Every label of a clip, by first frame (then last frame, id): its timeline. NOT_FOUND.
+  absl::StatusOr<std::vector<LabelRecord>> ClipLabels(int64_t clip_id);
+  // Deletes the labels of these ids, and those propagated from them, in one transaction;
+  // returns how many of the ids there were. NOT_FOUND naming label_ids[i] when an id is unknown,
+  // and nothing is deleted.
+  absl::StatusOr<int64_t> DeleteLabels(const std::vector<int64_t>& label_ids,
+                                       const WriteOptions& write = {});
+  // The same for every label `filter` takes (and those propagated from them); returns how many
+  // it took. INVALID_ARGUMENT for an empty filter: deleting every label is not a slip to allow.
+  absl::StatusOr<int64_t> DeleteLabels(const LabelFilter& filter, const WriteOptions& write = {});
 
   // Every skeleton, in id order, with its clip count and first clip, in one query.
   absl::StatusOr<std::vector<SkeletonSummary>> ListSkeletons();

@@ -23,9 +23,6 @@
 namespace motiondb::storage {
 namespace {
 
-constexpr int kDefaultPageSize = 100;
-constexpr int kMaxPageSize = 1000;
-
 // Where a page starts: after the clip `clip_id` (0: at the first), whose sort key is `key` (a
 // name, or a time in decimal; unused in id order).
 struct PageStart {
@@ -386,12 +383,7 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string
 }
 
 absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter& filter) {
-  const int page_size = page.page_size == 0 ? kDefaultPageSize : page.page_size;
-  if (page_size < 1 || page_size > kMaxPageSize) {
-    return absl::InvalidArgumentError(absl::StrCat("page_size must be 1 to ", kMaxPageSize,
-                                                   " (0 for ", kDefaultPageSize, "), got ",
-                                                   page.page_size));
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int page_size, CheckPageSize(page.page_size));
   MOTIONDB_ASSIGN_OR_RETURN(const PageStart start, ParsePageToken(filter.order, page.page_token));
   if (!filter.tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", filter.tag, kMaxTagBytes));
 

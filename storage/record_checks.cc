@@ -1,6 +1,7 @@
 #include "storage/internal/record_checks.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
@@ -99,6 +100,48 @@ absl::Status CheckProjection(const RowMatrixXf& coordinates, std::optional<int> 
   }
   if (!coordinates.allFinite()) {
     return absl::InvalidArgumentError(absl::StrCat(what, " contains NaN or infinite values"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<int> CheckPageSize(int page_size) {
+  if (page_size < 0 || page_size > kMaxPageSize) {
+    return absl::InvalidArgumentError(absl::StrCat("page_size must be 1 to ", kMaxPageSize,
+                                                   " (0 for ", kDefaultPageSize, "), got ",
+                                                   page_size));
+  }
+  return page_size == 0 ? kDefaultPageSize : page_size;
+}
+
+absl::Status CheckLabel(const LabelRecord& label, size_t index) {
+  const std::string item = absl::StrCat("labels[", index, "]");
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckName(absl::StrCat(item, ".descriptor"), label.descriptor, kMaxDescriptorBytes));
+  // Written so that NaN fails too.
+  if (!(label.value >= 0 && label.value <= 1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item, ".value: ", label.value, " is outside [0, 1]"));
+  }
+  if (label.first_frame < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item, ".first_frame: ", label.first_frame, " is negative"));
+  }
+  if (label.last_frame < label.first_frame) {
+    return absl::InvalidArgumentError(absl::StrCat(item, ".last_frame: ", label.last_frame,
+                                                   " is before first_frame ", label.first_frame));
+  }
+  if (label.origin == LabelOrigin::kManual) {
+    if (label.source_label_id != 0 || label.space_id != 0 || label.score != 0 ||
+        !label.job_id.empty()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(item, ": a manual label has no source_label_id, space_id, score or job_id"));
+    }
+  } else if (label.source_label_id <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item, ".source_label_id: a propagated label names the label it came from"));
+  } else if (!std::isfinite(label.score)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item, ".score: ", label.score, " is not finite"));
   }
   return absl::OkStatus();
 }

@@ -147,7 +147,7 @@ TEST_F(CliTest, UnknownCommandAndHelp) {
   const testing::CommandResult help = RunCli({"help"});
   EXPECT_EQ(help.exit_code, 0);
   for (const char* command : {"inspect", "convert", "project", "ingest", "clips", "clip", "export",
-                              "space", "search", "info", "help"}) {
+                              "space", "search", "label", "labels", "info", "help"}) {
     EXPECT_THAT(help.out, HasSubstr(std::string("\n  ") + command + " ")) << command;
   }
   EXPECT_EQ(RunCli({"--help"}).out, help.out);
@@ -614,6 +614,172 @@ TEST_F(CliServerTest, SpaceListAndShowCountTheClipsIngestedSinceTheBuild) {
   ASSERT_EQ(Remote({"clip", "delete", clip_id_}).exit_code, 0);
   r = Remote({"space", "show", "body", "--json"});
   EXPECT_EQ(nlohmann::json::parse(r.out)["clips"], 1);
+}
+
+// Labels on the fixture's clip (54 frames at 30 fps): added by id or name, in frames or seconds;
+// listed, found, deleted; the server's complaints told in the command's words.
+TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
+  testing::CommandResult r =
+      Remote({"label", "add", "walk54:10-20", "step", "--value", "0.8", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json framed = nlohmann::json::parse(r.out);
+  EXPECT_EQ(framed["clip_name"], "walk54");
+  EXPECT_EQ(framed["first_frame"], 10);
+  EXPECT_EQ(framed["last_frame"], 20);
+  EXPECT_EQ(framed["origin"], "manual");
+  r = Remote({"label", "add", clip_id_ + ":0.5-1", "step", "--seconds"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("clip " + clip_id_ + " (walk54) frames 15-30 (0.500-1.000 s)"));
+  ASSERT_EQ(Remote({"label", "add", clip_id_, "whole"}).exit_code, 0);
+
+  r = Remote({"labels", "list", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json listed = nlohmann::json::parse(r.out)["labels"];
+  ASSERT_EQ(listed.size(), 3u) << r.out;
+  EXPECT_EQ(listed[2]["first_frame"], 0);
+  EXPECT_EQ(listed[2]["last_frame"], kFrames - 1);
+  r = Remote({"labels", "list", "--descriptor", "step", "--min", "0.9", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  listed = nlohmann::json::parse(r.out)["labels"];
+  ASSERT_EQ(listed.size(), 1u) << r.out;
+  EXPECT_EQ(listed[0]["first_frame"], 15);
+  r = Remote({"labels", "list", "--limit", "1", "--origin", "manual"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("ID +CLIP +NAME +FRAMES"))) << r.out;
+  EXPECT_TRUE(
+      std::regex_search(r.out, std::regex(" walk54 +10-20 +0.33-0.67 +step +0.800 +manual")))
+      << r.out;
+  EXPECT_THAT(r.err, HasSubstr("next page: --page-token "));
+
+  r = Remote({"labels", "find", "step", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  listed = nlohmann::json::parse(r.out)["labels"];
+  ASSERT_EQ(listed.size(), 2u) << r.out;
+  EXPECT_EQ(listed[0]["value"], 1.0);  // strongest first
+  EXPECT_EQ(listed[1]["label_id"], framed["label_id"]);
+  r = Remote({"labels", "find", "step", "--tag", "nosuch", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.out)["labels"].empty());
+
+  const struct {
+    std::vector<std::string> args;
+    std::string message;
+  } errors[] = {
+      {{"label", "add", "walk54:10-99", "step"},
+       "INVALID_ARGUMENT: TO: 99 is past the clip's last frame 53"},
+      {{"label", "add", "walk54:20-10", "step"}, "TO: 10 is before first_frame 20"},
+      {{"label", "add", "walk54", "step", "--value", "1.5"}, "--value: 1.5 is outside [0, 1]"},
+      {{"label", "add", "walk54", ""}, "DESCRIPTOR must not be empty"},
+      {{"label", "add", "nosuch", "step"}, "NOT_FOUND: CLIP: no clip is named 'nosuch'"},
+      {{"label", "add", "walk54:1.5-3", "step"}, "frames are whole numbers"},
+      {{"labels", "find", "step", "--min", "2"}, "--min: 2 is outside [0, 1]"},
+      {{"labels", "delete", "999999"}, "NOT_FOUND: ID 999999: label 999999 not found"},
+      {{"labels", "delete"}, "give label ids or a filter"},
+  };
+  for (const auto& e : errors) {
+    r = Remote(e.args);
+    EXPECT_EQ(r.exit_code, 1) << e.message;
+    EXPECT_THAT(r.err, HasSubstr(e.message));
+  }
+
+  r = Remote({"labels", "delete", framed["label_id"].dump(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["deleted"], 1);
+  r = Remote({"labels", "delete", "--descriptor", "whole"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("deleted 1 labels"));
+  r = Remote({"labels", "list", "--json"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["labels"].size(), 1u) << r.out;
+
+  for (const std::vector<std::string>& help : {std::vector<std::string>{"label", "add", "--help"},
+                                               {"labels", "list", "--help"},
+                                               {"labels", "find", "--help"},
+                                               {"labels", "delete", "--help"},
+                                               {"labels", "import", "--help"},
+                                               {"labels", "export", "--help"}}) {
+    r = RunCli(help);
+    EXPECT_EQ(r.exit_code, 0) << help[1];
+    EXPECT_THAT(r.out, HasSubstr("Usage: motiondb " + help[0] + " " + help[1])) << r.out;
+  }
+  EXPECT_THAT(RunCli({"label", "add", "--help"}).out, HasSubstr("CLIP[:FROM-TO]"));
+  EXPECT_THAT(RunCli({"labels", "list", "--help"}).out, HasSubstr("--origin manual|propagated"));
+}
+
+// `labels export` writes what `labels import` reads: exported, deleted, imported and exported
+// again, the file is the same. Import is one batch: a bad line stores nothing, and is named.
+TEST_F(CliServerTest, LabelsExportAndImportRoundTripCsvAndJson) {
+  ASSERT_EQ(Remote({"label", "add", "walk54:0-9", "step, left", "--value", "0.25"}).exit_code, 0);
+  ASSERT_EQ(Remote({"label", "add", "walk54:10-20", "say \"hi\"", "--value", "0.7"}).exit_code, 0);
+  for (const std::string format : {"csv", "json"}) {
+    const std::string first = (dir_ / ("labels." + format)).string();
+    const std::string second = (dir_ / ("again." + format)).string();
+    testing::CommandResult r = Remote({"labels", "export", "-o", first});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("wrote 2 labels to " + first));
+    ASSERT_EQ(Remote({"labels", "delete", "--clip", clip_id_}).exit_code, 0);
+    r = Remote({"labels", "import", first, "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["imported"], 2);
+    ASSERT_EQ(Remote({"labels", "export", "-o", second}).exit_code, 0);
+    EXPECT_EQ(testing::ReadFileOrDie(second), testing::ReadFileOrDie(first)) << format;
+  }
+  EXPECT_THAT(testing::ReadFileOrDie((dir_ / "labels.csv").string()),
+              HasSubstr("walk54,0,9,\"step, left\",0.25,frames\n"));
+  testing::CommandResult r =
+      Remote({"labels", "export", "--format", "json", "--descriptor", "say \"hi\""});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json exported = nlohmann::json::parse(r.out);
+  ASSERT_EQ(exported.size(), 1u);
+  EXPECT_EQ(exported[0]["value"], 0.7);
+
+  // Another column order, seconds, an empty value (1) and end (the last frame).
+  const std::string seconds =
+      WriteText("seconds.csv",
+                "descriptor,clip,end,start,value,unit\r\nkick,walk54,1,0.5,,seconds\r\n"
+                "turn," +
+                    clip_id_ + ",,40,0.5,\r\n");
+  r = Remote({"labels", "import", seconds});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("imported 2 labels from " + seconds));
+  r = Remote({"labels", "list", "--json", "--descriptor", "kick"});
+  nlohmann::json listed = nlohmann::json::parse(r.out)["labels"];
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0]["first_frame"], 15);
+  EXPECT_EQ(listed[0]["last_frame"], 30);
+  EXPECT_EQ(listed[0]["value"], 1.0);
+  r = Remote({"labels", "list", "--json", "--descriptor", "turn"});
+  EXPECT_EQ(nlohmann::json::parse(r.out)["labels"][0]["last_frame"], kFrames - 1);
+
+  const struct {
+    std::string name;
+    std::string text;
+    std::string message;
+  } bad[] = {
+      {"value.csv", "clip,start,end,descriptor,value\nwalk54,0,5,a,1\n\nwalk54,0,5,b,1.5\n",
+       "value.csv: line 4, value: 1.5 is outside [0, 1]"},
+      {"frames.csv", "clip,start,end,descriptor,value\nwalk54,0,60,a,1\n",
+       "frames.csv: line 2, end: 60 is past the clip's last frame 53"},
+      {"clip.json",
+       R"([{"clip": "walk54", "descriptor": "a"}, {"clip": "nosuch", "descriptor": "b"}])",
+       "clip.json: item 1, clip: no clip is named 'nosuch'"},
+      {"number.csv", "clip,start,end,descriptor,value\nwalk54,x,5,a,1\n",
+       "number.csv: line 2: start: 'x' is not a number"},
+      {"header.csv", "clip,begin,end,descriptor,value\n",
+       "header.csv: line 1: header: unknown "
+       "column 'begin'"},
+      {"item.json", R"([{"clip": "walk54", "descriptor": "a", "start": "0"}])",
+       "item.json: item 0: start: expected a number"},
+      {"labels.txt", "clip,start,end,descriptor,value\n", "expected a .csv or .json file"},
+  };
+  const size_t before =
+      nlohmann::json::parse(Remote({"labels", "list", "--json"}).out)["labels"].size();
+  for (const auto& b : bad) {
+    r = Remote({"labels", "import", WriteText(b.name, b.text)});
+    EXPECT_EQ(r.exit_code, 1) << b.name;
+    EXPECT_THAT(r.err, HasSubstr(b.message));
+  }
+  EXPECT_EQ(nlohmann::json::parse(Remote({"labels", "list", "--json"}).out)["labels"].size(),
+            before);
 }
 
 TEST(CliAssimp, InspectsDebianTestModels) {

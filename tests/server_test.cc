@@ -21,6 +21,7 @@
 #include "core/bvh/bvh_writer.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/label_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
@@ -86,7 +87,8 @@ class Client {
         clips_(v1::ClipService::NewStub(channel_)),
         spaces_(v1::SpaceService::NewStub(channel_)),
         search_(v1::SearchService::NewStub(channel_)),
-        server_(v1::ServerService::NewStub(channel_)) {}
+        server_(v1::ServerService::NewStub(channel_)),
+        labels_(v1::LabelService::NewStub(channel_)) {}
 
   // A call context carrying the token and a deadline (generous by default: a test that hangs
   // should fail, not stall the suite).
@@ -127,6 +129,7 @@ class Client {
   v1::SpaceService::Stub& spaces() { return *spaces_; }
   v1::SearchService::Stub& search() { return *search_; }
   v1::ServerService::Stub& server() { return *server_; }
+  v1::LabelService::Stub& labels() { return *labels_; }
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
 
  private:
@@ -136,6 +139,7 @@ class Client {
   std::unique_ptr<v1::SpaceService::Stub> spaces_;
   std::unique_ptr<v1::SearchService::Stub> search_;
   std::unique_ptr<v1::ServerService::Stub> server_;
+  std::unique_ptr<v1::LabelService::Stub> labels_;
 };
 
 // A stored range as the query. These tests check that a search finds its own query first,
@@ -874,6 +878,234 @@ TEST_F(ServerTest, RealClipsSearchAndSkeletonMismatch) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Labels.
+
+// A manual label on frames `first`..`last` of a clip (both unset: the whole clip).
+v1::NewLabel FrameLabel(int64_t clip_id, std::optional<int> first, std::optional<int> last,
+                        const std::string& descriptor, std::optional<double> value = 1.0) {
+  v1::NewLabel label;
+  label.set_clip_id(clip_id);
+  if (first) label.set_first_frame(*first);
+  if (last) label.set_last_frame(*last);
+  label.set_descriptor_name(descriptor);
+  if (value) label.set_value(*value);
+  return label;
+}
+
+std::vector<int64_t> LabelIds(const google::protobuf::RepeatedPtrField<v1::Label>& labels) {
+  std::vector<int64_t> ids;
+  for (const v1::Label& label : labels) ids.push_back(label.label_id());
+  return ids;
+}
+
+TEST_F(ServerTest, LabelsAddListFindTimelineAndDelete) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()), {"walk"});
+  const int64_t turn = client.IngestOrFail("turn.bvh", BvhText(ChainClip(0.05)), {"turn"});
+
+  // Frames, seconds (the clip by name, the value unset: 1) and the whole clip, in one batch.
+  v1::AddLabelsRequest add;
+  *add.add_labels() = FrameLabel(walk, 10, 20, "step", 0.9);
+  v1::NewLabel* by_name = add.add_labels();
+  by_name->set_clip_name("turn");
+  by_name->set_start_s(0.5);
+  by_name->set_end_s(1.0);
+  by_name->set_descriptor_name("step");
+  *add.add_labels() = FrameLabel(walk, std::nullopt, std::nullopt, "walk", 0.6);
+  v1::AddLabelsResponse added;
+  grpc::Status status = client.labels().AddLabels(client.Context().get(), add, &added);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(added.labels_size(), 3);
+  const std::vector<int64_t> ids = LabelIds(added.labels());
+  const v1::Label& seconds = added.labels(1);
+  EXPECT_EQ(seconds.clip_id(), turn);
+  EXPECT_EQ(seconds.clip_name(), "turn");
+  EXPECT_EQ(seconds.first_frame(), 15);  // 0.5 s at 30 fps
+  EXPECT_EQ(seconds.last_frame(), 30);
+  EXPECT_NEAR(seconds.start_s(), 0.5, 1e-9);
+  EXPECT_NEAR(seconds.end_s(), 1.0, 1e-9);
+  EXPECT_EQ(seconds.value(), 1.0);
+  EXPECT_EQ(seconds.origin(), v1::LABEL_ORIGIN_MANUAL);
+  EXPECT_GT(seconds.created_unix_ms(), 0);
+  EXPECT_EQ(added.labels(2).first_frame(), 0);
+  EXPECT_EQ(added.labels(2).last_frame(), 60);
+
+  // Listed a page at a time in id order, as returned; filtered.
+  v1::ListLabelsRequest list;
+  list.set_page_size(2);
+  std::vector<int64_t> listed;
+  v1::ListLabelsResponse page;
+  do {
+    ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), list, &page).ok());
+    for (const v1::Label& label : page.labels()) listed.push_back(label.label_id());
+    list.set_page_token(page.next_page_token());
+  } while (!list.page_token().empty());
+  EXPECT_EQ(listed, ids);
+  v1::ListLabelsRequest filtered;
+  filtered.set_clip_id(walk);
+  filtered.set_min_value(0.7);
+  ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), filtered, &page).ok());
+  EXPECT_EQ(LabelIds(page.labels()), std::vector<int64_t>{ids[0]});
+  filtered.Clear();
+  filtered.set_origin(v1::LABEL_ORIGIN_PROPAGATED);
+  ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), filtered, &page).ok());
+  EXPECT_EQ(page.labels_size(), 0);
+
+  // Found strongest first, and by tag.
+  v1::FindLabelsRequest find;
+  find.set_descriptor_name("step");
+  v1::FindLabelsResponse found;
+  ASSERT_TRUE(client.labels().FindLabels(client.Context().get(), find, &found).ok());
+  EXPECT_EQ(LabelIds(found.labels()), (std::vector<int64_t>{ids[1], ids[0]}));
+  EXPECT_EQ(found.labels(1).clip_name(), "walk");
+  EXPECT_NEAR(found.labels(1).start_s(), 10.0 / 30, 1e-9);
+  find.add_tags("walk");
+  ASSERT_TRUE(client.labels().FindLabels(client.Context().get(), find, &found).ok());
+  EXPECT_EQ(LabelIds(found.labels()), std::vector<int64_t>{ids[0]});
+
+  // The clip's timeline, by first frame.
+  v1::GetClipLabelsRequest timeline_request;
+  timeline_request.set_clip_id(walk);
+  v1::GetClipLabelsResponse timeline;
+  ASSERT_TRUE(
+      client.labels().GetClipLabels(client.Context().get(), timeline_request, &timeline).ok());
+  EXPECT_EQ(timeline.clip_name(), "walk");
+  EXPECT_EQ(timeline.frame_count(), 61);
+  EXPECT_NEAR(timeline.fps(), 30, 1e-9);
+  EXPECT_EQ(LabelIds(timeline.labels()), (std::vector<int64_t>{ids[2], ids[0]}));
+
+  // Deleted by id, then by descriptor; deleting a clip takes its labels.
+  v1::DeleteLabelsRequest remove;
+  remove.add_label_ids(ids[1]);
+  v1::DeleteLabelsResponse removed;
+  ASSERT_TRUE(client.labels().DeleteLabels(client.Context().get(), remove, &removed).ok());
+  EXPECT_EQ(removed.deleted(), 1);
+  remove.Clear();
+  remove.set_descriptor_name("walk");
+  ASSERT_TRUE(client.labels().DeleteLabels(client.Context().get(), remove, &removed).ok());
+  EXPECT_EQ(removed.deleted(), 1);
+  v1::DeleteClipRequest delete_clip;
+  delete_clip.set_clip_id(walk);
+  v1::DeleteClipResponse clip_deleted;
+  ASSERT_TRUE(client.clips().DeleteClip(client.Context().get(), delete_clip, &clip_deleted).ok());
+  list.Clear();
+  ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), list, &page).ok());
+  EXPECT_EQ(page.labels_size(), 0);
+  EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.LabelService/AddLabels OK "));
+}
+
+// Every bad label gets its code and names its item and field, and a batch holding one stores
+// nothing, its good labels included.
+TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()));  // 61 frames, 30 fps
+  const auto seconds = [&](double start, double end) {
+    v1::NewLabel label = FrameLabel(walk, std::nullopt, std::nullopt, "x");
+    label.set_start_s(start);
+    label.set_end_s(end);
+    return label;
+  };
+  v1::NewLabel both = seconds(0, 1);
+  both.set_first_frame(0);
+  v1::NewLabel named = FrameLabel(0, 0, 1, "x");
+  named.set_clip_name("nowhere");
+  const struct {
+    v1::NewLabel bad;
+    grpc::StatusCode code;
+    std::string message;
+  } cases[] = {
+      {FrameLabel(999999, 0, 1, "x"), grpc::StatusCode::NOT_FOUND,
+       "labels[1].clip_id: clip 999999 not found"},
+      {named, grpc::StatusCode::NOT_FOUND, "labels[1].clip_name: no clip is named 'nowhere'"},
+      {FrameLabel(0, 0, 1, "x"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1]: give clip_id or clip_name"},
+      {FrameLabel(walk, 20, 10, "x"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].last_frame: 10 is before first_frame 20"},
+      {FrameLabel(walk, 50, 61, "x"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].last_frame: 61 is outside the clip's frames 0..60"},
+      {FrameLabel(walk, -1, 5, "x"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].first_frame: -1 is negative"},
+      {seconds(1, 2.5), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].end_s: 2.5 s is past the clip's last frame 60"},
+      {seconds(-0.5, 1), grpc::StatusCode::INVALID_ARGUMENT, "labels[1].start_s: -0.5"},
+      {seconds(NAN, 1), grpc::StatusCode::INVALID_ARGUMENT, "labels[1].start_s: nan"},
+      {seconds(1.5, 1), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].end_s: 1 is before start_s 1.5"},
+      {both, grpc::StatusCode::INVALID_ARGUMENT, "labels[1]: give the range in frames"},
+      {FrameLabel(walk, 0, 1, "x", 1.5), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].value: 1.5 is outside [0, 1]"},
+      {FrameLabel(walk, 0, 1, "x", -0.5), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].value: -0.5 is outside [0, 1]"},
+      {FrameLabel(walk, 0, 1, "x", NAN), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].value: nan is outside [0, 1]"},
+      {FrameLabel(walk, 0, 1, ""), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].descriptor must not be empty"},
+      {FrameLabel(walk, 0, 1, std::string(257, 'd')), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].descriptor is 257 bytes long"},
+      {FrameLabel(walk, 0, 1, "step\x1b[2J"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].descriptor 'step\\x1b[2J' holds a control character at byte 4"},
+  };
+  v1::AddLabelsResponse added;
+  for (const auto& c : cases) {
+    v1::AddLabelsRequest request;
+    *request.add_labels() = FrameLabel(walk, 0, 10, "good");
+    *request.add_labels() = c.bad;
+    const grpc::Status status = client.labels().AddLabels(client.Context().get(), request, &added);
+    EXPECT_EQ(status.error_code(), c.code) << c.message;
+    EXPECT_THAT(status.error_message(), HasSubstr(c.message));
+  }
+  EXPECT_EQ(client.labels()
+                .AddLabels(client.Context().get(), v1::AddLabelsRequest(), &added)
+                .error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::ListLabelsRequest list;
+  v1::ListLabelsResponse listed;
+  ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), list, &listed).ok());
+  EXPECT_EQ(listed.labels_size(), 0) << "a failed batch stored a label";
+
+  // The other calls' bad inputs.
+  list.set_origin(static_cast<v1::LabelOrigin>(7));
+  EXPECT_EQ(client.labels().ListLabels(client.Context().get(), list, &listed).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  list.Clear();
+  list.set_page_size(-1);
+  EXPECT_EQ(client.labels().ListLabels(client.Context().get(), list, &listed).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  list.Clear();
+  list.set_page_token("bogus");
+  EXPECT_EQ(client.labels().ListLabels(client.Context().get(), list, &listed).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::FindLabelsRequest find;
+  v1::FindLabelsResponse found;
+  EXPECT_EQ(client.labels().FindLabels(client.Context().get(), find, &found).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  find.set_descriptor_name("step");
+  find.set_min_value(2);
+  EXPECT_EQ(client.labels().FindLabels(client.Context().get(), find, &found).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::DeleteLabelsRequest remove;
+  v1::DeleteLabelsResponse removed;
+  EXPECT_EQ(client.labels().DeleteLabels(client.Context().get(), remove, &removed).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  remove.add_label_ids(999999);
+  const grpc::Status unknown =
+      client.labels().DeleteLabels(client.Context().get(), remove, &removed);
+  EXPECT_EQ(unknown.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(unknown.error_message(), HasSubstr("label_ids[0]"));
+  v1::GetClipLabelsRequest timeline_request;
+  timeline_request.set_clip_id(999999);
+  v1::GetClipLabelsResponse timeline;
+  EXPECT_EQ(client.labels()
+                .GetClipLabels(client.Context().get(), timeline_request, &timeline)
+                .error_code(),
+            grpc::StatusCode::NOT_FOUND);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Errors.
 
 TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
@@ -1240,7 +1472,7 @@ TEST_F(ServerTest, ReflectionListsAndDescribesTheServices) {
   EXPECT_THAT(names,
               ::testing::IsSupersetOf({"motiondb.v1.ClipService", "motiondb.v1.SpaceService",
                                        "motiondb.v1.SearchService", "motiondb.v1.ServerService",
-                                       "grpc.health.v1.Health"}));
+                                       "motiondb.v1.LabelService", "grpc.health.v1.Health"}));
   // file_containing_symbol (4) -> file_descriptor_response (4) -> file_descriptor_proto (1).
   for (const auto& [symbol, file] : std::vector<std::pair<std::string, std::string>>{
            {"grpc.health.v1.Health", "grpc/health/v1/health.proto"},

@@ -11,6 +11,7 @@
 #include "server/grpc/call_gate.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
+#include "server/grpc/label_service.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/search_service.h"
 #include "server/grpc/server_info_service.h"
@@ -37,6 +38,7 @@ struct MotionDbServer::State {
   std::unique_ptr<ClipServiceImpl> clips;
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
+  std::unique_ptr<LabelServiceImpl> labels;
   std::unique_ptr<ServerInfoServiceImpl> info;
   std::unique_ptr<grpc::Server> server;
 };
@@ -84,6 +86,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
                                               *s.watchdog, *s.gate);
   s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
+  s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<grpc::ServerCredentials> credentials,
@@ -101,6 +104,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.clips.get());
   builder.RegisterService(s.spaces.get());
   builder.RegisterService(s.search.get());
+  builder.RegisterService(s.labels.get());
   builder.RegisterService(s.info.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   if (options.log_requests) {

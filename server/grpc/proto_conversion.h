@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
+#include "motiondb/v1/label_service.pb.h"
 #include "motiondb/v1/search_service.pb.h"
 #include "motiondb/v1/server_service.pb.h"
 #include "motiondb/v1/space_service.pb.h"
@@ -14,6 +15,7 @@
 #include "server/clip_ingest.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
+#include "server/label_catalog.h"
 #include "server/search_runner.h"
 #include "server/space_builder.h"
 #include "server/space_curve.h"
@@ -31,6 +33,10 @@ storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request);
 absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request);
 absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request);
 CurveRequest FromProto(const v1::GetCurveRequest& request);
+std::vector<NewLabel> FromProto(const v1::AddLabelsRequest& request);
+absl::StatusOr<storage::LabelFilter> FromProto(const v1::ListLabelsRequest& request);
+absl::StatusOr<LabelDeletion> FromProto(const v1::DeleteLabelsRequest& request);
+storage::LabelQuery FromProto(const v1::FindLabelsRequest& request);
 
 // Results.
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
@@ -45,6 +51,11 @@ void ToProto(const SpaceSnapshot& snapshot, v1::Space* space);
 void ToProto(const SpaceSnapshot& snapshot, v1::SpaceIndex* index);
 // Coordinates as little-endian float32, as the API promises.
 void ToProto(const Curve& curve, v1::GetCurveResponse* response);
+// The range also in seconds (frame x the clip's frame time).
+void ToProto(const storage::LabelRecord& record, v1::Label* label);
+void ToProto(const storage::LabelPage& page, v1::ListLabelsResponse* response);
+void ToProto(const storage::LabelPage& page, v1::FindLabelsResponse* response);
+void ToProto(const ClipTimeline& timeline, v1::GetClipLabelsResponse* response);
 
 }  // namespace motiondb::server
 

@@ -1,7 +1,8 @@
 // What a Database holds: one writer connection, serialised by a mutex, and a pool of read-only
 // connections. In WAL mode readers see the last commit and never wait for the writer, nor it for
 // them. The files that implement the Database's operations run their SQL through Write and Read:
-// database.cc (Open, and the counts), database_clips.cc and database_spaces.cc.
+// database.cc (Open, and the counts), database_clips.cc, database_spaces.cc and
+// database_labels.cc.
 //
 // Thread-safe.
 #ifndef MOTIONDB_STORAGE_INTERNAL_DATABASE_IMPL_H_

@@ -13,12 +13,15 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/motion/matrix.h"
+#include "storage/label_record.h"
 
 namespace motiondb::storage {
 
 inline constexpr size_t kMaxNameBytes = 512;  // clip, source file and space names
 inline constexpr size_t kMaxTagBytes = 128;
 inline constexpr size_t kMaxTags = 64;  // a clip's
+inline constexpr int kDefaultPageSize = 100;
+inline constexpr int kMaxPageSize = 1000;
 
 // INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`), one longer than
 // `max_bytes`, or one holding a control character (NUL, the rest of C0, DEL, or C1 encoded as
@@ -42,6 +45,16 @@ absl::StatusOr<std::vector<std::string>> CanonicalTags(std::vector<std::string> 
 // `space_dims` (the dimensions of the stored space, when known yet), or with non-finite values.
 absl::Status CheckProjection(const RowMatrixXf& coordinates, std::optional<int> space_dims,
                              absl::string_view what);
+
+// The rows of a page that Page::page_size asks for: 0 means kDefaultPageSize; outside
+// 0..kMaxPageSize is INVALID_ARGUMENT.
+absl::StatusOr<int> CheckPageSize(int page_size);
+
+// What AddLabels can check of `label`, item `index` of its batch, without the database:
+// INVALID_ARGUMENT naming "labels[index].field" for a negative or reversed range, a value
+// outside [0, 1] (NaN too), a descriptor that CheckName refuses (at most kMaxDescriptorBytes),
+// a manual label with a source, space, score or job, or a propagated one without a source.
+absl::Status CheckLabel(const LabelRecord& label, size_t index);
 
 }  // namespace motiondb::storage
 

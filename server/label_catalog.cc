@@ -1,0 +1,165 @@
+#include "server/label_catalog.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
+#include "util/status_prefix.h"
+
+namespace motiondb::server {
+namespace {
+
+// The clips a batch names, each read once: a studio's import labels few clips many times.
+class ClipResolver {
+ public:
+  explicit ClipResolver(storage::Database& database) : database_(database) {}
+
+  absl::StatusOr<const storage::ClipRecord*> Resolve(const NewLabel& label,
+                                                     const std::string& item) {
+    if (label.clip_id != 0) {
+      return Cached(by_id_, label.clip_id, absl::StrCat(item, ".clip_id"),
+                    [&] { return database_.GetClipRecord(label.clip_id); });
+    }
+    if (label.clip_name.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(item, ": give clip_id or clip_name"));
+    }
+    return Cached(by_name_, label.clip_name, absl::StrCat(item, ".clip_name"),
+                  [&] { return database_.GetClipRecordByName(label.clip_name); });
+  }
+
+ private:
+  template <typename Key, typename Read>
+  absl::StatusOr<const storage::ClipRecord*> Cached(
+      absl::flat_hash_map<Key, storage::ClipRecord>& cache, const Key& key,
+      const std::string& field, const Read& read) {
+    auto found = cache.find(key);
+    if (found == cache.end()) {
+      MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record, Prefixed(field, read()));
+      found = cache.emplace(key, std::move(record)).first;
+    }
+    return &found->second;
+  }
+
+  storage::Database& database_;
+  absl::flat_hash_map<int64_t, storage::ClipRecord> by_id_;
+  absl::flat_hash_map<std::string, storage::ClipRecord> by_name_;
+};
+
+// The frame nearest `seconds` into `clip`; INVALID_ARGUMENT naming `field` for a time that is
+// not finite, negative, or past the clip's last frame.
+absl::StatusOr<int64_t> FrameAt(double seconds, const storage::ClipRecord& clip,
+                                const std::string& field) {
+  if (!std::isfinite(seconds) || seconds < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": ", seconds, " is not a time in the clip (seconds from 0)"));
+  }
+  const double frame = std::round(seconds / clip.frame_time);
+  if (frame > static_cast<double>(clip.frame_count - 1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": ", seconds, " s is past the clip's last frame ",
+                     clip.frame_count - 1, " at ", (clip.frame_count - 1) * clip.frame_time, " s"));
+  }
+  return static_cast<int64_t>(frame);
+}
+
+// Sets `record`'s range from `label`'s frames or seconds; storage checks the frames.
+absl::Status ResolveRange(const NewLabel& label, const storage::ClipRecord& clip,
+                          const std::string& item, storage::LabelRecord& record) {
+  const bool frames = label.first_frame || label.last_frame;
+  const bool seconds = label.start_s || label.end_s;
+  if (frames && seconds) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item,
+                     ": give the range in frames (first_frame, last_frame) or in seconds "
+                     "(start_s, end_s), not both"));
+  }
+  record.first_frame = label.first_frame.value_or(0);
+  record.last_frame = label.last_frame.value_or(clip.frame_count - 1);
+  if (label.start_s) {
+    MOTIONDB_ASSIGN_OR_RETURN(record.first_frame,
+                              FrameAt(*label.start_s, clip, absl::StrCat(item, ".start_s")));
+  }
+  if (label.end_s) {
+    MOTIONDB_ASSIGN_OR_RETURN(record.last_frame,
+                              FrameAt(*label.end_s, clip, absl::StrCat(item, ".end_s")));
+  }
+  if (label.start_s && label.end_s && *label.end_s < *label.start_s) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(item, ".end_s: ", *label.end_s, " is before start_s ", *label.start_s));
+  }
+  return absl::OkStatus();
+}
+
+int64_t NowUnixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
+    storage::Database& database, const std::vector<NewLabel>& labels,
+    const std::function<bool()>& should_stop) {
+  if (labels.size() > kMaxLabelsPerBatch) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("labels: at most ", kMaxLabelsPerBatch, " a call, got ", labels.size()));
+  }
+  // One time for the batch, so that what is returned is what was stored.
+  const int64_t now = NowUnixMs();
+  ClipResolver clips(database);
+  std::vector<storage::LabelRecord> records;
+  records.reserve(labels.size());
+  for (size_t i = 0; i < labels.size(); ++i) {
+    const NewLabel& label = labels[i];
+    const std::string item = absl::StrCat("labels[", i, "]");
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord* clip, clips.Resolve(label, item));
+    storage::LabelRecord& record = records.emplace_back();
+    record.clip_id = clip->clip_id;
+    record.clip_name = clip->name;
+    record.frame_time = clip->frame_time;
+    MOTIONDB_RETURN_IF_ERROR(ResolveRange(label, *clip, item, record));
+    record.descriptor = label.descriptor;
+    record.value = label.value.value_or(1.0);
+    record.created_unix_ms = now;
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> ids,
+                            database.AddLabels(records, {.should_stop = should_stop}));
+  for (size_t i = 0; i < ids.size(); ++i) records[i].label_id = ids[i];
+  return records;
+}
+
+absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const PageRequest& page,
+                                              const storage::LabelFilter& filter) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
+  return database.ListLabels(stored, filter);
+}
+
+absl::StatusOr<storage::LabelPage> FindLabels(storage::Database& database, const PageRequest& page,
+                                              const storage::LabelQuery& query) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
+  return database.FindLabels(stored, query);
+}
+
+absl::StatusOr<int64_t> DeleteLabels(storage::Database& database, const LabelDeletion& deletion,
+                                     const std::function<bool()>& should_stop) {
+  if (deletion.label_ids.empty()) {
+    return database.DeleteLabels(deletion.filter, {.should_stop = should_stop});
+  }
+  if (!deletion.filter.empty()) {
+    return absl::InvalidArgumentError("give label_ids or a filter, not both");
+  }
+  return database.DeleteLabels(deletion.label_ids, {.should_stop = should_stop});
+}
+
+absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id) {
+  ClipTimeline timeline;
+  MOTIONDB_ASSIGN_OR_RETURN(timeline.clip, database.GetClipRecord(clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(timeline.labels, database.ClipLabels(clip_id));
+  return timeline;
+}
+
+}  // namespace motiondb::server
