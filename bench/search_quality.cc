@@ -54,7 +54,7 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
   app.add_flag("--keep-heading", flags->keep_heading, "keep the body's facing in the pose");
   SearchParams& params = flags->retrieval.params;
   for (auto [name, field, what, min] :
-       {std::tuple{"--neighbours", &params.neighbours, "seeds", 1},
+       {std::tuple{"--neighbours", &params.neighbours, "seeds (0: by the library's size)", 0},
         {"--places", &flags->places, "distinct places as seeds (0: the nearest frames)", 0},
         {"--ann-dims", &params.ann_dims, "seed search dimensions", 1},
         {"--dtw-dims", &params.dtw_dims, "time-warp dimensions", 1},

@@ -45,12 +45,14 @@ struct Parameter {
   const char* description;
   std::optional<int> SearchFlags::*value;
   void (v1::SearchRequest::*set)(int32_t);
+  int least = 1;  // the smallest value the flag takes
 };
 constexpr Parameter kParameters[] = {
     {"--places", "places", "N", "128", "--seeds places: distinct places, one warp each",
      &SearchFlags::places, &v1::SearchRequest::set_places},
-    {"--neighbours", "neighbours", "K", "1000", "--seeds frames: nearest frames, clustered",
-     &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours},
+    {"--neighbours", "neighbours", "K", "0",
+     "--seeds frames: nearest frames, clustered (0: by the library's size, 1000 up to 10 h)",
+     &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours, 0},
     {"--ann-dims", "ann_dims", "N", "5", "dimensions of the seed search", &SearchFlags::ann_dims,
      &v1::SearchRequest::set_ann_dims},
     {"--dtw-dims", "dtw_dims", "N", "5", "dimensions of the time warp's pose distance",
@@ -193,7 +195,7 @@ void AddSearch(Commands& commands) {
     search->add_option(parameter.flag, flags.get()->*parameter.value, parameter.description)
         ->type_name(parameter.value_name)
         ->default_str(parameter.default_value)
-        ->check(WholeAtLeast(1));
+        ->check(WholeAtLeast(parameter.least));
   }
   search->add_option("--epsilon", flags->epsilon, "approximation bound of the seed search")
       ->type_name("E")

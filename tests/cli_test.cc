@@ -174,7 +174,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--to T=last",
                              "--seeds frames|places=frames",
                              "--places N=128",
-                             "--neighbours K=1000",
+                             "--neighbours K=0",
                              "--threads N=0 = one per core",
                              "--ann-dims N=5",
                              "--dtw-dims N=5",

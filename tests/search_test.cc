@@ -83,8 +83,8 @@ const float* FrameRow(const LibraryIndex& library, int64_t frame) {
 }
 
 // The k nearest frames over the tree's dims, nearest first, by brute force, and as the index
-// finds them (kd-tree, kd-tree with a filter: its frames only; linear scan: every frame). The
-// library is one block, so the tree's frames are the multiples of tree_every().
+// finds them (kd-tree, kd-tree with a filter: its frames only, the multiples of tree_every();
+// linear scan: every frame).
 void ExpectNearestAgreesWithBruteForce(const LibraryIndex& library, int clips) {
   const int dims = library.ann_dims();
   std::mt19937 rng(3);
@@ -153,7 +153,9 @@ TEST(LibraryIndexCoarseTree, HoldsAbout15FramesASecond) {
 // frames and it is built anew.
 TEST(LibraryIndexAdditions, AnswerAsABuildOfEveryClip) {
   std::vector<LibraryClip> clips;
-  const std::vector<int64_t> lengths = {1500, 1500, 60, 50, 40, 1400};
+  // Odd lengths, so that the second block starts between the kd-tree's frames (every second at
+  // 30 Hz); the one-frame clip alone is a block with no tree frame.
+  const std::vector<int64_t> lengths = {1501, 1500, 1, 60, 41, 1400};
   for (size_t c = 0; c < lengths.size(); ++c) {
     RowMatrixXf curve = testing::SmoothNoise(lengths[c], kDims, 80 + c);
     if (c == 3) testing::Plant(curve, testing::Pattern(40, kDims), 5);
@@ -251,6 +253,30 @@ TEST_F(SearchTest, FastSearchFindsEveryPlantedCopyFirst) {
   EXPECT_NEAR(results[0].start_s, results[0].first_frame / 30.0, 1e-9);
 }
 
+// Unless a search says how many, the seeds follow the library's size: the thesis's 1000 up to
+// 10 h of seed frames (540,000 at about 15 Hz), then 1000 more per tenfold.
+TEST(SearchSeeds, FollowTheLibrarysSize) {
+  const RowMatrixXf query = testing::Pattern(40, 5);
+  SearchParams params;
+  params.characteristic_frame = 20;
+  for (const auto& [frames, seeds] :
+       {std::pair<int64_t, int64_t>{3'000, 1000}, {1'080'000, 1000}, {1'200'000, 1046}}) {
+    std::vector<LibraryClip> clips;
+    for (int64_t first = 0; first < frames; first += 300'000) {
+      clips.push_back({first,
+                       "noise",
+                       {},
+                       testing::SmoothNoise(std::min<int64_t>(300'000, frames - first), 5, 3)});
+    }
+    const std::unique_ptr<LibraryIndex> library = *LibraryIndex::Build(std::move(clips), 30, {});
+    ASSERT_EQ(library->tree_every(), 2);
+    params.neighbours = 0;
+    EXPECT_EQ(Search(*library, CoordinateView::Of(query), params)->stats.seeds, seeds) << frames;
+    params.neighbours = 300;
+    EXPECT_EQ(Search(*library, CoordinateView::Of(query), params)->stats.seeds, 300) << frames;
+  }
+}
+
 TEST_F(SearchTest, PathsAreReturnedOnRequest) {
   SearchParams params;
   params.return_path = true;
@@ -339,7 +365,7 @@ TEST_F(SearchTest, RejectsBadParametersAndQueries) {
   EXPECT_EQ(code([](SearchParams& p) { p.ann_dims = 0; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.ann_dims = 13; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.dtw_dims = 99; }), bad);
-  EXPECT_EQ(code([](SearchParams& p) { p.neighbours = 0; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.neighbours = -1; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.neighbours = 100'000'000; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.epsilon = -1; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.epsilon = NAN; }), bad);

@@ -49,6 +49,7 @@ TEST(RefineCandidate, MovesALateCandidateOntoTheMatch) {
                     candidate);
     EXPECT_LT(candidate.score, 1e-6) << "from " << before;
     if (factor > 1) {
+      for (int64_t& frame : candidate.path) frame *= factor;  // in the clip's own frames
       ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 100, factor,
                                    {2, 5}, workspace, candidate));
     }
@@ -69,6 +70,7 @@ TEST(RefineFromCoarse, GivesAFullRateWarpOfTheModel) {
   const RowMatrixXf q = CopyRows(CoarseView(CoordinateView::Of(query), 4));
   const RowMatrixXf c = CopyRows(CoarseView(CoordinateView::Of(clip), 4));
   SearchResult candidate = DiagonalCandidate(q, c, 77, 15);  // 8 full-rate frames late
+  for (int64_t& frame : candidate.path) frame *= 4;          // in the clip's own frames
   BandWorkspace workspace;
   ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
                                workspace, candidate));

@@ -24,19 +24,21 @@ bool Nearer(const Neighbour& a, const Neighbour& b) {
 }  // namespace
 
 // A single kd-tree (exact, and the fastest FLANN index at ~10 dimensions) over the first
-// ann_dims columns of every `every`-th row of the coordinate block, read in place through the
-// row stride. Its point i is the block's row i * every.
+// ann_dims columns of every `every`-th row of the coordinate block from row `first`, read in
+// place through the row stride. Its point i is the block's row first + i * every.
 class LibraryIndex::Tree {
  public:
-  Tree(const RowMatrixXf& coordinates, int ann_dims, int leaf_size, int every)
-      : index_(flann::Matrix<float>(const_cast<float*>(coordinates.data()),
-                                    (coordinates.rows() + every - 1) / every, ann_dims,
+  Tree(const RowMatrixXf& coordinates, int ann_dims, int leaf_size, int64_t first, int every)
+      : index_(flann::Matrix<float>(const_cast<float*>(coordinates.row(first).data()),
+                                    (coordinates.rows() - first + every - 1) / every, ann_dims,
                                     every * coordinates.cols() * sizeof(float)),
                flann::KDTreeSingleIndexParams(leaf_size, /*reorder=*/false)),
+        first_(first),
         every_(every) {
     index_.buildIndex();
   }
 
+  int64_t first() const { return first_; }
   int every() const { return every_; }
   int64_t points() const { return static_cast<int64_t>(index_.size()); }
 
@@ -64,12 +66,13 @@ class LibraryIndex::Tree {
     }
     std::vector<Neighbour> result(found);
     for (int i = 0; i < found; ++i) {
-      result[i] = {static_cast<int64_t>(indices[i]) * every_, std::sqrt(squared[i])};
+      result[i] = {first_ + static_cast<int64_t>(indices[i]) * every_, std::sqrt(squared[i])};
     }
     return result;
   }
 
-  // Every point nearer than `places`' worst, offered to it (numbered from 0: row / every()).
+  // Every point nearer than `places`' worst, offered to it (numbered from 0: point i is row
+  // first() + i * every()).
   void Offer(const float* point, float epsilon, flann::ResultSet<float>& places) const {
     flann::SearchParams params;
     params.eps = epsilon;
@@ -84,6 +87,7 @@ class LibraryIndex::Tree {
 
  private:
   flann::KDTreeSingleIndex<flann::L2<float>> index_;
+  int64_t first_;
   int every_;
 };
 
@@ -210,8 +214,15 @@ void LibraryIndex::AddBlock(std::vector<LibraryClip> clips, int64_t first_frame)
     next += clip.coordinates.rows();
     clip.coordinates = RowMatrixXf();  // release each copy as soon as it is in the block
   }
-  block->tree = std::make_unique<Tree>(block->coordinates, options_.ann_dims, options_.leaf_size,
-                                       tree_every());
+  // The tree's frames are the global frames that are multiples of tree_every(), whatever the
+  // blocks: a library grown clip by clip seeds as one built at once.
+  // A block shorter than the gap to its first such frame has none, and no tree.
+  const int every = tree_every();
+  const int64_t first_tree_row = (every - first_frame % every) % every;
+  if (first_tree_row < rows) {
+    block->tree = std::make_unique<Tree>(block->coordinates, options_.ann_dims, options_.leaf_size,
+                                         first_tree_row, every);
+  }
   blocks_.push_back(std::move(block));
   total_frames_ += rows;
 }
@@ -233,8 +244,8 @@ RowMatrixXf LibraryIndex::CopyClipCoordinates(int index) const {
 
 std::vector<Neighbour> LibraryIndex::TreeNearest(const float* point, int dims, int k,
                                                  float epsilon) const {
-  const Tree& base = *blocks_[0]->tree;
-  if (blocks_.size() == 1) {
+  const Tree& base = *blocks_[0]->tree;  // the first block starts at frame 0, a tree frame
+  if (blocks_.size() == 1 || !blocks_[1]->tree) {
     return base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())),
                         epsilon);
   }
@@ -283,7 +294,7 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
   k = static_cast<int>(std::min<int64_t>(k, total_frames()));
   if (dims == options_.ann_dims) {
     int64_t tree_points = 0;
-    for (const auto& block : blocks_) tree_points += block->tree->points();
+    for (const auto& block : blocks_) tree_points += block->tree ? block->tree->points() : 0;
     if (allowed_clips.empty()) return TreeNearest(point, dims, k, epsilon);
     // When the filter keeps most frames, ask the tree for enough extra neighbours to cover the
     // filtered-out ones (doubling a few times), and scan only if that is not enough.
@@ -332,7 +343,8 @@ std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims,
   DistinctPlaces places(k, separation, clip_of, allowed_clips);
   if (dims == options_.ann_dims && AllowedFrames(allowed_clips) * 2 >= total_frames_) {
     for (const auto& block : blocks_) {
-      places.set_rows(block->first_frame, block->tree->every());
+      if (!block->tree) continue;
+      places.set_rows(block->first_frame + block->tree->first(), block->tree->every());
       block->tree->Offer(point, epsilon, places);
     }
     return places.Take();
@@ -359,7 +371,7 @@ int64_t LibraryIndex::coordinate_bytes() const {
 
 int64_t LibraryIndex::tree_bytes() const {
   int64_t bytes = 0;
-  for (const auto& block : blocks_) bytes += block->tree->bytes();
+  for (const auto& block : blocks_) bytes += block->tree ? block->tree->bytes() : 0;
   return bytes;
 }
 

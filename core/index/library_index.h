@@ -88,7 +88,7 @@ class LibraryIndex {
   double rate() const { return rate_; }
   int dims() const { return dims_; }
   int ann_dims() const { return options_.ann_dims; }
-  // The kd-tree holds every tree_every()-th frame of each block.
+  // The kd-tree holds the global frames that are multiples of tree_every().
   int tree_every() const;
   int64_t total_frames() const { return total_frames_; }
   int clip_count() const { return static_cast<int>(clips_.size()); }

@@ -15,16 +15,30 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Refinement lowers scores, so it considers this many candidates per result returned: a warp
-// pinned to a seed in a held pose can rank far below where its refined warp lands, and more
-// seeds then crowd it out of a small pool. Measured (bench/RESULTS.md, issue 11; recall@10
-// against the exact search, 10 h at 30 Hz): 2 gave 0.66, 4 gave 0.92 and 8 gave 0.95 for
-// 0.3 ms more.
-constexpr int kRefinePoolFactor = 8;
-// This many candidates per result returned, the best after the coarse refinement, are settled
-// at the full rate: 2 gave recall@10 0.92 at 10 h / 30 Hz, 4 gave 0.95 (coarse scores at 15 Hz
-// order nearly equal matches less surely).
-constexpr int kFinePoolFactor = 4;
+// Refinement lowers scores, so it considers this many candidates per result returned, per
+// thousand seeds (for fewer seeds, as for a thousand): a warp pinned to a seed in a held pose
+// can rank far below where its refined warp lands, and more seeds crowd it out of a small pool.
+// Measured (bench/RESULTS.md, issue 11; recall@10 against the exact search): 1 h at 30 Hz,
+// pools of 2 and 4 per result gave 0.81 and 0.95; 10 h, 4 and 8 gave 0.92 and 0.95; 100 h,
+// 2000 seeds, 16 and 24 gave 0.87 and 0.95.
+constexpr double kRefinePoolPerThousandSeeds = 12;
+// The best this share of the refined pool are settled at the full rate from the coarse rate:
+// coarse scores order nearly equal matches less surely the denser the library (100 h, 2000
+// seeds: a third gave 0.87, two thirds 0.95), and a settle costs factor^2 times a coarse one, so
+// from 45 Hz (factor 3) a third (10 h at 120 Hz: 0.96 at 4 ms; two thirds took 5.3 ms).
+double FineShare(int factor) { return factor <= 2 ? 2.0 / 3.0 : 1.0 / 3.0; }
+
+// The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
+// to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
+// Measured at 100 h of synthetic capture at 30 Hz with every candidate refined: 1000 seeds gave
+// recall@10 0.88, 2000 gave 0.95 (8.2 ms).
+int NearestFrameSeeds(const LibraryIndex& library, const SearchParams& params) {
+  if (params.neighbours > 0) return params.neighbours;
+  constexpr double kTenHoursOfSeeds = 10 * 3600 * kCoarseRate;
+  const double tree_frames = static_cast<double>(library.total_frames()) / library.tree_every();
+  return static_cast<int>(
+      std::lround(1000 * (1 + std::log10(std::max(1.0, tree_frames / kTenHoursOfSeeds)))));
+}
 
 struct Seed {
   int clip;
@@ -71,9 +85,34 @@ int64_t PlaceSeparation(int64_t gap, int64_t query_rows) {
   return std::max<int64_t>(gap + 1, query_rows / 4);
 }
 
-// The pool's candidates (warps at 1 / `factor` of the library's rate, with their paths) moved to
-// the best warps near them; from a coarse rate, the best of them are then settled at the full
-// rate.
+// Every factor-th frame of `clip` from `phase`: what a warp at 1 / factor of the rate sees when
+// `phase` is its seed's frame modulo factor, so that the seed is among them. Fixed from frame 0
+// instead, an instance whose best alignment falls between those frames scored worse at the
+// coarse rate than its peers: at 100 h of synthetic capture, recall@10 against the exact search
+// rose from 0.74 to ... with seeds' phases kept.
+CoordinateView PhasedView(CoordinateView clip, int factor, int64_t phase) {
+  return CoarseView(clip.middle_rows(phase, clip.rows - phase), factor);
+}
+
+// A candidate's frames between PhasedView's (coarse) and the clip's own: x <-> x * factor + phase.
+void ToClipFrames(int factor, int64_t phase, SearchResult& candidate) {
+  const auto scale = [&](int64_t& frame) { frame = frame * factor + phase; };
+  scale(candidate.first_frame);
+  scale(candidate.last_frame);
+  scale(candidate.seed_frame);
+  for (int64_t& frame : candidate.path) scale(frame);
+}
+void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
+  const auto unscale = [&](int64_t& frame) { frame = (frame - phase) / factor; };
+  unscale(candidate.first_frame);
+  unscale(candidate.last_frame);
+  unscale(candidate.seed_frame);
+  for (int64_t& frame : candidate.path) unscale(frame);
+}
+
+// The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
+// frames) moved to the best warps near them; from a coarse rate, the best of them are then
+// settled at the full rate.
 absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
                                                  int anchor, int coarse_anchor, int factor,
                                                  const WarpConstraints& constraints,
@@ -83,13 +122,18 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
   for (size_t i = 0; i < candidates.size(); ++i) {
     if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     SearchResult& candidate = candidates[i];
+    const int64_t phase = candidate.first_frame % factor;
+    ToCoarseFrames(factor, phase, candidate);
     RefineCandidate(CoarseView(query, factor),
-                    CoarseView(library.clip_coordinates(candidate.clip_index), factor),
+                    PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
                     coarse_anchor, library.rate() / factor, constraints, workspace, candidate);
+    ToClipFrames(factor, phase, candidate);
   }
   if (factor > 1) {
-    candidates = RankResults(std::move(candidates), params.max_overlap,
-                             params.max_results * kFinePoolFactor);
+    const int fine_pool =
+        std::max<int>(params.max_results,
+                      std::lround(FineShare(factor) * static_cast<double>(candidates.size())));
+    candidates = RankResults(std::move(candidates), params.max_overlap, fine_pool);
     for (size_t i = 0; i < candidates.size(); ++i) {
       if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
       SearchResult& candidate = candidates[i];
@@ -157,8 +201,8 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const std::vector<Neighbour> neighbours =
       distinct ? library.NearestPlaces(query.row(anchor), params.ann_dims, params.places,
                                        PlaceSeparation(gap, query.rows), params.epsilon, allowed)
-               : library.Nearest(query.row(anchor), params.ann_dims, params.neighbours,
-                                 params.epsilon, allowed);
+               : library.Nearest(query.row(anchor), params.ann_dims,
+                                 NearestFrameSeeds(library, params), params.epsilon, allowed);
   stats.seeds = static_cast<int64_t>(neighbours.size());
   stats.seeds_ms = MillisecondsSince(stage);
 
@@ -179,9 +223,6 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const CoordinateView warp_query = CoarseView(query, factor);
   const int warp_anchor = static_cast<int>(
       std::min<int64_t>(std::lround(anchor / static_cast<double>(factor)), warp_query.rows - 1));
-  const auto warp_clip = [&](int clip) {
-    return CoarseView(library.clip_coordinates(clip), factor);
-  };
 
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
@@ -189,20 +230,25 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
             [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
   WarpWorkspace workspace;
-  const int pool = params.refine ? params.max_results * kRefinePoolFactor : params.max_results;
+  const int pool =
+      params.refine
+          ? static_cast<int>(std::lround(params.max_results * kRefinePoolPerThousandSeeds *
+                                         std::max(1.0, static_cast<double>(stats.seeds) / 1000.0)))
+          : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
     if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     const Seed& seed = order[i];
-    const CoordinateView clip = warp_clip(seed.clip);
-    const int64_t seed_frame =
-        std::min<int64_t>(std::llround(seed.frame / static_cast<double>(factor)), clip.rows - 1);
+    const int64_t phase = seed.frame % factor;
     std::optional<Warp> warp =
-        AnchoredWarp(warp_query, clip, warp_anchor, seed_frame, constraints,
+        AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
+                     warp_anchor, seed.frame / factor, constraints,
                      params.return_path || params.refine, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
-    top.Offer(MakeResult(seed.clip, *std::move(warp), seed.frame));
+    SearchResult candidate = MakeResult(seed.clip, *std::move(warp), seed.frame / factor);
+    ToClipFrames(factor, phase, candidate);
+    top.Offer(std::move(candidate));
   }
   stats.warps_ms = MillisecondsSince(stage);
 

@@ -23,8 +23,8 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (params.dtw_dims < 1 || params.dtw_dims > dims) {
     return OutOfRange("dtw_dims", params.dtw_dims, dims_range);
   }
-  if (params.neighbours < 1 || params.neighbours > 1'000'000) {
-    return OutOfRange("neighbours", params.neighbours, "1..1000000");
+  if (params.neighbours < 0 || params.neighbours > 1'000'000) {
+    return OutOfRange("neighbours", params.neighbours, "0..1000000 (0: by the library's size)");
   }
   if (params.places < 1 || params.places > 100'000) {
     return OutOfRange("places", params.places, "1..100000");

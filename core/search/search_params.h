@@ -44,8 +44,9 @@ struct SearchParams {
   SeedSelection seed_selection = SeedSelection::kNearestFrames;
   // kDistinctPlaces: seeds, one warp each.
   int places = 128;
-  // kNearestFrames: seeds, nearest library frames to the characteristic pose.
-  int neighbours = 1000;
+  // kNearestFrames: seeds, nearest library frames to the characteristic pose; 0: by the
+  // library's size (1000 up to 10 hours, 2000 at 100 hours; core/search/motion_search.cc).
+  int neighbours = 0;
   // Approximation bound of the seed search (0 = exact).
   float epsilon = 0.0f;
   // Dimensions of the pose distance inside the time warp.

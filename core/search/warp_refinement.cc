@@ -33,8 +33,8 @@ std::optional<Warp> Settle(CoordinateView query, CoordinateView clip, std::vecto
   return best;
 }
 
-// A full-rate centre from a coarse path (coarse row j and frame c are fine row and frame
-// j * factor and c * factor): linear between the coarse points, rounded down, so each row
+// A full-rate centre from a coarse path (the clip frame of every factor-th query row, row j
+// being fine row j * factor): linear between the coarse points, rounded down, so each row
 // advances at most as many frames as the coarse path did per coarse row; past the last coarse
 // row, one frame per row. Inside [0, clip_rows).
 std::vector<int64_t> Upsample(const std::vector<int64_t>& coarse, int factor, int64_t rows,
@@ -42,8 +42,8 @@ std::vector<int64_t> Upsample(const std::vector<int64_t>& coarse, int factor, in
   std::vector<int64_t> fine(rows);
   for (int64_t i = 0; i < rows; ++i) {
     const size_t j = static_cast<size_t>(i / factor);
-    const int64_t from = coarse[j] * factor;
-    const int64_t to = j + 1 < coarse.size() ? coarse[j + 1] * factor : from + factor;
+    const int64_t from = coarse[j];
+    const int64_t to = j + 1 < coarse.size() ? coarse[j + 1] : from + factor;
     fine[i] = std::clamp<int64_t>(from + (to - from) * (i % factor) / factor, 0, clip_rows - 1);
   }
   return fine;

@@ -32,10 +32,10 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate);
 
-// `candidate`, a warp of CoarseView(query, factor) onto CoarseView(clip, factor) with its path,
-// becomes the best full-rate warp in a narrow band around it (whatever its score: coarse and
-// full-rate scores are not comparable), in full-rate frames; false when the band holds no warp
-// within the constraints (the candidate is then unchanged).
+// `candidate`, a warp of CoarseView(query, factor) onto every factor-th frame of `clip` with its
+// path, its frames given as the clip's own, becomes the best full-rate warp in a narrow band
+// around it (whatever its score: coarse and full-rate scores are not comparable); false when
+// the band holds no warp within the constraints (the candidate is then unchanged).
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
                       const WarpConstraints& constraints, BandWorkspace& workspace,
                       SearchResult& candidate);
