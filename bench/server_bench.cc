@@ -146,11 +146,31 @@ std::vector<double> LoggedSearchMs(const std::string& log, size_t from) {
   return ms;
 }
 
-v1::SearchRequest QueryOf(int64_t clip_id) {
+v1::SearchRequest QueryOf(int64_t clip_id, const std::string& space = "bench") {
   v1::SearchRequest request;
-  request.set_space("bench");
+  request.set_space(space);
   request.mutable_clip()->set_clip_id(clip_id);
   return request;
+}
+
+// Client-side latencies of searches by 2.8 s ranges of `clip_id` (one every 10 s of it) in
+// `space`, one at a time, in ms.
+absl::StatusOr<std::vector<double>> TimeSearches(const std::string& address,
+                                                 const std::string& space, int64_t clip_id,
+                                                 int count) {
+  auto stub = v1::SearchService::NewStub(OwnConnection(address));
+  std::vector<double> ms;
+  for (int i = 0; i < count; ++i) {
+    v1::SearchRequest request = QueryOf(clip_id, space);
+    request.mutable_clip()->set_first_frame(300 * i);
+    request.mutable_clip()->set_last_frame(300 * i + 83);
+    v1::SearchResponse response;
+    grpc::ClientContext context;
+    const Clock::time_point sent = Clock::now();
+    MOTIONDB_RETURN_IF_ERROR(FromGrpc(stub->Search(&context, request, &response), "Search"));
+    ms.push_back(1000 * SecondsSince(sent));
+  }
+  return ms;
 }
 
 // Searches from `clients` clients, each on its own connection to `address`, every clip of `ids`
@@ -416,7 +436,7 @@ absl::StatusOr<BackupRun> BackupDuringIngest(const std::string& address,
 absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const std::string db = (work / "synthetic.sqlite").string();
   Clock::time_point start = Clock::now();
-  int64_t frames = 0;
+  int64_t frames = 0, first_id = 0;
   {
     SyntheticCorpusOptions options;
     options.fps = 30;
@@ -426,7 +446,6 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
                               storage::Database::Open(db));
     server::IndexRegistry registry;
     server::Catalog catalog(*database, registry);
-    int64_t first_id = 0;
     for (size_t c = 0; c < generated.clips.size(); ++c) {
       storage::ClipRecord record;
       record.name = absl::StrCat("synthetic_", c);
@@ -456,6 +475,8 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const double serving_s = SecondsSince(start);
   const double rss = StatusMiB(server.pid(), "VmRSS"), hwm = StatusMiB(server.pid(), "VmHWM");
   const std::string log = server.Log();
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<double> search_ms,
+                            TimeSearches(server.address(), "synthetic", first_id, 20));
 
   // Ingest into the large library: 10 clips of a minute, projected and indexed on arrival.
   SyntheticCorpusOptions extra;
@@ -502,6 +523,10 @@ absl::Status StartToServing(double hours, const std::filesystem::path& work) {
               load_line.c_str());
   std::printf("server resident memory when serving: VmRSS %.0f MiB, peak VmHWM %.0f MiB\n", rss,
               hwm);
+  std::printf(
+      "searches over gRPC, one at a time (2.8 s ranges of the first clip, defaults): p50 %.2f "
+      "ms, p99 %.2f ms (%zu)\n",
+      Percentile(search_ms, 0.5), Percentile(search_ms, 0.99), search_ms.size());
   std::printf(
       "ingest into it over gRPC (each clip projected and indexed): %zu clips, %lld frames in "
       "%.2f s = %.0f frames/s, %.0f ms per clip\n",
