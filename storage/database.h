@@ -106,9 +106,14 @@ struct SpaceRecord {
   std::string build_report_json;  // dims, explained variance, reconstruction errors, options
 };
 
+// The rows of a listing's page: Page::page_size 0 means kDefaultPageSize, and more than
+// kMaxPageSize is refused (the server reads a larger request as kMaxPageSize).
+inline constexpr int kDefaultPageSize = 100;
+inline constexpr int kMaxPageSize = 1000;
+
 struct Page {
-  int page_size = 100;     // at most 1000
-  std::string page_token;  // empty for the first page
+  int page_size = kDefaultPageSize;  // at most kMaxPageSize
+  std::string page_token;            // empty for the first page
 };
 
 // The order of a clip listing; each has its own page tokens.
