@@ -1,6 +1,7 @@
 // motiondb label add CLIP[:FROM-TO] DESCRIPTOR [--value V] [--seconds] | labels list [filters] |
 // labels find DESCRIPTOR [--min V] [--tag T]... | labels delete (ID... | --clip ID |
 // --descriptor D) | labels import FILE | labels export [-o FILE] [--format csv|json]
+// [--origin manual|propagated]
 #include <functional>
 #include <iostream>
 #include <map>
@@ -11,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -31,8 +33,12 @@ constexpr int64_t kMaxLabelFileBytes = int64_t{1} << 30;
 
 constexpr char kLabelFileHelp[] =
     "Label files: CSV with the header clip,start,end,descriptor,value (and optionally unit,\n"
-    "frames or seconds), or JSON, a list of objects with those keys. A clip is its id or its\n"
-    "name; an empty start or end is the clip's first or last frame, an empty value 1.";
+    "frames or seconds), or JSON, a list of objects with those keys. clip is the clip's name,\n"
+    "digits too; to give a clip by id, use a clip_id column (or key) instead. An empty start\n"
+    "or end is the clip's first or last frame, an empty value 1.";
+
+constexpr char kClipHelp[] =
+    "CLIP is a clip's name, digits too (0012 is the clip named 0012), or id:N for clip N.";
 
 nlohmann::json LabelJson(const v1::Label& label) {
   nlohmann::json json = {
@@ -150,7 +156,7 @@ FlagNames LabelItemNames(size_t index, const std::string& item,
   const std::string label = absl::StrCat("labels[", index, "]");
   FlagNames names = {{label, item}};
   for (const auto& [field, name] :
-       std::vector<std::pair<std::string, std::string>>{{"clip_id", "clip"},
+       std::vector<std::pair<std::string, std::string>>{{"clip_id", "clip_id"},
                                                         {"clip_name", "clip"},
                                                         {"first_frame", "start"},
                                                         {"start_s", "start"},
@@ -170,19 +176,31 @@ struct AddFlags {
   bool seconds = false;
 };
 
-// "12", "walk_01", "12:30-90" or "walk_01:1.5-3" (with --seconds): the clip by id (digits) or
-// name, and the range; a name holding ':' and a range-like tail must be given by id.
+// Whether the text after a CLIP's last ':' is meant as a range: digits, '.' and '-', with a '-'
+// and a digit ("10-20", "1.5-3", but also the slips "10-" and "-1-5").
+bool LooksLikeRange(const std::string& tail) {
+  return tail.find('-') != std::string::npos &&
+         tail.find_first_of("0123456789") != std::string::npos &&
+         tail.find_first_not_of("0123456789.-") == std::string::npos;
+}
+
+// "walk_01", "walk_01:30-90", "id:12", "id:12:1.5-3" (with --seconds): the clip by name, or by
+// id as id:N, and the range. A name is a name, digits too; a name ending in ':' and a range
+// must be given by id.
 absl::StatusOr<v1::NewLabel> ParseTarget(const std::string& spec, bool seconds) {
   v1::NewLabel label;
   std::string clip = spec;
   const size_t colon = spec.rfind(':');
-  const std::vector<std::string> bounds = colon == std::string::npos
-                                              ? std::vector<std::string>()
-                                              : absl::StrSplit(spec.substr(colon + 1), '-');
-  double from = 0, to = 0;
-  if (bounds.size() == 2 && absl::SimpleAtod(bounds[0], &from) &&
-      absl::SimpleAtod(bounds[1], &to)) {
+  const std::string tail = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (LooksLikeRange(tail)) {
     clip = spec.substr(0, colon);
+    const std::vector<std::string> bounds = absl::StrSplit(tail, '-');
+    double from = 0, to = 0;
+    if (bounds.size() != 2 || !absl::SimpleAtod(bounds[0], &from) ||
+        !absl::SimpleAtod(bounds[1], &to)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "'", spec, "': the range '", tail, "' is not FROM-TO, two numbers from 0 (e.g. 10-20)"));
+    }
     if (seconds) {
       label.set_start_s(from);
       label.set_end_s(to);
@@ -195,10 +213,19 @@ absl::StatusOr<v1::NewLabel> ParseTarget(const std::string& spec, bool seconds) 
       label.set_first_frame(first);
       label.set_last_frame(last);
     }
+  } else if (seconds) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--seconds: '", spec, "' has no range; give CLIP:FROM-TO with FROM and TO in seconds"));
   }
-  int64_t id = 0;
   if (clip.empty()) return absl::InvalidArgumentError(absl::StrCat("'", spec, "' names no clip"));
-  if (absl::SimpleAtoi(clip, &id) && clip.find_first_not_of("0123456789") == std::string::npos) {
+  if (absl::StartsWith(clip, "id:")) {
+    const std::string id_text = clip.substr(3);
+    int64_t id = 0;
+    if (id_text.empty() || id_text.find_first_not_of("0123456789") != std::string::npos ||
+        !absl::SimpleAtoi(id_text, &id) || id == 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("'", spec, "': id:N gives a clip by id, N a whole number from 1"));
+    }
     label.set_clip_id(id);
   } else {
     label.set_clip_name(clip);
@@ -211,11 +238,9 @@ absl::Status AddLabel(const AddFlags& flags, bool json, const ServerConnection& 
   MOTIONDB_ASSIGN_OR_RETURN(*request.add_labels(), ParseTarget(flags.target, flags.seconds));
   request.mutable_labels(0)->set_descriptor_name(flags.descriptor);
   if (flags.value) request.mutable_labels(0)->set_value(*flags.value);
-  const std::map<std::string, std::string> words = {{"clip", "CLIP"},
-                                                    {"start", "FROM"},
-                                                    {"end", "TO"},
-                                                    {"descriptor", "DESCRIPTOR"},
-                                                    {"value", "--value"}};
+  const std::map<std::string, std::string> words = {
+      {"clip", "CLIP"}, {"clip_id", "CLIP"},          {"start", "FROM"},
+      {"end", "TO"},    {"descriptor", "DESCRIPTOR"}, {"value", "--value"}};
   MOTIONDB_ASSIGN_OR_RETURN(
       const v1::AddLabelsResponse response,
       CallUnary(connection, &v1::LabelService::Stub::AddLabels, request,
@@ -248,7 +273,7 @@ absl::Status ListLabels(const ListFlags& flags, bool json, const ServerConnectio
   request.set_origin(OriginOf(flags.origin));
   if (flags.min) request.set_min_value(*flags.min);
   return PrintPages(connection, &v1::LabelService::Stub::ListLabels, request, flags.page,
-                    {{"min_value", "--min"}}, json);
+                    {{"min_value", "--min"}, {"clip_id", "--clip"}}, json);
 }
 
 struct FindFlags {
@@ -280,7 +305,7 @@ struct DeleteFlags {
 
 absl::Status DeleteLabels(const DeleteFlags& flags, bool json, const ServerConnection& connection) {
   v1::DeleteLabelsRequest request;
-  FlagNames names;
+  FlagNames names = {{"clip_id", "--clip"}};
   for (size_t i = 0; i < flags.ids.size(); ++i) {
     request.add_label_ids(flags.ids[i]);
     names.emplace_back(absl::StrCat("label_ids[", i, "]"), absl::StrCat("ID ", flags.ids[i]));
@@ -334,7 +359,9 @@ struct ExportFlags {
   std::string format;  // empty: the extension of `out`, else csv
   int64_t clip = 0;
   std::string descriptor;
-  std::string origin;
+  // The file has no origin column, and imports as manual labels: propagated ones exported with
+  // them would come back as manual ones.
+  std::string origin = "manual";
 };
 
 absl::Status ExportLabels(const ExportFlags& flags, bool json, const ServerConnection& connection) {
@@ -350,8 +377,8 @@ absl::Status ExportLabels(const ExportFlags& flags, bool json, const ServerConne
   request.set_descriptor_name(flags.descriptor);
   request.set_origin(OriginOf(flags.origin));
   MOTIONDB_ASSIGN_OR_RETURN(
-      const Pages pages,
-      ReadPages(connection, &v1::LabelService::Stub::ListLabels, request, false, {}));
+      const Pages pages, ReadPages(connection, &v1::LabelService::Stub::ListLabels, request, false,
+                                   {{"clip_id", "--clip"}}));
   const std::string text = FormatLabelFile(pages.labels, format);
   if (flags.out.empty()) {
     std::cout << text;
@@ -396,8 +423,11 @@ void AddLabelAdd(Commands& commands) {
       ->type_name("V")
       ->default_str("1")
       ->check(NumberAtLeast(0));
-  adder->add_flag("--seconds", add->seconds, "FROM-TO are seconds, not frames");
-  adder->footer("Frame numbers count from 0 at the clip's own rate; a clip of digits is an id.");
+  adder->add_flag("--seconds", add->seconds, "FROM-TO are seconds, not frames (needs FROM-TO)");
+  adder->footer(absl::StrCat(
+      kClipHelp,
+      "\nFrame numbers count from 0 at the clip's own rate; FROM-TO is inclusive. In seconds, TO\n"
+      "may be the clip's duration (a half-open end): that is its last frame."));
 }
 
 void AddListAndFind(Commands& commands, CLI::App* labels) {
@@ -472,7 +502,13 @@ void AddDeleteImportExport(Commands& commands, CLI::App* labels) {
   exporter->add_option("--clip", out->clip, "only the labels of clip ID")
       ->type_name("ID")
       ->check(WholeAtLeast(1));
-  AddFilterFlags(exporter, &out->descriptor, &out->origin);
+  exporter->add_option("--descriptor", out->descriptor, "only labels of descriptor D")
+      ->type_name("D");
+  OneOf(exporter->add_option("--origin", out->origin, "manual (the default) or propagated labels"),
+        {"manual", "propagated"});
+  exporter->footer(
+      "Exports manual labels unless --origin propagated: the file has no origin column, and\n"
+      "every label imported from it is manual.");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -19,7 +21,8 @@
 namespace motiondb::cli {
 namespace {
 
-constexpr const char* kColumns[] = {"clip", "start", "end", "descriptor", "value", "unit"};
+constexpr const char* kColumns[] = {"clip",       "clip_id", "start", "end",
+                                    "descriptor", "value",   "unit"};
 
 bool IsDigits(absl::string_view text) {
   return !text.empty() &&
@@ -33,6 +36,9 @@ std::string ShortestNumber(double value) {
   return std::string(buffer, written.ptr);
 }
 
+// The largest frame number a file may give (what the API's int32 holds).
+constexpr double kMaxFrame = std::numeric_limits<int32_t>::max();
+
 // One label's fields as a file gives them, before they become a NewLabel.
 struct LabelFields {
   std::optional<int64_t> clip_id;
@@ -44,18 +50,23 @@ struct LabelFields {
 
 absl::StatusOr<v1::NewLabel> ToNewLabel(const LabelFields& fields) {
   v1::NewLabel label;
-  if (fields.clip_id) {
-    label.set_clip_id(*fields.clip_id);
-  } else if (fields.clip_name.empty()) {
-    return absl::InvalidArgumentError("clip: missing");
-  } else {
-    label.set_clip_name(fields.clip_name);
+  if (!fields.clip_id && fields.clip_name.empty()) {
+    return absl::InvalidArgumentError("clip: missing (give the clip's name, or its id as clip_id)");
   }
+  // Both given, the server checks that they name one clip.
+  if (fields.clip_id) label.set_clip_id(*fields.clip_id);
+  label.set_clip_name(fields.clip_name);
   if (fields.unit == "seconds") {
     if (fields.start) label.set_start_s(*fields.start);
     if (fields.end) label.set_end_s(*fields.end);
   } else if (fields.unit == "frames") {
     for (const auto& [bound, name] : {std::pair{fields.start, "start"}, {fields.end, "end"}}) {
+      // Checked before the cast, which is undefined for NaN, infinities and numbers out of range.
+      if (bound && (!std::isfinite(*bound) || std::abs(*bound) > kMaxFrame)) {
+        return absl::InvalidArgumentError(absl::StrCat(name, ": ", *bound,
+                                                       " is not a frame number (at most ",
+                                                       std::numeric_limits<int32_t>::max(), ")"));
+      }
       if (bound && (*bound != static_cast<int32_t>(*bound))) {
         return absl::InvalidArgumentError(
             absl::StrCat(name, ": ", *bound, " is not a whole frame number"));
@@ -103,7 +114,8 @@ absl::StatusOr<std::optional<double>> CsvNumber(const std::string& text, const c
   return number;
 }
 
-// The header's column of each name; every column but unit is required.
+// The header's column of each name, each named once; every column but unit is required, and
+// clip and clip_id are one: either will do.
 absl::StatusOr<std::map<std::string, size_t>> CsvHeader(const std::vector<std::string>& names) {
   std::map<std::string, size_t> columns;
   for (size_t i = 0; i < names.size(); ++i) {
@@ -112,9 +124,15 @@ absl::StatusOr<std::map<std::string, size_t>> CsvHeader(const std::vector<std::s
       return absl::InvalidArgumentError(absl::StrCat(
           "header: unknown column '", name, "'; the columns are ", absl::StrJoin(kColumns, ", ")));
     }
-    columns[name] = i;
+    if (const auto [known, added] = columns.emplace(name, i); !added) {
+      return absl::InvalidArgumentError(absl::StrCat("header: column '", name, "' is named twice (",
+                                                     known->second + 1, " and ", i + 1, ")"));
+    }
   }
-  for (const char* required : {"clip", "start", "end", "descriptor", "value"}) {
+  if (!columns.contains("clip") && !columns.contains("clip_id")) {
+    return absl::InvalidArgumentError("header: no 'clip' (or 'clip_id') column");
+  }
+  for (const char* required : {"start", "end", "descriptor", "value"}) {
     if (!columns.contains(required)) {
       return absl::InvalidArgumentError(absl::StrCat("header: no '", required, "' column"));
     }
@@ -129,12 +147,18 @@ absl::StatusOr<LabelFields> CsvFields(const std::vector<std::string>& row,
         absl::StrCat(row.size(), " fields, but the header names ", columns.size()));
   }
   LabelFields fields;
-  const std::string& clip = row[columns.at("clip")];
-  int64_t id = 0;
-  if (IsDigits(clip) && absl::SimpleAtoi(clip, &id)) {
+  // clip is always a name, digits too; an id is a clip_id.
+  if (const auto clip = columns.find("clip"); clip != columns.end()) {
+    fields.clip_name = row[clip->second];
+  }
+  if (const auto clip_id = columns.find("clip_id");
+      clip_id != columns.end() && !row[clip_id->second].empty()) {
+    const std::string& text = row[clip_id->second];
+    int64_t id = 0;
+    if (!IsDigits(text) || !absl::SimpleAtoi(text, &id) || id == 0) {
+      return absl::InvalidArgumentError(absl::StrCat("clip_id: '", text, "' is not a clip id"));
+    }
     fields.clip_id = id;
-  } else {
-    fields.clip_name = clip;
   }
   MOTIONDB_ASSIGN_OR_RETURN(fields.start, CsvNumber(row[columns.at("start")], "start"));
   MOTIONDB_ASSIGN_OR_RETURN(fields.end, CsvNumber(row[columns.at("end")], "end"));
@@ -146,7 +170,9 @@ absl::StatusOr<LabelFields> CsvFields(const std::vector<std::string>& row,
   return fields;
 }
 
-absl::StatusOr<LabelFile> ParseCsv(const std::string& text) {
+absl::StatusOr<LabelFile> ParseCsv(absl::string_view text) {
+  // Spreadsheets saving "CSV UTF-8" begin the file with a byte order mark.
+  absl::ConsumePrefix(&text, "\xEF\xBB\xBF");
   LabelFile file;
   std::optional<std::map<std::string, size_t>> columns;
   int line_number = 0;
@@ -186,13 +212,18 @@ absl::StatusOr<LabelFields> JsonFields(const nlohmann::json& item) {
     }
   }
   LabelFields fields;
-  const nlohmann::json clip = item.value("clip", nlohmann::json());
-  if (clip.is_number_unsigned()) {
-    fields.clip_id = clip.get<int64_t>();
-  } else if (clip.is_string()) {
-    fields.clip_name = clip.get<std::string>();
-  } else {
-    return absl::InvalidArgumentError("clip: expected a clip id or name");
+  if (item.contains("clip")) {
+    if (!item["clip"].is_string()) {
+      return absl::InvalidArgumentError("clip: expected a clip name (give an id as clip_id)");
+    }
+    fields.clip_name = item["clip"].get<std::string>();
+  }
+  if (item.contains("clip_id")) {
+    if (!item["clip_id"].is_number_unsigned() || item["clip_id"].get<uint64_t>() == 0 ||
+        item["clip_id"].get<uint64_t>() > std::numeric_limits<int64_t>::max()) {
+      return absl::InvalidArgumentError("clip_id: expected a clip id (a whole number from 1)");
+    }
+    fields.clip_id = item["clip_id"].get<int64_t>();
   }
   if (!item.value("descriptor", nlohmann::json()).is_string()) {
     return absl::InvalidArgumentError("descriptor: expected a string");
@@ -222,12 +253,6 @@ absl::StatusOr<LabelFile> ParseJson(const std::string& text) {
   return file;
 }
 
-// A clip as a CSV file names it: by name, which another database knows it by too; by id when
-// the name is all digits, which would read back as an id.
-std::string CsvClip(const v1::Label& label) {
-  return IsDigits(label.clip_name()) ? absl::StrCat(label.clip_id()) : label.clip_name();
-}
-
 std::string CsvField(const std::string& text) {
   if (text.find_first_of(",\"") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -253,7 +278,6 @@ std::string FormatLabelFile(const std::vector<v1::Label>& labels, LabelFileForma
   if (format == LabelFileFormat::kJson) {
     nlohmann::json items = nlohmann::json::array();
     for (const v1::Label& label : labels) {
-      // A JSON string is always a name.
       items.push_back({{"clip", label.clip_name()},
                        {"start", label.first_frame()},
                        {"end", label.last_frame()},
@@ -265,7 +289,8 @@ std::string FormatLabelFile(const std::vector<v1::Label>& labels, LabelFileForma
   }
   std::string text = "clip,start,end,descriptor,value,unit\n";
   for (const v1::Label& label : labels) {
-    absl::StrAppend(&text, CsvField(CsvClip(label)), ",", label.first_frame(), ",",
+    // By name, which another database knows the clip by too.
+    absl::StrAppend(&text, CsvField(label.clip_name()), ",", label.first_frame(), ",",
                     label.last_frame(), ",", CsvField(label.descriptor_name()), ",",
                     ShortestNumber(label.value()), ",frames\n");
   }

@@ -1,9 +1,11 @@
 // The label files `labels import` reads and `labels export` writes: what studio labelling tools
-// exchange. CSV with a header naming the columns clip, start, end, descriptor, value, and
-// optionally unit (frames, the default, or seconds), in any order; fields holding a comma or a
-// quote are quoted ("a, b", "say ""hi"""). JSON: a list of objects with the same keys. A clip
-// is its id (a CSV field of digits, a JSON number) or its name; an empty (or absent) start or
-// end is the clip's first or last frame, an empty value 1.
+// exchange. CSV with a header naming the columns clip (or clip_id, or both), start, end,
+// descriptor, value, and optionally unit (frames, the default, or seconds), in any order, each
+// once; fields holding a comma or a quote are quoted ("a, b", "say ""hi"""); a UTF-8 byte order
+// mark before the header is skipped. JSON: a list of objects with the same keys. clip is always
+// the clip's name, digits too ("0012" is the clip named 0012); clip_id its id. Given both, they
+// must name one clip. An empty (or absent) start or end is the clip's first or last frame, an
+// empty value 1.
 #ifndef MOTIONDB_CLIENT_LABEL_FILES_H_
 #define MOTIONDB_CLIENT_LABEL_FILES_H_
 
@@ -29,8 +31,8 @@ struct LabelFile {
 // Parses a label file's `text`; errors say where ("line 4: value 'x' is not a number").
 absl::StatusOr<LabelFile> ParseLabelFile(const std::string& text, LabelFileFormat format);
 
-// `labels` in a file ParseLabelFile reads back as the same labels: the clip by name, the range
-// in frames.
+// `labels` in a file ParseLabelFile reads back as the same labels: the clip by name (in clip),
+// the range in frames. It has no origin column: what it holds imports as manual labels.
 std::string FormatLabelFile(const std::vector<v1::Label>& labels, LabelFileFormat format);
 
 }  // namespace motiondb::cli

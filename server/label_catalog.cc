@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include "absl/container/flat_hash_map.h"
@@ -12,52 +13,69 @@
 namespace motiondb::server {
 namespace {
 
-// The clips a batch names, each read once: a studio's import labels few clips many times.
+// The clips a batch names, each read once: a studio's import labels few clips many times. The
+// records are held by pointer, so one that Resolve returns stays valid as the maps grow.
 class ClipResolver {
  public:
   explicit ClipResolver(storage::Database& database) : database_(database) {}
 
   absl::StatusOr<const storage::ClipRecord*> Resolve(const NewLabel& label,
                                                      const std::string& item) {
-    if (label.clip_id != 0) {
-      return Cached(by_id_, label.clip_id, absl::StrCat(item, ".clip_id"),
-                    [&] { return database_.GetClipRecord(label.clip_id); });
-    }
-    if (label.clip_name.empty()) {
+    if (label.clip_id == 0 && label.clip_name.empty()) {
       return absl::InvalidArgumentError(absl::StrCat(item, ": give clip_id or clip_name"));
     }
-    return Cached(by_name_, label.clip_name, absl::StrCat(item, ".clip_name"),
-                  [&] { return database_.GetClipRecordByName(label.clip_name); });
+    const storage::ClipRecord* by_id = nullptr;
+    if (label.clip_id != 0) {
+      MOTIONDB_ASSIGN_OR_RETURN(by_id,
+                                Cached(by_id_, label.clip_id, absl::StrCat(item, ".clip_id"),
+                                       [&] { return database_.GetClipRecord(label.clip_id); }));
+      if (label.clip_name.empty()) return by_id;
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const storage::ClipRecord* by_name,
+        Cached(by_name_, label.clip_name, absl::StrCat(item, ".clip_name"),
+               [&] { return database_.GetClipRecordByName(label.clip_name); }));
+    // Both given: they must name one clip, or which one was meant is a guess.
+    if (by_id != nullptr && by_id->clip_id != by_name->clip_id) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(item, ": clip_id ", label.clip_id, " and clip_name '", label.clip_name,
+                       "' (clip ", by_name->clip_id, ") name different clips; give one"));
+    }
+    return by_name;
   }
 
  private:
   template <typename Key, typename Read>
   absl::StatusOr<const storage::ClipRecord*> Cached(
-      absl::flat_hash_map<Key, storage::ClipRecord>& cache, const Key& key,
+      absl::flat_hash_map<Key, std::unique_ptr<storage::ClipRecord>>& cache, const Key& key,
       const std::string& field, const Read& read) {
     auto found = cache.find(key);
     if (found == cache.end()) {
       MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record, Prefixed(field, read()));
-      found = cache.emplace(key, std::move(record)).first;
+      found = cache.emplace(key, std::make_unique<storage::ClipRecord>(std::move(record))).first;
     }
-    return &found->second;
+    return found->second.get();
   }
 
   storage::Database& database_;
-  absl::flat_hash_map<int64_t, storage::ClipRecord> by_id_;
-  absl::flat_hash_map<std::string, storage::ClipRecord> by_name_;
+  absl::flat_hash_map<int64_t, std::unique_ptr<storage::ClipRecord>> by_id_;
+  absl::flat_hash_map<std::string, std::unique_ptr<storage::ClipRecord>> by_name_;
 };
 
 // The frame nearest `seconds` into `clip`; INVALID_ARGUMENT naming `field` for a time that is
-// not finite, negative, or past the clip's last frame.
+// not finite, negative, or past the clip's last frame. An `end` may be the clip's end (its
+// duration, frame_count x frame time, as tools write a half-open range), give or take half a
+// frame: that is the last frame.
 absl::StatusOr<int64_t> FrameAt(double seconds, const storage::ClipRecord& clip,
-                                const std::string& field) {
+                                const std::string& field, bool end) {
   if (!std::isfinite(seconds) || seconds < 0) {
     return absl::InvalidArgumentError(
         absl::StrCat(field, ": ", seconds, " is not a time in the clip (seconds from 0)"));
   }
-  const double frame = std::round(seconds / clip.frame_time);
-  if (frame > static_cast<double>(clip.frame_count - 1)) {
+  const double last = static_cast<double>(clip.frame_count - 1);
+  double frame = std::round(seconds / clip.frame_time);
+  if (end && frame == last + 1) frame = last;
+  if (frame > last) {
     return absl::InvalidArgumentError(
         absl::StrCat(field, ": ", seconds, " s is past the clip's last frame ",
                      clip.frame_count - 1, " at ", (clip.frame_count - 1) * clip.frame_time, " s"));
@@ -78,13 +96,20 @@ absl::Status ResolveRange(const NewLabel& label, const storage::ClipRecord& clip
   }
   record.first_frame = label.first_frame.value_or(0);
   record.last_frame = label.last_frame.value_or(clip.frame_count - 1);
+  // Storage checks the range as given; a first frame past the clip, the last one unset, would
+  // be told as a reversed range.
+  if (label.first_frame && *label.first_frame >= clip.frame_count) {
+    return absl::InvalidArgumentError(absl::StrCat(item, ".first_frame: ", *label.first_frame,
+                                                   " is outside the clip's frames 0..",
+                                                   clip.frame_count - 1));
+  }
   if (label.start_s) {
     MOTIONDB_ASSIGN_OR_RETURN(record.first_frame,
-                              FrameAt(*label.start_s, clip, absl::StrCat(item, ".start_s")));
+                              FrameAt(*label.start_s, clip, absl::StrCat(item, ".start_s"), false));
   }
   if (label.end_s) {
     MOTIONDB_ASSIGN_OR_RETURN(record.last_frame,
-                              FrameAt(*label.end_s, clip, absl::StrCat(item, ".end_s")));
+                              FrameAt(*label.end_s, clip, absl::StrCat(item, ".end_s"), true));
   }
   if (label.start_s && label.end_s && *label.end_s < *label.start_s) {
     return absl::InvalidArgumentError(
@@ -157,7 +182,7 @@ absl::StatusOr<int64_t> DeleteLabels(storage::Database& database, const LabelDel
 
 absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id) {
   ClipTimeline timeline;
-  MOTIONDB_ASSIGN_OR_RETURN(timeline.clip, database.GetClipRecord(clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(timeline.clip, Prefixed("clip_id", database.GetClipRecord(clip_id)));
   MOTIONDB_ASSIGN_OR_RETURN(timeline.labels, database.ClipLabels(clip_id));
   return timeline;
 }

@@ -22,9 +22,10 @@ namespace motiondb::server {
 
 inline constexpr size_t kMaxLabelsPerBatch = 100000;
 
-// A manual label to add: the clip is clip_id, or when that is 0 the clip named clip_name; the
-// range in frames or in seconds (each rounded to the nearest frame), not both, an unset bound
-// being the clip's first or last frame.
+// A manual label to add: the clip is clip_id, or when that is 0 the clip named clip_name (both
+// set, they must name one clip); the inclusive range in frames or in seconds (each rounded to
+// the nearest frame, an end_s at the clip's duration being its last frame), not both, an unset
+// bound being the clip's first or last frame.
 struct NewLabel {
   int64_t clip_id = 0;
   std::string clip_name{};
@@ -35,9 +36,10 @@ struct NewLabel {
 };
 
 // Stores the batch, all or nothing; returns the labels as stored, in its order. NOT_FOUND for
-// an unknown clip; INVALID_ARGUMENT for what storage::Database::AddLabels refuses, a time that
-// is not finite, negative, past the clip or reversed, frames and seconds both given, no clip
-// named, or over kMaxLabelsPerBatch labels. `should_stop` as the Catalog's writes take it.
+// an unknown clip; INVALID_ARGUMENT for what storage::Database::AddLabels refuses, a first
+// frame or time that is past the clip, a time that is not finite, negative or reversed, frames
+// and seconds both given, no clip named or clip_id and clip_name naming two, or over
+// kMaxLabelsPerBatch labels. `should_stop` as the Catalog's writes take it.
 absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
     storage::Database& database, const std::vector<NewLabel>& labels,
     const std::function<bool()>& should_stop = {});
@@ -57,7 +59,7 @@ struct LabelDeletion {
 absl::StatusOr<int64_t> DeleteLabels(storage::Database& database, const LabelDeletion& deletion,
                                      const std::function<bool()>& should_stop = {});
 
-// A clip and its labels by first frame.
+// A clip and its labels by first frame; NOT_FOUND naming clip_id for an unknown clip.
 struct ClipTimeline {
   storage::ClipRecord clip;
   std::vector<storage::LabelRecord> labels;

@@ -9,12 +9,10 @@
 namespace motiondb::server {
 namespace {
 
-constexpr int kDefaultPageSize = 100;
-constexpr int kMaxPageSize = 1000;
-
+// The API's reading of a page size (server/listing.h), in storage's limits.
 absl::StatusOr<int> ResolvePageSize(int requested) {
   if (requested < 0) return absl::InvalidArgumentError("page_size: must not be negative");
-  return requested == 0 ? kDefaultPageSize : std::min(requested, kMaxPageSize);
+  return requested == 0 ? storage::kDefaultPageSize : std::min(requested, storage::kMaxPageSize);
 }
 
 absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort) {

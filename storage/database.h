@@ -106,9 +106,14 @@ struct SpaceRecord {
   std::string build_report_json;  // dims, explained variance, reconstruction errors, options
 };
 
+// The rows of a listing's page: Page::page_size 0 means kDefaultPageSize, and more than
+// kMaxPageSize is refused (the server reads a larger request as kMaxPageSize).
+inline constexpr int kDefaultPageSize = 100;
+inline constexpr int kMaxPageSize = 1000;
+
 struct Page {
-  int page_size = 100;     // at most 1000
-  std::string page_token;  // empty for the first page
+  int page_size = kDefaultPageSize;  // at most kMaxPageSize
+  std::string page_token;            // empty for the first page
 };
 
 // The order of a clip listing; each has its own page tokens.
@@ -212,13 +217,14 @@ class Database {
   absl::StatusOr<std::vector<int64_t>> AddLabels(const std::vector<LabelRecord>& labels,
                                                  const WriteOptions& write = {});
   // Labels matching `filter`, in label id order; Page as ListClips takes it (its token is the
-  // last label id).
+  // last label id). NOT_FOUND naming clip_id when the filter's clip is unknown.
   absl::StatusOr<LabelPage> ListLabels(const Page& page, const LabelFilter& filter);
   // Labels of `query.descriptor` with a value of at least `query.min_value`, strongest first,
-  // then by clip and first frame. INVALID_ARGUMENT for an empty descriptor or a min_value
-  // outside [0, 1].
+  // then by clip and first frame. INVALID_ARGUMENT for an empty descriptor, a min_value
+  // outside [0, 1], more than kMaxTags tags or a malformed page token.
   absl::StatusOr<LabelPage> FindLabels(const Page& page, const LabelQuery& query);
-  // Every label of a clip, by first frame (then last frame, id): its timeline. NOT_FOUND.
+  // Every label of a clip, by first frame (then last frame, id): its timeline. NOT_FOUND naming
+  // clip_id.
   absl::StatusOr<std::vector<LabelRecord>> ClipLabels(int64_t clip_id);
   // Deletes the labels of these ids, and those propagated from them, in one transaction;
   // returns how many of the ids there were. NOT_FOUND naming label_ids[i] when an id is unknown,
@@ -226,7 +232,8 @@ class Database {
   absl::StatusOr<int64_t> DeleteLabels(const std::vector<int64_t>& label_ids,
                                        const WriteOptions& write = {});
   // The same for every label `filter` takes (and those propagated from them); returns how many
-  // it took. INVALID_ARGUMENT for an empty filter: deleting every label is not a slip to allow.
+  // it took. INVALID_ARGUMENT for an empty filter: deleting every label is not a slip to allow;
+  // NOT_FOUND naming clip_id when the filter's clip is unknown.
   absl::StatusOr<int64_t> DeleteLabels(const LabelFilter& filter, const WriteOptions& write = {});
 
   // Every skeleton, in id order, with its clip count and first clip, in one query.

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "absl/container/flat_hash_map.h"
@@ -128,10 +129,19 @@ absl::StatusOr<FindStart> ParseFindToken(const std::string& page_token) {
   if (parts.size() != 5 || parts[0] != "f" || !absl::SimpleAtod(parts[1], &start.value) ||
       !absl::SimpleAtoi(parts[2], &start.clip_id) ||
       !absl::SimpleAtoi(parts[3], &start.first_frame) ||
-      !absl::SimpleAtoi(parts[4], &start.label_id)) {
+      !absl::SimpleAtoi(parts[4], &start.label_id) || !std::isfinite(start.value) ||
+      start.value < 0 || start.value > 1) {
     return MalformedToken(page_token);
   }
   return start;
+}
+
+// NOT_FOUND naming `field` when no clip has `clip_id`.
+absl::Status CheckClipExists(SqliteConnection& db, int64_t clip_id, absl::string_view field) {
+  MOTIONDB_ASSIGN_OR_RETURN(const bool exists,
+                            Exists(db, "SELECT 1 FROM clips WHERE clip_id = ?", clip_id));
+  if (exists) return absl::OkStatus();
+  return absl::NotFoundError(absl::StrCat(field, ": clip ", clip_id, " not found"));
 }
 
 // The frame counts of the clips a batch names, read once each in the batch's transaction.
@@ -238,6 +248,8 @@ absl::StatusOr<LabelPage> Database::ListLabels(const Page& page, const LabelFilt
                                                    " ORDER BY l.label_id LIMIT ?2"));
   LabelPage result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    if (filter.clip_id != 0)
+      MOTIONDB_RETURN_IF_ERROR(CheckClipExists(db, filter.clip_id, "clip_id"));
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query, db.Prepare(sql));
     query.BindInt64(1, after).BindInt64(2, page_size + 1);
     BindFilter(query, filter);
@@ -254,21 +266,24 @@ absl::StatusOr<LabelPage> Database::FindLabels(const Page& page, const LabelQuer
   MOTIONDB_ASSIGN_OR_RETURN(const FindStart start, ParseFindToken(page.page_token));
   MOTIONDB_RETURN_IF_ERROR(CheckName("descriptor", query.descriptor, kMaxDescriptorBytes));
   MOTIONDB_RETURN_IF_ERROR(CheckMinValue(query.min_value));
-  for (size_t i = 0; i < query.tags.size(); ++i) {
-    MOTIONDB_RETURN_IF_ERROR(CheckName(absl::StrCat("tags[", i, "]"), query.tags[i], kMaxTagBytes));
+  // At most kMaxTags, each once: the query binds one parameter per tag.
+  if (query.tags.size() > kMaxTags) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("tags: at most ", kMaxTags, " a query, got ", query.tags.size()));
   }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> tags, CanonicalTags(query.tags, "tags"));
   // Strongest first; (value, clip, first frame, id) orders every label once, so a page starts
   // right after the last one of the page before.
   std::string sql = LabelSelect(
       "WHERE l.descriptor = ?1 AND l.value >= ?2 AND (l.value < ?3 OR (l.value = ?3 AND "
       "(l.clip_id, l.first_frame, l.label_id) > (?4, ?5, ?6)))");
-  if (!query.tags.empty()) {
-    std::vector<std::string> tags;
-    for (size_t i = 0; i < query.tags.size(); ++i) tags.push_back(absl::StrCat("?", 8 + i));
+  if (!tags.empty()) {
+    std::vector<std::string> parameters;
+    for (size_t i = 0; i < tags.size(); ++i) parameters.push_back(absl::StrCat("?", 8 + i));
     absl::StrAppend(&sql,
                     " AND EXISTS (SELECT 1 FROM clip_tags t WHERE t.clip_id = l.clip_id AND t.tag "
                     "IN (",
-                    absl::StrJoin(tags, ", "), "))");
+                    absl::StrJoin(parameters, ", "), "))");
   }
   absl::StrAppend(&sql, " ORDER BY l.value DESC, l.clip_id, l.first_frame, l.label_id LIMIT ?7");
   LabelPage result;
@@ -281,9 +296,7 @@ absl::StatusOr<LabelPage> Database::FindLabels(const Page& page, const LabelQuer
         .BindInt64(5, start.first_frame)
         .BindInt64(6, start.label_id)
         .BindInt64(7, page_size + 1);
-    for (size_t i = 0; i < query.tags.size(); ++i) {
-      statement.BindText(static_cast<int>(8 + i), query.tags[i]);
-    }
+    for (size_t i = 0; i < tags.size(); ++i) statement.BindText(static_cast<int>(8 + i), tags[i]);
     MOTIONDB_ASSIGN_OR_RETURN(std::vector<LabelRecord> labels, ReadLabels(statement));
     result = PageOf(std::move(labels), page_size, FindToken);
     return absl::OkStatus();
@@ -294,9 +307,7 @@ absl::StatusOr<LabelPage> Database::FindLabels(const Page& page, const LabelQuer
 absl::StatusOr<std::vector<LabelRecord>> Database::ClipLabels(int64_t clip_id) {
   std::vector<LabelRecord> labels;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
-    MOTIONDB_ASSIGN_OR_RETURN(const bool exists,
-                              Exists(db, "SELECT 1 FROM clips WHERE clip_id = ?", clip_id));
-    if (!exists) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
+    MOTIONDB_RETURN_IF_ERROR(CheckClipExists(db, clip_id, "clip_id"));
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement query,
         db.Prepare(
@@ -345,6 +356,8 @@ absl::StatusOr<int64_t> Database::DeleteLabels(const LabelFilter& filter,
   }
   int64_t deleted = 0;
   MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
+    if (filter.clip_id != 0)
+      MOTIONDB_RETURN_IF_ERROR(CheckClipExists(db, filter.clip_id, "clip_id"));
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement erase,
         db.Prepare(absl::StrCat("DELETE FROM labels WHERE 1", FilterSql(filter, ""))));

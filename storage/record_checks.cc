@@ -6,6 +6,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "storage/database.h"
 #include "util/status_macros.h"
 
 namespace motiondb::storage {

@@ -12,6 +12,7 @@
 
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
+#include "storage/sqlite_connection.h"
 #include "testing/server_process.h"
 #include "tests/clip_builder.h"
 #include "tests/synthetic_motion.h"
@@ -627,10 +628,10 @@ TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
   EXPECT_EQ(framed["first_frame"], 10);
   EXPECT_EQ(framed["last_frame"], 20);
   EXPECT_EQ(framed["origin"], "manual");
-  r = Remote({"label", "add", clip_id_ + ":0.5-1", "step", "--seconds"});
+  r = Remote({"label", "add", "id:" + clip_id_ + ":0.5-1", "step", "--seconds"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("clip " + clip_id_ + " (walk54) frames 15-30 (0.500-1.000 s)"));
-  ASSERT_EQ(Remote({"label", "add", clip_id_, "whole"}).exit_code, 0);
+  ASSERT_EQ(Remote({"label", "add", "id:" + clip_id_, "whole"}).exit_code, 0);
 
   r = Remote({"labels", "list", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -672,9 +673,20 @@ TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
       {{"label", "add", "walk54", ""}, "DESCRIPTOR must not be empty"},
       {{"label", "add", "nosuch", "step"}, "NOT_FOUND: CLIP: no clip is named 'nosuch'"},
       {{"label", "add", "walk54:1.5-3", "step"}, "frames are whole numbers"},
+      {{"label", "add", "walk54:10-", "step"},
+       "'walk54:10-': the range '10-' is not FROM-TO, two numbers from 0 (e.g. 10-20)"},
+      {{"label", "add", "walk54:-1-5", "step"}, "the range '-1-5' is not FROM-TO"},
+      {{"label", "add", "walk54", "step", "--seconds"},
+       "--seconds: 'walk54' has no range; give CLIP:FROM-TO"},
+      {{"label", "add", "id:x", "step"}, "'id:x': id:N gives a clip by id"},
+      {{"label", "add", "id:999999", "step"}, "NOT_FOUND: CLIP: clip 999999 not found"},
+      {{"label", "add", clip_id_, "step"}, "NOT_FOUND: CLIP: no clip is named '" + clip_id_ + "'"},
       {{"labels", "find", "step", "--min", "2"}, "--min: 2 is outside [0, 1]"},
       {{"labels", "delete", "999999"}, "NOT_FOUND: ID 999999: label 999999 not found"},
       {{"labels", "delete"}, "give label ids or a filter"},
+      {{"labels", "list", "--clip", "999999"}, "NOT_FOUND: --clip: clip 999999 not found"},
+      {{"labels", "delete", "--clip", "999999"}, "NOT_FOUND: --clip: clip 999999 not found"},
+      {{"labels", "export", "--clip", "999999"}, "NOT_FOUND: --clip: clip 999999 not found"},
   };
   for (const auto& e : errors) {
     r = Remote(e.args);
@@ -702,6 +714,10 @@ TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
     EXPECT_THAT(r.out, HasSubstr("Usage: motiondb " + help[0] + " " + help[1])) << r.out;
   }
   EXPECT_THAT(RunCli({"label", "add", "--help"}).out, HasSubstr("CLIP[:FROM-TO]"));
+  EXPECT_THAT(RunCli({"label", "add", "--help"}).out, HasSubstr("or id:N for clip N"));
+  EXPECT_THAT(RunCli({"labels", "import", "--help"}).out, HasSubstr("use a clip_id column"));
+  EXPECT_THAT(RunCli({"labels", "export", "--help"}).out,
+              HasSubstr("Exports manual labels unless --origin propagated"));
   EXPECT_THAT(RunCli({"labels", "list", "--help"}).out, HasSubstr("--origin manual|propagated"));
 }
 
@@ -735,8 +751,8 @@ TEST_F(CliServerTest, LabelsExportAndImportRoundTripCsvAndJson) {
   // Another column order, seconds, an empty value (1) and end (the last frame).
   const std::string seconds =
       WriteText("seconds.csv",
-                "descriptor,clip,end,start,value,unit\r\nkick,walk54,1,0.5,,seconds\r\n"
-                "turn," +
+                "descriptor,clip,clip_id,end,start,value,unit\r\nkick,walk54,,1,0.5,,seconds\r\n"
+                "turn,," +
                     clip_id_ + ",,40,0.5,\r\n");
   r = Remote({"labels", "import", seconds});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -770,7 +786,31 @@ TEST_F(CliServerTest, LabelsExportAndImportRoundTripCsvAndJson) {
       {"item.json", R"([{"clip": "walk54", "descriptor": "a", "start": "0"}])",
        "item.json: item 0: start: expected a number"},
       {"labels.txt", "clip,start,end,descriptor,value\n", "expected a .csv or .json file"},
+      {"twice.csv", "clip,start,end,descriptor,value,start\nwalk54,0,5,a,1,0\n",
+       "twice.csv: line 1: header: column 'start' is named twice (2 and 6)"},
+      {"noclip.csv", "start,end,descriptor,value\n", "header: no 'clip' (or 'clip_id') column"},
+      {"nan.csv", "clip,start,end,descriptor,value\nwalk54,nan,5,a,1\n",
+       "nan.csv: line 2: start: nan is not a frame number (at most 2147483647)"},
+      {"inf.csv", "clip,start,end,descriptor,value\nwalk54,0,inf,a,1\n",
+       "inf.csv: line 2: end: inf is not a frame number"},
+      {"big.csv", "clip,start,end,descriptor,value\nwalk54,0,1e10,a,1\n",
+       "big.csv: line 2: end: 1e+10 is not a frame number"},
+      {"small.csv", "clip,start,end,descriptor,value\nwalk54,-3e9,5,a,1\n",
+       "small.csv: line 2: start: -3e+09 is not a frame number"},
+      {"clipid.csv", "clip_id,start,end,descriptor,value\nwalk54,0,5,a,1\n",
+       "clipid.csv: line 2: clip_id: 'walk54' is not a clip id"},
+      {"unknownid.csv", "clip,clip_id,start,end,descriptor,value\n,999999,0,5,a,1\n",
+       "unknownid.csv: line 2, clip_id: clip 999999 not found"},
+      {"number.json", R"([{"clip": 1, "descriptor": "a"}])",
+       "number.json: item 0: clip: expected a clip name (give an id as clip_id)"},
   };
+  // A byte order mark (as spreadsheets write it) before the header.
+  r = Remote({"labels", "import",
+              WriteText("bom.csv",
+                        "\xEF\xBB\xBF"
+                        "clip,start,end,descriptor,value\nwalk54,0,5,bom,1\n")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
   const size_t before =
       nlohmann::json::parse(Remote({"labels", "list", "--json"}).out)["labels"].size();
   for (const auto& b : bad) {
@@ -780,6 +820,95 @@ TEST_F(CliServerTest, LabelsExportAndImportRoundTripCsvAndJson) {
   }
   EXPECT_EQ(nlohmann::json::parse(Remote({"labels", "list", "--json"}).out)["labels"].size(),
             before);
+}
+
+// A clip's name is a name, digits too: a clip named like another's id is labelled by name,
+// in files and on the command line; ids are explicit (id:N, clip_id).
+TEST_F(CliServerTest, ClipNamesOfDigitsAreNamesAndIdsAreExplicit) {
+  // A second clip named as the fixture's clip's id, and one named with leading zeros.
+  const std::string walk = (dir_ / "walk54.bvh").string();
+  testing::CommandResult r = Remote({"ingest", walk, "--name", clip_id_, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const int digits = nlohmann::json::parse(r.out)["ingested"][0]["clip_id"].get<int>();
+  ASSERT_NE(std::to_string(digits), clip_id_);
+  r = Remote({"ingest", walk, "--name", "000" + clip_id_});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  r = Remote({"label", "add", clip_id_ + ":1-2", "by-name", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["clip_id"], digits);
+  r = Remote({"label", "add", "id:" + clip_id_ + ":1-2", "by-id", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["clip_id"].dump(), clip_id_);
+  r = Remote({"label", "add", "000" + clip_id_, "zeros", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["clip_name"], "000" + clip_id_);
+
+  // Files: clip is a name, clip_id an id; both must agree. Export writes names.
+  r = Remote(
+      {"labels", "import",
+       WriteText("digits.csv", "clip,clip_id,start,end,descriptor,value\n" + clip_id_ +
+                                   ",,0,1,file-name,1\n," + clip_id_ + ",0,1,file-id,1\nwalk54," +
+                                   clip_id_ + ",0,1,file-both,1\n")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = Remote({"labels", "import",
+              WriteText("digits.json", R"([{"clip": ")" + clip_id_ +
+                                           R"(", "descriptor": "json-name"}, {"clip_id": )" +
+                                           clip_id_ + R"(, "descriptor": "json-id"}])")});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json listed = nlohmann::json::parse(Remote({"labels", "list", "--json"}).out);
+  std::map<std::string, std::string> clip_of;
+  for (const nlohmann::json& label : listed["labels"]) {
+    clip_of[label["descriptor"]] = label["clip_id"].dump();
+  }
+  const std::string named = std::to_string(digits);
+  EXPECT_EQ(clip_of, (std::map<std::string, std::string>{{"by-name", named},
+                                                         {"by-id", clip_id_},
+                                                         {"zeros", clip_of["zeros"]},
+                                                         {"file-name", named},
+                                                         {"file-id", clip_id_},
+                                                         {"file-both", clip_id_},
+                                                         {"json-name", named},
+                                                         {"json-id", clip_id_}}));
+  r = Remote({"labels", "import",
+              WriteText("disagree.csv", "clip,clip_id,start,end,descriptor,value\nwalk54," +
+                                            std::to_string(digits) + ",0,1,x,1\n")});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("disagree.csv: line 2: clip_id " + std::to_string(digits) +
+                               " and clip_name 'walk54'"));
+  r = Remote({"labels", "export", "--clip", named});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("\n" + clip_id_ + ",1,2,by-name,1,frames\n"));
+  EXPECT_THAT(r.out, Not(HasSubstr(named + ",1,2,by-name")));
+}
+
+// `labels export` writes manual labels unless told otherwise: its file has no origin column,
+// so propagated labels exported with them would come back as manual ones.
+TEST_F(CliServerTest, LabelsExportManualLabelsByDefault) {
+  testing::CommandResult r = Remote({"label", "add", "walk54:0-9", "kick", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string source = nlohmann::json::parse(r.out)["label_id"].dump();
+  {
+    // A propagated label, as a propagation job would write it.
+    const absl::StatusOr<std::unique_ptr<storage::SqliteConnection>> db =
+        storage::SqliteConnection::Open((dir_ / "motiondb.sqlite").string(),
+                                        storage::SqliteConnection::Mode::kReadWrite, 5000);
+    ASSERT_TRUE(db.ok()) << db.status();
+    const absl::Status inserted = (*db)->Execute(
+        "INSERT INTO labels (clip_id, first_frame, last_frame, descriptor, value, origin, "
+        "source_label_id, score, created_unix_ms) VALUES (" +
+        clip_id_ + ", 20, 29, 'kick', 0.5, 'propagated', " + source + ", 0.9, 1)");
+    ASSERT_TRUE(inserted.ok()) << inserted;
+  }
+  r = Remote({"labels", "list", "--json"});
+  ASSERT_EQ(nlohmann::json::parse(r.out)["labels"].size(), 2u) << r.out;
+
+  r = Remote({"labels", "export"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "clip,start,end,descriptor,value,unit\nwalk54,0,9,kick,1,frames\n");
+  r = Remote({"labels", "export", "--origin", "propagated"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "clip,start,end,descriptor,value,unit\nwalk54,20,29,kick,0.5,frames\n");
 }
 
 TEST(CliAssimp, InspectsDebianTestModels) {

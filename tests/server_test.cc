@@ -14,9 +14,11 @@
 #include <gmock/gmock.h>
 #include <google/protobuf/descriptor.pb.h>
 #include <google/protobuf/unknown_field_set.h>
+#include <google/protobuf/util/json_util.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_cat.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
 #include "grpc/health/v1/health.grpc.pb.h"
@@ -36,6 +38,7 @@ namespace {
 
 namespace v1 = ::motiondb::v1;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::ServerProcess;
 
 // ---------------------------------------------------------------------------------------------
@@ -1003,6 +1006,7 @@ TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
   ASSERT_NE(server, nullptr);
   Client client(testing::InsecureChannel(server->address()));
   const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()));  // 61 frames, 30 fps
+  const int64_t turn = client.IngestOrFail("turn.bvh", BvhText(ChainClip(0.05)));
   const auto seconds = [&](double start, double end) {
     v1::NewLabel label = FrameLabel(walk, std::nullopt, std::nullopt, "x");
     label.set_start_s(start);
@@ -1013,6 +1017,10 @@ TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
   both.set_first_frame(0);
   v1::NewLabel named = FrameLabel(0, 0, 1, "x");
   named.set_clip_name("nowhere");
+  v1::NewLabel two_clips = FrameLabel(walk, 0, 1, "x");
+  two_clips.set_clip_name("turn");
+  v1::NewLabel id_and_unknown_name = FrameLabel(walk, 0, 1, "x");
+  id_and_unknown_name.set_clip_name("nowhere");
   const struct {
     v1::NewLabel bad;
     grpc::StatusCode code;
@@ -1023,6 +1031,13 @@ TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
       {named, grpc::StatusCode::NOT_FOUND, "labels[1].clip_name: no clip is named 'nowhere'"},
       {FrameLabel(0, 0, 1, "x"), grpc::StatusCode::INVALID_ARGUMENT,
        "labels[1]: give clip_id or clip_name"},
+      {two_clips, grpc::StatusCode::INVALID_ARGUMENT,
+       absl::StrCat("labels[1]: clip_id ", walk, " and clip_name 'turn' (clip ", turn,
+                    ") name different clips")},
+      {id_and_unknown_name, grpc::StatusCode::NOT_FOUND,
+       "labels[1].clip_name: no clip is named 'nowhere'"},
+      {FrameLabel(walk, 70, std::nullopt, "x"), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].first_frame: 70 is outside the clip's frames 0..60"},
       {FrameLabel(walk, 20, 10, "x"), grpc::StatusCode::INVALID_ARGUMENT,
        "labels[1].last_frame: 10 is before first_frame 20"},
       {FrameLabel(walk, 50, 61, "x"), grpc::StatusCode::INVALID_ARGUMENT,
@@ -1031,6 +1046,10 @@ TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
        "labels[1].first_frame: -1 is negative"},
       {seconds(1, 2.5), grpc::StatusCode::INVALID_ARGUMENT,
        "labels[1].end_s: 2.5 s is past the clip's last frame 60"},
+      {seconds(1, 62.0 / 30), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].end_s: 2.06667 s is past the clip's last frame 60"},
+      {seconds(61.0 / 30, 61.0 / 30), grpc::StatusCode::INVALID_ARGUMENT,
+       "labels[1].start_s: 2.03333 s is past the clip's last frame 60"},
       {seconds(-0.5, 1), grpc::StatusCode::INVALID_ARGUMENT, "labels[1].start_s: -0.5"},
       {seconds(NAN, 1), grpc::StatusCode::INVALID_ARGUMENT, "labels[1].start_s: nan"},
       {seconds(1.5, 1), grpc::StatusCode::INVALID_ARGUMENT,
@@ -1099,10 +1118,80 @@ TEST_F(ServerTest, BadLabelsGetTheirStatusCodesAndStoreNothing) {
   v1::GetClipLabelsRequest timeline_request;
   timeline_request.set_clip_id(999999);
   v1::GetClipLabelsResponse timeline;
-  EXPECT_EQ(client.labels()
-                .GetClipLabels(client.Context().get(), timeline_request, &timeline)
-                .error_code(),
-            grpc::StatusCode::NOT_FOUND);
+  const grpc::Status no_timeline =
+      client.labels().GetClipLabels(client.Context().get(), timeline_request, &timeline);
+  EXPECT_EQ(no_timeline.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(no_timeline.error_message(), "clip_id: clip 999999 not found");
+  list.Clear();
+  list.set_clip_id(999999);
+  const grpc::Status no_list = client.labels().ListLabels(client.Context().get(), list, &listed);
+  EXPECT_EQ(no_list.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(no_list.error_message(), "clip_id: clip 999999 not found");
+  remove.Clear();
+  remove.set_clip_id(999999);
+  const grpc::Status no_delete =
+      client.labels().DeleteLabels(client.Context().get(), remove, &removed);
+  EXPECT_EQ(no_delete.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(no_delete.error_message(), "clip_id: clip 999999 not found");
+  find.Clear();
+  find.set_descriptor_name("step");
+  for (int i = 0; i < 65; ++i) find.add_tags(absl::StrCat("tag", i));
+  const grpc::Status many_tags = client.labels().FindLabels(client.Context().get(), find, &found);
+  EXPECT_EQ(many_tags.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(many_tags.error_message(), HasSubstr("tags: at most 64"));
+}
+
+// Seconds ranges as tools write them, half-open, end at the clip's duration: the last frame.
+// A clip named by both id and name is taken when they agree.
+TEST_F(ServerTest, LabelRangesMayEndAtTheClipsDurationAndNameTheClipTwice) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()));  // 61 frames, 30 fps
+  v1::AddLabelsRequest add;
+  for (const double end : {61.0 / 30, 61.4 / 30, 60.6 / 30}) {
+    v1::NewLabel* label = add.add_labels();
+    label->set_clip_name("walk");
+    label->set_start_s(1);
+    label->set_end_s(end);
+    label->set_descriptor_name("step");
+  }
+  v1::NewLabel* twice = add.add_labels();
+  *twice = FrameLabel(walk, 3, 4, "both");
+  twice->set_clip_name("walk");
+  v1::AddLabelsResponse added;
+  const grpc::Status status = client.labels().AddLabels(client.Context().get(), add, &added);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(added.labels_size(), 4);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(added.labels(i).first_frame(), 30) << i;
+    EXPECT_EQ(added.labels(i).last_frame(), 60) << i;
+  }
+  EXPECT_EQ(added.labels(3).clip_id(), walk);
+  EXPECT_EQ(added.labels(3).first_frame(), 3);
+}
+
+// The descriptor is "descriptor" in JSON (descriptor_name only in the .proto), both ways.
+TEST(LabelJson, DescriptorIsCalledDescriptorInJson) {
+  v1::Label label;
+  label.set_label_id(7);
+  label.set_clip_name("walk");
+  label.set_descriptor_name("raise-right-hand");
+  label.set_value(0.5);
+  std::string json;
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(label, &json).ok());
+  EXPECT_THAT(json, HasSubstr("\"descriptor\":\"raise-right-hand\""));
+  EXPECT_THAT(json, Not(HasSubstr("descriptor_name")));
+  EXPECT_THAT(json, Not(HasSubstr("descriptorName")));
+  v1::Label back;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(json, &back).ok());
+  EXPECT_EQ(back.SerializeAsString(), label.SerializeAsString());
+  v1::NewLabel added;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(
+                  R"({"clipName": "walk", "descriptor": "kick", "endS": 2})", &added)
+                  .ok());
+  EXPECT_EQ(added.descriptor_name(), "kick");
+  EXPECT_EQ(added.end_s(), 2);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1325,6 +1325,72 @@ TEST_F(StorageTest, LabelsAreListedFoundAndTimelinedAndPagedOnce) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// FindLabels pages of one and of two across ties: labels of one value and clip told apart by
+// first frame, and of one first frame told apart by id, each visited once in order.
+TEST_F(StorageTest, FindLabelsPagesAcrossTies) {
+  const int64_t walk = Insert(Named("walk"), Motion(testing::ChainSkeleton(), 50, 1));
+  const int64_t kick = Insert(Named("kick"), Motion(testing::ChainSkeleton(), 30, 2));
+  const absl::StatusOr<std::vector<int64_t>> ids = Db().AddLabels({
+      Manual(walk, 20, 29, "step", 0.5),  // ids[0]
+      Manual(walk, 10, 19, "step", 0.5),  // ids[1]
+      Manual(walk, 10, 12, "step", 0.5),  // ids[2]: ids[1]'s first frame
+      Manual(kick, 0, 9, "step", 0.5),    // ids[3]
+      Manual(walk, 10, 30, "step", 0.5),  // ids[4]: ids[1]'s first frame again
+      Manual(walk, 0, 5, "step", 0.9),    // ids[5]
+  });
+  ASSERT_TRUE(ids.ok()) << ids.status();
+  const std::vector<int64_t> order = {(*ids)[5], (*ids)[1], (*ids)[2],
+                                      (*ids)[4], (*ids)[0], (*ids)[3]};
+  ASSERT_LT(walk, kick);
+  EXPECT_EQ(IdsOf(Db().FindLabels({}, {.descriptor = "step"})->labels), order);
+  for (const int size : {1, 2, 3, 4}) {
+    std::vector<int64_t> paged;
+    Page page = Sized(size);
+    do {
+      const absl::StatusOr<LabelPage> next = Db().FindLabels(page, {.descriptor = "step"});
+      ASSERT_TRUE(next.ok()) << next.status();
+      ASSERT_LE(next->labels.size(), static_cast<size_t>(size));
+      for (const LabelRecord& label : next->labels) paged.push_back(label.label_id);
+      page.page_token = next->next_page_token;
+    } while (!page.page_token.empty());
+    EXPECT_EQ(paged, order) << "pages of " << size;
+  }
+}
+
+// Tags of a query are a set of at most kMaxTags; a token's value is a label's, in [0, 1];
+// filters and timelines of an unknown clip are NOT_FOUND naming clip_id.
+TEST_F(StorageTest, LabelQueriesRefuseTooManyTagsForgedTokensAndUnknownClips) {
+  const int64_t walk = Insert(Named("walk", {"gait"}), Motion(testing::ChainSkeleton(), 50, 1));
+  ASSERT_TRUE(Db().AddLabels({Manual(walk, 0, 9, "step", 0.5)}).ok());
+
+  std::vector<std::string> tags(64, "gait");
+  EXPECT_EQ(Db().FindLabels({}, {.descriptor = "step", .tags = tags})->labels.size(), 1u);
+  tags.push_back("gait");
+  const absl::Status too_many = Db().FindLabels({}, {.descriptor = "step", .tags = tags}).status();
+  EXPECT_EQ(too_many.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(too_many.message()), HasSubstr("tags: at most 64"));
+  EXPECT_EQ(Db().FindLabels({}, {.descriptor = "step", .tags = {"gait", ""}}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+
+  for (const std::string token : {"f:nan:1:0:1", "f:inf:1:0:1", "f:-inf:1:0:1", "f:1.5:1:0:1",
+                                  "f:-0.5:1:0:1", "f:NaN:1:0:1"}) {
+    const absl::Status forged =
+        Db().FindLabels({.page_token = token}, {.descriptor = "step"}).status();
+    EXPECT_EQ(forged.code(), absl::StatusCode::kInvalidArgument) << token;
+    EXPECT_THAT(std::string(forged.message()), HasSubstr("malformed page_token")) << token;
+  }
+  EXPECT_TRUE(Db().FindLabels({.page_token = "f:1:1:0:0"}, {.descriptor = "step"}).ok());
+
+  const auto names_clip = [](const absl::Status& status) {
+    EXPECT_EQ(status.code(), absl::StatusCode::kNotFound);
+    EXPECT_EQ(status.message(), "clip_id: clip 4242 not found");
+  };
+  names_clip(Db().ListLabels({}, {.clip_id = 4242}).status());
+  names_clip(Db().DeleteLabels(LabelFilter{.clip_id = 4242}).status());
+  names_clip(Db().ClipLabels(4242).status());
+  EXPECT_EQ(CountsNow().labels, 1);
+}
+
 // Each bad label fails the whole batch with the item and field named, and nothing is stored.
 TEST_F(StorageTest, LabelBatchesAreAllOrNothing) {
   const int64_t walk = Insert(Named("walk"), Motion(testing::ChainSkeleton(), 50, 1));

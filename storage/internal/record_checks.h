@@ -20,8 +20,6 @@ namespace motiondb::storage {
 inline constexpr size_t kMaxNameBytes = 512;  // clip, source file and space names
 inline constexpr size_t kMaxTagBytes = 128;
 inline constexpr size_t kMaxTags = 64;  // a clip's
-inline constexpr int kDefaultPageSize = 100;
-inline constexpr int kMaxPageSize = 1000;
 
 // INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`), one longer than
 // `max_bytes`, or one holding a control character (NUL, the rest of C0, DEL, or C1 encoded as
