@@ -82,6 +82,7 @@ void AddIngest(Commands& commands);                        // ingest_command.cc
 void AddClipCommands(Commands& commands);                  // clip_commands.cc: clips, clip, export
 void AddSearch(Commands& commands);                        // search_command.cc
 void AddLabelCommands(Commands& commands);                 // label_commands.cc: label, labels
+void AddJobCommands(Commands& commands);                   // job_commands.cc: propagate, jobs, job
 void AddInfo(Commands& commands);                          // info_command.cc
 void AddBackup(Commands& commands);                        // backup_command.cc
 

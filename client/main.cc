@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   motiondb::cli::AddRemoteSpace(commands, space);
   motiondb::cli::AddSearch(commands);
   motiondb::cli::AddLabelCommands(commands);
+  motiondb::cli::AddJobCommands(commands);
   motiondb::cli::AddInfo(commands);
   motiondb::cli::AddBackup(commands);
   commands.AddHelp();

@@ -9,6 +9,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "storage/internal/database_impl.h"
+#include "storage/internal/record_rows.h"
 #include "storage/schema.h"
 #include "storage/sqlite_transaction.h"
 #include "util/status_macros.h"
@@ -51,6 +52,18 @@ absl::Status QuickCheck(SqliteConnection& connection) {
       "the file failed its integrity check (PRAGMA quick_check): ", absl::StrJoin(problems, "; ")));
 }
 
+// A job found queued or running at open was cut off: its process ended (stopped, crashed or
+// killed) without finishing it, since one process serves a file at a time. Its output, written
+// in the transaction that ends a job, is absent, so the job can simply be started again.
+absl::Status InterruptUnfinishedJobs(SqliteConnection& writer) {
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement update,
+      writer.Prepare("UPDATE jobs SET state = 'interrupted', finished_unix_ms = ?, error = "
+                     "'the server stopped before the job ended' WHERE state IN ('queued', "
+                     "'running')"));
+  return update.BindInt64(1, CreationTime(0)).Run();
+}
+
 // Everything Open does on the writer connection once the file is known to be SQLite.
 absl::Status PrepareFile(SqliteConnection& writer, const DatabaseOptions& options) {
   // Read-only checks first, so that a file this build must refuse is not modified.
@@ -69,7 +82,8 @@ absl::Status PrepareFile(SqliteConnection& writer, const DatabaseOptions& option
   if (foreign_keys != 1) {
     return absl::FailedPreconditionError("this SQLite build does not enforce foreign keys");
   }
-  return MigrateSchema(writer);
+  MOTIONDB_RETURN_IF_ERROR(MigrateSchema(writer));
+  return InterruptUnfinishedJobs(writer);
 }
 
 // The writer connection of a file, checked and prepared; errors do not name the file.

@@ -31,6 +31,7 @@
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
 #include "core/space/motion_space.h"
+#include "storage/job_record.h"
 #include "storage/label_record.h"
 
 namespace motiondb::storage {
@@ -235,6 +236,31 @@ class Database {
   // it took. INVALID_ARGUMENT for an empty filter: deleting every label is not a slip to allow;
   // NOT_FOUND naming clip_id when the filter's clip is unknown.
   absl::StatusOr<int64_t> DeleteLabels(const LabelFilter& filter, const WriteOptions& write = {});
+
+  // The descriptors that manual labels carry, sorted.
+  absl::StatusOr<std::vector<std::string>> ManualDescriptors();
+
+  // Jobs (storage/job_record.h). Open() marks every job it finds queued or running
+  // `interrupted`: a database file is served by one process at a time, so such a job has nobody
+  // left to run it (its process stopped or died first).
+  //
+  // Stores a new job (its id and creation time assigned) and returns it as stored.
+  // INVALID_ARGUMENT for a kind other than "propagation" or a final state.
+  absl::StatusOr<JobRecord> CreateJob(const JobRecord& job, const WriteOptions& write = {});
+  // Writes the job's state, progress, counts, error and times. NOT_FOUND for an unknown job.
+  absl::Status UpdateJob(const JobRecord& job, const WriteOptions& write = {});
+  absl::StatusOr<JobRecord> GetJob(const std::string& job_id);  // NOT_FOUND
+  // Newest first; Page as ListClips takes it (its token is the last job's number).
+  absl::StatusOr<JobPage> ListJobs(const Page& page);
+  // A propagation job's output and its final row, in one transaction: the propagated labels of
+  // output.descriptors found in output.space_id are deleted, output.labels inserted (those whose
+  // clip or source label was deleted meanwhile are left out), and output.job written with
+  // labels_written set to the number inserted, which is returned. A crash leaves the old labels
+  // and the job unfinished, or the new ones and the job done. INVALID_ARGUMENT naming
+  // labels[i] for a label AddLabels would refuse or that is not propagated by this job from this
+  // space with one of the descriptors; NOT_FOUND for an unknown job.
+  absl::StatusOr<int64_t> FinishPropagation(const PropagationOutput& output,
+                                            const WriteOptions& write = {});
 
   // Every skeleton, in id order, with its clip count and first clip, in one query.
   absl::StatusOr<std::vector<SkeletonSummary>> ListSkeletons();

@@ -110,6 +110,31 @@ ALTER TABLE clips ADD COLUMN content_hash TEXT NOT NULL DEFAULT '';
 CREATE INDEX clips_by_content_hash ON clips (content_hash);
 )sql";
 
+// Background jobs (SPEC 7): a propagation job's row, its state, progress and counts, and its
+// parameters as JSON text (the job's starter decides what they hold). The number is the
+// AUTOINCREMENT key, so that a job id ("job-N") is never handed to a second job: labels keep
+// the id of the job that wrote them.
+constexpr const char* kMigration3 = R"sql(
+CREATE TABLE jobs (
+  job_number INTEGER PRIMARY KEY AUTOINCREMENT,
+  kind TEXT NOT NULL CHECK (kind IN ('propagation')),
+  state TEXT NOT NULL CHECK (state IN ('queued', 'running', 'succeeded', 'failed', 'cancelled',
+                                       'interrupted')),
+  parameters TEXT NOT NULL,
+  done INTEGER NOT NULL DEFAULT 0 CHECK (done >= 0),
+  total INTEGER NOT NULL DEFAULT 0 CHECK (total >= 0),
+  queries INTEGER NOT NULL DEFAULT 0,
+  queries_skipped INTEGER NOT NULL DEFAULT 0,
+  labels_written INTEGER NOT NULL DEFAULT 0,
+  error TEXT NOT NULL DEFAULT '',
+  created_unix_ms INTEGER NOT NULL,
+  started_unix_ms INTEGER NOT NULL DEFAULT 0,
+  finished_unix_ms INTEGER NOT NULL DEFAULT 0
+);
+-- Open() finds the jobs a dead process left unfinished through this index.
+CREATE INDEX jobs_by_state ON jobs (state);
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -153,6 +178,7 @@ struct Migration {
 constexpr std::array kMigrations = {
     Migration{kMigration1, nullptr},
     Migration{kMigration2, BackfillContentHashes},
+    Migration{kMigration3, nullptr},
 };
 
 }  // namespace

@@ -147,8 +147,9 @@ TEST_F(CliTest, UnknownCommandAndHelp) {
   EXPECT_EQ(RunCli({}).exit_code, 2);
   const testing::CommandResult help = RunCli({"help"});
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* command : {"inspect", "convert", "project", "ingest", "clips", "clip", "export",
-                              "space", "search", "label", "labels", "info", "help"}) {
+  for (const char* command :
+       {"inspect", "convert", "project", "ingest", "clips", "clip", "export", "space", "search",
+        "label", "labels", "propagate", "jobs", "job", "info", "help"}) {
     EXPECT_THAT(help.out, HasSubstr(std::string("\n  ") + command + " ")) << command;
   }
   EXPECT_EQ(RunCli({"--help"}).out, help.out);
@@ -619,6 +620,67 @@ TEST_F(CliServerTest, SpaceListAndShowCountTheClipsIngestedSinceTheBuild) {
 
 // Labels on the fixture's clip (54 frames at 30 fps): added by id or name, in frames or seconds;
 // listed, found, deleted; the server's complaints told in the command's words.
+// A propagation on the fixture's clip: started and waited for, listed, shown, and the errors of
+// each job command in its own words.
+TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
+  testing::CommandResult r = Remote({"propagate", "--space", "body", "--wait"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("FAILED_PRECONDITION"));
+  EXPECT_THAT(r.err, HasSubstr("no manual label"));
+  ASSERT_EQ(Remote({"label", "add", "walk54:0-20", "step"}).exit_code, 0);
+  ASSERT_EQ(Remote({"label", "add", "walk54:30-50", "turn", "--value", "0.5"}).exit_code, 0);
+
+  r = Remote({"propagate", "--space", "body", "--descriptor", "step", "--max-results", "3",
+              "--wait", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json job = nlohmann::json::parse(r.out);
+  EXPECT_EQ(job["state"], "succeeded");
+  EXPECT_EQ(job["descriptors"], nlohmann::json::array({"step"}));
+  EXPECT_EQ(job["total"], 1);
+  EXPECT_EQ(job["done"], 1);
+  EXPECT_EQ(job["parameters"]["max_results"], 3);
+  const std::string id = job["job_id"];
+  r = Remote({"propagate", "--space", "body", "--wait"});  // every manual descriptor
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(" succeeded: step, turn in space body, 2/2 labels searched"));
+
+  r = Remote({"jobs", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json jobs = nlohmann::json::parse(r.out)["jobs"];
+  ASSERT_EQ(jobs.size(), 2u);
+  EXPECT_EQ(jobs[1]["job_id"], id);
+  r = Remote({"jobs"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("JOB"));
+  EXPECT_THAT(r.out, HasSubstr(id + " "));
+  r = Remote({"job", "show", id, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["state"], "succeeded");
+  r = Remote({"job", "watch", id});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(id + " succeeded"));
+
+  for (const auto& [args, error] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"job", "cancel", id}, "FAILED_PRECONDITION: " + id + " has already ended"},
+           {{"job", "show", "job-999"}, "NOT_FOUND"},
+           {{"job", "watch", "job-999"}, "NOT_FOUND"},
+           {{"propagate", "--space", "nosuch", "--descriptor", "step"}, "NOT_FOUND"},
+           {{"propagate", "--space", "body", "--descriptor", ""}, "--descriptor ''"}}) {
+    r = Remote(args);
+    EXPECT_EQ(r.exit_code, 1) << args[0] << " " << args[1];
+    EXPECT_THAT(r.err, HasSubstr(error)) << args[0] << " " << args[1];
+  }
+  EXPECT_EQ(Remote({"propagate", "--wait"}).exit_code, 2);  // --space is required
+  for (const std::vector<std::string>& help :
+       std::vector<std::vector<std::string>>{{"propagate", "--help"},
+                                             {"jobs", "--help"},
+                                             {"job", "show", "--help"},
+                                             {"job", "watch", "--help"},
+                                             {"job", "cancel", "--help"}}) {
+    EXPECT_EQ(RunCli(help).exit_code, 0) << help[0];
+  }
+}
+
 TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
   testing::CommandResult r =
       Remote({"label", "add", "walk54:10-20", "step", "--value", "0.8", "--json"});

@@ -23,6 +23,7 @@
 #include "core/bvh/bvh_writer.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/job_service.grpc.pb.h"
 #include "motiondb/v1/label_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
@@ -91,7 +92,8 @@ class Client {
         spaces_(v1::SpaceService::NewStub(channel_)),
         search_(v1::SearchService::NewStub(channel_)),
         server_(v1::ServerService::NewStub(channel_)),
-        labels_(v1::LabelService::NewStub(channel_)) {}
+        labels_(v1::LabelService::NewStub(channel_)),
+        jobs_(v1::JobService::NewStub(channel_)) {}
 
   // A call context carrying the token and a deadline (generous by default: a test that hangs
   // should fail, not stall the suite).
@@ -133,6 +135,7 @@ class Client {
   v1::SearchService::Stub& search() { return *search_; }
   v1::ServerService::Stub& server() { return *server_; }
   v1::LabelService::Stub& labels() { return *labels_; }
+  v1::JobService::Stub& jobs() { return *jobs_; }
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
 
  private:
@@ -143,6 +146,7 @@ class Client {
   std::unique_ptr<v1::SearchService::Stub> search_;
   std::unique_ptr<v1::ServerService::Stub> server_;
   std::unique_ptr<v1::LabelService::Stub> labels_;
+  std::unique_ptr<v1::JobService::Stub> jobs_;
 };
 
 // A stored range as the query. These tests check that a search finds its own query first,
@@ -1561,7 +1565,8 @@ TEST_F(ServerTest, ReflectionListsAndDescribesTheServices) {
   EXPECT_THAT(names,
               ::testing::IsSupersetOf({"motiondb.v1.ClipService", "motiondb.v1.SpaceService",
                                        "motiondb.v1.SearchService", "motiondb.v1.ServerService",
-                                       "motiondb.v1.LabelService", "grpc.health.v1.Health"}));
+                                       "motiondb.v1.LabelService", "motiondb.v1.JobService",
+                                       "grpc.health.v1.Health"}));
   // file_containing_symbol (4) -> file_descriptor_response (4) -> file_descriptor_proto (1).
   for (const auto& [symbol, file] : std::vector<std::pair<std::string, std::string>>{
            {"grpc.health.v1.Health", "grpc/health/v1/health.proto"},
@@ -2151,6 +2156,366 @@ TEST_F(ServerTest, KillDuringIngestLosesNoAcknowledgedClipAndLeavesNoHalfClip) {
     ASSERT_TRUE(client.Search(ClipQuery("body", any_id, 0, 40), &found).ok());
     EXPECT_EQ(found.counts().library_frames(), space.index().frames());
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Propagation jobs.
+
+// Adds `labels` (manual); returns them as stored.
+std::vector<v1::Label> AddLabelsOrFail(Client& client, const std::vector<v1::NewLabel>& labels) {
+  v1::AddLabelsRequest add;
+  for (const v1::NewLabel& label : labels) *add.add_labels() = label;
+  v1::AddLabelsResponse added;
+  const grpc::Status status = client.labels().AddLabels(client.Context().get(), add, &added);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  return {added.labels().begin(), added.labels().end()};
+}
+
+v1::StartPropagationRequest Propagation(const std::vector<std::string>& descriptors,
+                                        int max_results = 8) {
+  v1::StartPropagationRequest request;
+  request.set_space("body");
+  for (const std::string& descriptor : descriptors) request.add_descriptor_names(descriptor);
+  request.mutable_search()->set_max_results(max_results);
+  return request;
+}
+
+// The job as started; an empty job after a failed expectation.
+v1::Job StartOrFail(Client& client, const v1::StartPropagationRequest& request) {
+  v1::Job job;
+  const grpc::Status status = client.jobs().StartPropagation(client.Context().get(), request, &job);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(job.state(), v1::JOB_STATE_QUEUED);
+  return job;
+}
+
+bool Ended(const v1::Job& job) {
+  return job.state() != v1::JOB_STATE_QUEUED && job.state() != v1::JOB_STATE_RUNNING;
+}
+
+// Polls the job until `done(job)` (the job then) or 120 s (a failed expectation).
+v1::Job PollJob(Client& client, const std::string& job_id,
+                const std::function<bool(const v1::Job&)>& done = Ended) {
+  v1::GetJobRequest get;
+  get.set_job_id(job_id);
+  v1::Job job;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < give_up) {
+    const grpc::Status status = client.jobs().GetJob(client.Context().get(), get, &job);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    if (!status.ok() || done(job)) return job;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ADD_FAILURE() << job_id << " never got there: " << job.ShortDebugString();
+  return job;
+}
+
+// Every propagated label, in id order.
+std::vector<v1::Label> Propagated(Client& client) {
+  v1::ListLabelsRequest list;
+  list.set_origin(v1::LABEL_ORIGIN_PROPAGATED);
+  list.set_page_size(1000);
+  std::vector<v1::Label> labels;
+  v1::ListLabelsResponse page;
+  do {
+    const grpc::Status status = client.labels().ListLabels(client.Context().get(), list, &page);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    if (!status.ok()) break;
+    labels.insert(labels.end(), page.labels().begin(), page.labels().end());
+    list.set_page_token(page.next_page_token());
+  } while (!list.page_token().empty());
+  return labels;
+}
+
+bool Overlap(int64_t first, int64_t last, const SyntheticSegment& segment) {
+  return first <= segment.last_frame && last >= segment.first_frame;
+}
+
+TEST_F(ServerTest, PropagationLabelsSimilarRangesAndReRunsReplaceItsOutput) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  // Two right-arm raises labelled by hand, and a shrug.
+  std::vector<const SyntheticSegment*> raises, shrugs;
+  for (const SyntheticSegment& segment : Humanoid().segments) {
+    (segment.action == SyntheticAction::kRightArmRaise ? raises : shrugs).push_back(&segment);
+  }
+  ASSERT_GE(raises.size(), 4u);
+  std::vector<v1::NewLabel> given;
+  for (const SyntheticSegment* raise : {raises[0], raises[1]}) {
+    given.push_back(
+        FrameLabel(ids[raise->clip], raise->first_frame, raise->last_frame, "raise-right", 1.0));
+  }
+  given.push_back(FrameLabel(ids[Humanoid().segments.back().clip],
+                             Humanoid().segments.back().first_frame,
+                             Humanoid().segments.back().last_frame, "other", 0.5));
+  const std::vector<v1::Label> manual = AddLabelsOrFail(client, given);
+  ASSERT_EQ(manual.size(), 3u);
+
+  // Watched to its end: the first message is the job as it was, the last its end.
+  const v1::Job started = StartOrFail(client, Propagation({"raise-right"}));
+  EXPECT_THAT(started.job_id(), ::testing::StartsWith("job-"));
+  EXPECT_EQ(started.space(), "body");
+  EXPECT_THAT(started.descriptor_names(), ::testing::ElementsAre("raise-right"));
+  v1::WatchJobRequest watch;
+  watch.set_job_id(started.job_id());
+  auto context = client.Context();
+  auto reader = client.jobs().WatchJob(context.get(), watch);
+  std::vector<v1::Job> seen;
+  for (v1::Job job; reader->Read(&job);) seen.push_back(job);
+  ASSERT_TRUE(reader->Finish().ok());
+  ASSERT_GE(seen.size(), 2u);
+  const v1::Job& ended = seen.back();
+  ASSERT_EQ(ended.state(), v1::JOB_STATE_SUCCEEDED) << ended.error();
+  for (size_t i = 0; i + 1 < seen.size(); ++i) EXPECT_FALSE(Ended(seen[i]));
+  EXPECT_EQ(ended.total(), 2);
+  EXPECT_EQ(ended.done(), 2);
+  EXPECT_EQ(ended.queries(), 2);
+  EXPECT_GT(ended.labels_written(), 0);
+  EXPECT_GT(ended.finished_unix_ms(), 0);
+
+  // Found: propagated ranges with their source, job, space and score, values in (0, 1], no two
+  // overlapping by more than half, on other raises too, and none of the "other" descriptor.
+  v1::FindLabelsRequest find;
+  find.set_descriptor_name("raise-right");
+  find.set_page_size(1000);
+  v1::FindLabelsResponse found;
+  ASSERT_TRUE(client.labels().FindLabels(client.Context().get(), find, &found).ok());
+  std::vector<v1::Label> propagated;
+  for (const v1::Label& label : found.labels()) {
+    if (label.origin() == v1::LABEL_ORIGIN_PROPAGATED) propagated.push_back(label);
+  }
+  EXPECT_EQ(static_cast<int64_t>(propagated.size()), ended.labels_written());
+  EXPECT_EQ(Propagated(client).size(), propagated.size());
+  int on_other_raises = 0;
+  for (const v1::Label& label : propagated) {
+    EXPECT_GT(label.value(), 0);
+    EXPECT_LE(label.value(), 1);
+    EXPECT_EQ(label.job_id(), started.job_id());
+    EXPECT_EQ(label.space(), "body");
+    EXPECT_THAT(label.source_label_id(),
+                ::testing::AnyOf(manual[0].label_id(), manual[1].label_id()));
+    EXPECT_GE(label.score(), 0);
+    for (size_t r = 2; r < raises.size(); ++r) {
+      if (ids[raises[r]->clip] == label.clip_id() &&
+          Overlap(label.first_frame(), label.last_frame(), *raises[r])) {
+        ++on_other_raises;
+        break;
+      }
+    }
+    for (const v1::Label& other : propagated) {
+      if (other.label_id() == label.label_id() || other.clip_id() != label.clip_id()) continue;
+      const int64_t shared = std::min(label.last_frame(), other.last_frame()) -
+                             std::max(label.first_frame(), other.first_frame()) + 1;
+      EXPECT_LE(2 * shared, std::max(label.last_frame() - label.first_frame() + 1,
+                                     other.last_frame() - other.first_frame() + 1));
+    }
+  }
+  EXPECT_GE(on_other_raises, 2);
+  // Strongest first: the best propagated label is the closest (the factor falls with score).
+  EXPECT_LE(propagated.front().score(), propagated.back().score());
+
+  // A re-run replaces the output: the same labels, of the new job; the manual ones unchanged.
+  const v1::Job again = PollJob(client, StartOrFail(client, Propagation({"raise-right"})).job_id());
+  ASSERT_EQ(again.state(), v1::JOB_STATE_SUCCEEDED) << again.error();
+  EXPECT_EQ(again.labels_written(), ended.labels_written());
+  const std::vector<v1::Label> replaced = Propagated(client);
+  ASSERT_EQ(replaced.size(), propagated.size());
+  for (const v1::Label& label : replaced) EXPECT_EQ(label.job_id(), again.job_id());
+  v1::ListLabelsRequest list;
+  list.set_origin(v1::LABEL_ORIGIN_MANUAL);
+  v1::ListLabelsResponse kept;
+  ASSERT_TRUE(client.labels().ListLabels(client.Context().get(), list, &kept).ok());
+  ASSERT_EQ(kept.labels_size(), 3);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(kept.labels(i).ShortDebugString(), manual[i].ShortDebugString());
+
+  // Listed newest first; a finished job cannot be cancelled.
+  v1::ListJobsRequest jobs_request;
+  v1::ListJobsResponse jobs;
+  ASSERT_TRUE(client.jobs().ListJobs(client.Context().get(), jobs_request, &jobs).ok());
+  ASSERT_EQ(jobs.jobs_size(), 2);
+  EXPECT_EQ(jobs.jobs(0).job_id(), again.job_id());
+  EXPECT_EQ(jobs.jobs(1).job_id(), started.job_id());
+  v1::CancelJobRequest cancel;
+  cancel.set_job_id(started.job_id());
+  v1::Job cancelled;
+  const grpc::Status refused = client.jobs().CancelJob(client.Context().get(), cancel, &cancelled);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(refused.error_message(), HasSubstr("succeeded"));
+  EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.JobService/StartPropagation OK "));
+}
+
+TEST_F(ServerTest, BadPropagationsGetTheirStatusCodes) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()));
+  v1::CreateSpaceRequest create;
+  create.set_name("body");
+  v1::Space space;
+  ASSERT_TRUE(client.CreateSpace(create, &space).ok());
+
+  const auto start = [&](const v1::StartPropagationRequest& request) {
+    v1::Job job;
+    return client.jobs().StartPropagation(client.Context().get(), request, &job);
+  };
+  // No descriptors given and no manual label: there is nothing to propagate (refused, rather
+  // than a job that does nothing).
+  grpc::Status status = start(Propagation({}));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(status.error_message(), HasSubstr("no manual label"));
+  v1::StartPropagationRequest request = Propagation({"step"});
+  request.set_space("nowhere");
+  EXPECT_EQ(start(request).error_code(), grpc::StatusCode::NOT_FOUND);
+  request = Propagation({"step", ""});
+  status = start(request);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("descriptors[1]"));
+  request = Propagation({"step"});
+  request.mutable_search()->set_max_results(0);
+  status = start(request);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("max_results"));
+  request = Propagation({"step"});
+  request.mutable_search()->mutable_clip()->set_clip_id(walk);
+  status = start(request);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("search.query"));
+
+  // Unknown jobs.
+  for (const std::string id : {"job-42", "nonsense"}) {
+    v1::GetJobRequest get;
+    get.set_job_id(id);
+    v1::Job job;
+    EXPECT_EQ(client.jobs().GetJob(client.Context().get(), get, &job).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+    v1::CancelJobRequest cancel;
+    cancel.set_job_id(id);
+    EXPECT_EQ(client.jobs().CancelJob(client.Context().get(), cancel, &job).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+    v1::WatchJobRequest watch;
+    watch.set_job_id(id);
+    auto context = client.Context();
+    auto reader = client.jobs().WatchJob(context.get(), watch);
+    EXPECT_FALSE(reader->Read(&job));
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::NOT_FOUND);
+  }
+  // Given descriptors without manual labels: a job that finds nothing and writes nothing.
+  const v1::Job job = PollJob(client, StartOrFail(client, Propagation({"step"})).job_id());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error();
+  EXPECT_EQ(job.total(), 0);
+  EXPECT_EQ(job.labels_written(), 0);
+  v1::ListJobsRequest list;
+  list.set_page_size(-1);
+  v1::ListJobsResponse jobs;
+  EXPECT_EQ(client.jobs().ListJobs(client.Context().get(), list, &jobs).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+// Many manual labels of "long" over the humanoid library, so that a job runs for a while.
+std::vector<v1::Label> LabelManyRanges(Client& client, const std::vector<int64_t>& ids, int count) {
+  std::vector<v1::NewLabel> given;
+  for (int i = 0; i < count; ++i) {
+    const size_t clip = i % ids.size();
+    const int frames = Humanoid().clips[clip].frame_count();
+    const int first = (i / static_cast<int>(ids.size()) * 37) % (frames - 80);
+    given.push_back(FrameLabel(ids[clip], first, first + 60, "long", 1.0));
+  }
+  return AddLabelsOrFail(client, given);
+}
+
+bool Running(const v1::Job& job) {
+  return Ended(job) || (job.state() == v1::JOB_STATE_RUNNING && job.done() >= 1);
+}
+
+TEST_F(ServerTest, RunningJobsRefuseOverlapsAreCancelledAndWatchedOutsideTheCallGate) {
+  // One call at a time: a watch that held its place would block every other call.
+  ServerProcess* server = StartServer({"--threads", "1"});
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  LabelManyRanges(client, ids, 400);
+  AddLabelsOrFail(client, {FrameLabel(ids[0], 0, 50, "calm", 1.0)});
+  v1::StartPropagationRequest request = Propagation({"long", "calm"});
+  request.mutable_search()->set_exact(true);  // slower queries: a longer job
+  const v1::Job started = StartOrFail(client, request);
+
+  std::vector<v1::Job> watched;
+  grpc::Status watch_status;
+  std::thread watcher([&] {
+    v1::WatchJobRequest watch;
+    watch.set_job_id(started.job_id());
+    auto context = client.Context(std::chrono::milliseconds(120000));
+    auto reader = client.jobs().WatchJob(context.get(), watch);
+    for (v1::Job job; reader->Read(&job);) watched.push_back(job);
+    watch_status = reader->Finish();
+  });
+  const v1::Job running = PollJob(client, started.job_id(), Running);
+  ASSERT_EQ(running.state(), v1::JOB_STATE_RUNNING);
+
+  // A second job for one of its descriptors is refused, naming it; another descriptor runs.
+  v1::Job second;
+  const grpc::Status refused =
+      client.jobs().StartPropagation(client.Context().get(), Propagation({"calm"}), &second);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(refused.error_message(), HasSubstr(started.job_id()));
+
+  v1::CancelJobRequest cancel;
+  cancel.set_job_id(started.job_id());
+  v1::Job cancelled;
+  const grpc::Status status = client.jobs().CancelJob(client.Context().get(), cancel, &cancelled);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(cancelled.state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_LT(cancelled.done(), cancelled.total());
+  watcher.join();
+  EXPECT_TRUE(watch_status.ok()) << watch_status.error_message();
+  ASSERT_FALSE(watched.empty());
+  EXPECT_EQ(watched.back().state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_TRUE(Propagated(client).empty());
+  // Once it ended, the descriptor is free again.
+  EXPECT_EQ(PollJob(client, StartOrFail(client, Propagation({"calm"})).job_id()).state(),
+            v1::JOB_STATE_SUCCEEDED);
+}
+
+TEST_F(ServerTest, KillDuringAJobLeavesItInterruptedWithoutOutputAndItRunsAgain) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  std::string job_id;
+  int64_t earlier = 0;  // labels of the first, complete run
+  {
+    Client client(testing::InsecureChannel(server->address()));
+    const std::vector<int64_t> ids = IngestHumanoid(client);
+    CreateHumanoidSpace(client);
+    LabelManyRanges(client, ids, 400);
+    const v1::Job first = PollJob(client, StartOrFail(client, Propagation({"long"})).job_id());
+    ASSERT_EQ(first.state(), v1::JOB_STATE_SUCCEEDED) << first.error();
+    earlier = first.labels_written();
+    ASSERT_GT(earlier, 0);
+    job_id = StartOrFail(client, Propagation({"long"})).job_id();
+    ASSERT_EQ(PollJob(client, job_id, Running).state(), v1::JOB_STATE_RUNNING);
+  }
+  EXPECT_EQ(server->Stop(SIGKILL), 128 + SIGKILL);
+
+  server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  v1::GetJobRequest get;
+  get.set_job_id(job_id);
+  v1::Job job;
+  ASSERT_TRUE(client.jobs().GetJob(client.Context().get(), get, &job).ok());
+  EXPECT_EQ(job.state(), v1::JOB_STATE_INTERRUPTED);
+  EXPECT_THAT(job.error(), HasSubstr("stopped"));
+  // The first run's output, whole; nothing of the cut-off run.
+  const std::vector<v1::Label> labels = Propagated(client);
+  EXPECT_EQ(static_cast<int64_t>(labels.size()), earlier);
+  for (const v1::Label& label : labels) EXPECT_NE(label.job_id(), job_id);
+  const v1::Job again = PollJob(client, StartOrFail(client, Propagation({"long"})).job_id());
+  EXPECT_EQ(again.state(), v1::JOB_STATE_SUCCEEDED) << again.error();
+  EXPECT_EQ(again.labels_written(), earlier);
 }
 
 }  // namespace

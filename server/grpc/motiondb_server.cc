@@ -11,12 +11,14 @@
 #include "server/grpc/call_gate.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
+#include "server/grpc/job_service.h"
 #include "server/grpc/label_service.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/search_service.h"
 #include "server/grpc/server_info_service.h"
 #include "server/grpc/space_service.h"
 #include "server/index_registry.h"
+#include "server/job_runner.h"
 #include "server/search_runner.h"
 #include "storage/database.h"
 #include "util/status_macros.h"
@@ -32,6 +34,7 @@ struct MotionDbServer::State {
   IndexRegistry registry;
   std::unique_ptr<Catalog> catalog;
   std::unique_ptr<SearchRunner> runner;
+  std::unique_ptr<JobRunner> jobs;  // its worker uses the runner, the registry and the database
   std::unique_ptr<CallGate> gate;
   std::unique_ptr<UploadBudget> uploads;
   std::unique_ptr<StreamWatchdog> watchdog;
@@ -39,6 +42,7 @@ struct MotionDbServer::State {
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
   std::unique_ptr<LabelServiceImpl> labels;
+  std::unique_ptr<JobServiceImpl> job_service;
   std::unique_ptr<ServerInfoServiceImpl> info;
   std::unique_ptr<grpc::Server> server;
 };
@@ -78,6 +82,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
           .count()));
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
+  s.jobs = std::make_unique<JobRunner>(*s.database, s.registry, *s.runner);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.watchdog =
@@ -87,6 +92,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
   s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
+  s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<grpc::ServerCredentials> credentials,
@@ -105,6 +111,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.spaces.get());
   builder.RegisterService(s.search.get());
   builder.RegisterService(s.labels.get());
+  builder.RegisterService(s.job_service.get());
   builder.RegisterService(s.info.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   if (options.log_requests) {
@@ -132,6 +139,8 @@ void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
   if (grpc::HealthCheckServiceInterface* health = state_->server->GetHealthCheckService()) {
     health->SetServingStatus(false);
   }
+  // Jobs end first, as interrupted, so that their watchers see the end before the calls close.
+  state_->jobs->Stop();
   state_->server->Shutdown(deadline);
 }
 

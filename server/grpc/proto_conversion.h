@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
+#include "motiondb/v1/job_service.pb.h"
 #include "motiondb/v1/label_service.pb.h"
 #include "motiondb/v1/search_service.pb.h"
 #include "motiondb/v1/server_service.pb.h"
@@ -16,6 +17,7 @@
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/label_catalog.h"
+#include "server/propagation.h"
 #include "server/search_runner.h"
 #include "server/space_builder.h"
 #include "server/space_curve.h"
@@ -37,6 +39,8 @@ std::vector<NewLabel> FromProto(const v1::AddLabelsRequest& request);
 absl::StatusOr<storage::LabelFilter> FromProto(const v1::ListLabelsRequest& request);
 absl::StatusOr<LabelDeletion> FromProto(const v1::DeleteLabelsRequest& request);
 storage::LabelQuery FromProto(const v1::FindLabelsRequest& request);
+// INVALID_ARGUMENT naming search.FIELD for a search field the job sets itself.
+absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& request);
 
 // Results.
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
@@ -56,6 +60,9 @@ void ToProto(const storage::LabelRecord& record, v1::Label* label);
 void ToProto(const storage::LabelPage& page, v1::ListLabelsResponse* response);
 void ToProto(const storage::LabelPage& page, v1::FindLabelsResponse* response);
 void ToProto(const ClipTimeline& timeline, v1::GetClipLabelsResponse* response);
+// The space and descriptors read from the job's parameters.
+void ToProto(const storage::JobRecord& record, v1::Job* job);
+void ToProto(const storage::JobPage& page, v1::ListJobsResponse* response);
 
 }  // namespace motiondb::server
 

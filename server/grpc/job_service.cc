@@ -1,0 +1,85 @@
+#include "server/grpc/job_service.h"
+
+#include <chrono>
+
+#include "server/grpc/proto_conversion.h"
+#include "server/grpc/status_conversion.h"
+
+namespace motiondb::server {
+namespace {
+
+// How long a watch waits for a change before it looks whether its call is still there: gRPC
+// does not wake a handler when its client goes.
+constexpr std::chrono::milliseconds kWatchPoll{200};
+
+// The call's answer: `job` in `response`, or its status.
+grpc::Status Reply(const absl::StatusOr<storage::JobRecord>& job, v1::Job* response) {
+  if (!job.ok()) return ToGrpcStatus(job.status());
+  ToProto(*job, response);
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status JobServiceImpl::StartPropagation(grpc::ServerContext* context,
+                                              const v1::StartPropagationRequest* request,
+                                              v1::Job* response) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    absl::StatusOr<PropagationRequest> propagation = FromProto(*request);
+    if (!propagation.ok()) return ToGrpcStatus(propagation.status());
+    return Reply(jobs_.StartPropagation(*std::move(propagation)), response);
+  });
+}
+
+grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
+                                    v1::Job* response) {
+  return gate_.Run(context, [&] { return Reply(jobs_.Get(request->job_id()), response); });
+}
+
+grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context,
+                                      const v1::ListJobsRequest* request,
+                                      v1::ListJobsResponse* response) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<storage::JobPage> page =
+        jobs_.List({request->page_size(), request->page_token()});
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    ToProto(*page, response);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
+                                       const v1::CancelJobRequest* request, v1::Job* response) {
+  return gate_.Run(context, [&] { return Reply(jobs_.Cancel(request->job_id()), response); });
+}
+
+grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context,
+                                      const v1::WatchJobRequest* request,
+                                      grpc::ServerWriter<v1::Job>* writer) {
+  absl::StatusOr<storage::JobRecord> job;
+  const grpc::Status admitted = gate_.Run(context, [&]() -> grpc::Status {
+    job = jobs_.Get(request->job_id());
+    return job.ok() ? grpc::Status::OK : ToGrpcStatus(job.status());
+  });
+  if (!admitted.ok()) return admitted;
+  v1::Job message;
+  ToProto(*job, &message);
+  if (!writer->Write(message)) return grpc::Status(grpc::StatusCode::CANCELLED, "the client left");
+  while (!storage::IsFinal(job->state)) {
+    if (context->IsCancelled()) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "the watch was cancelled");
+    }
+    const storage::JobRecord seen = *job;
+    job = jobs_.WaitForChange(request->job_id(), seen, kWatchPoll);
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    if (SameProgress(*job, seen)) continue;  // the wait timed out
+    message.Clear();
+    ToProto(*job, &message);
+    if (!writer->Write(message)) {
+      return grpc::Status(grpc::StatusCode::CANCELLED, "the client left");
+    }
+  }
+  return grpc::Status::OK;
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,104 @@
+// Background jobs (SPEC §7): propagation jobs queued and run one at a time on one worker
+// thread, their rows kept in the database (storage/job_record.h) and their live progress here.
+//
+// The worker runs at a lower CPU priority than the threads serving calls: it raises its own
+// nice value by kWorkerNiceIncrement (Linux keeps a nice value per thread, and threads a search
+// starts inherit it), so that while a job runs, interactive searches get the cores first and
+// the job takes what is left. Cancellation and shutdown are checked between queries and inside
+// each search. A job's output and its final row are written in one transaction at its end
+// (storage::Database::FinishPropagation): a job cut off by a stop or a crash leaves nothing
+// half-written and becomes `interrupted` (at Stop(), or at the next open after a crash).
+//
+// A descriptor is propagated by one job at a time: a job whose descriptors overlap those of a
+// queued or running one is refused (FAILED_PRECONDITION naming that job) rather than queued
+// behind it, since both would replace the same output.
+//
+// Thread-safe.
+#ifndef MOTIONDB_SERVER_JOB_RUNNER_H_
+#define MOTIONDB_SERVER_JOB_RUNNER_H_
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "server/index_registry.h"
+#include "server/listing.h"
+#include "server/propagation.h"
+#include "server/search_runner.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+inline constexpr int kMaxQueuedJobs = 16;
+
+// Whether two views of a job show the same state, progress and counts (a watcher's "nothing
+// new").
+bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b);
+inline constexpr int kWorkerNiceIncrement = 10;
+
+class JobRunner {
+ public:
+  JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner);
+  JobRunner(const JobRunner&) = delete;
+  JobRunner& operator=(const JobRunner&) = delete;
+  ~JobRunner();  // Stop()
+
+  // Queues a propagation job and returns it (queued). ResolvePropagation's errors;
+  // FAILED_PRECONDITION when a queued or running job propagates one of the descriptors;
+  // RESOURCE_EXHAUSTED past kMaxQueuedJobs waiting jobs; UNAVAILABLE once stopping.
+  absl::StatusOr<storage::JobRecord> StartPropagation(PropagationRequest request);
+  // The job as it is now (a live job's progress from memory, fresher than its row). NOT_FOUND.
+  absl::StatusOr<storage::JobRecord> Get(const std::string& job_id) const;
+  // Newest first, live jobs as Get gives them.
+  absl::StatusOr<storage::JobPage> List(const PageRequest& page) const;
+  // Cancels a queued job at once, a running one at its next check (waited for, briefly), and
+  // returns the job as it ended: one that finished before the cancel reached it keeps its end.
+  // NOT_FOUND; FAILED_PRECONDITION naming the state for a job that had ended already.
+  absl::StatusOr<storage::JobRecord> Cancel(const std::string& job_id);
+  // The job once it differs from `seen` (progress, counts or state), or as it is after
+  // `max_wait`. NOT_FOUND.
+  absl::StatusOr<storage::JobRecord> WaitForChange(const std::string& job_id,
+                                                   const storage::JobRecord& seen,
+                                                   std::chrono::milliseconds max_wait) const;
+  // Ends the running job and the queued ones as interrupted, and joins the worker; new jobs are
+  // refused from then on. Idempotent.
+  void Stop();
+
+ private:
+  struct Live {
+    storage::JobRecord record;
+    PropagationRequest request;
+  };
+
+  void Work();
+  // Runs the job `job_id` (its Live entry present) to its end and records the end.
+  void Run(const std::string& job_id);
+  // The first live job sharing a descriptor with `descriptors`, or null.
+  const Live* Conflict(const std::vector<std::string>& descriptors) const;
+  // Records `record` (its end) in memory and in the database, and drops the live entry.
+  void Finish(const storage::JobRecord& record);
+
+  storage::Database& database_;
+  const IndexRegistry& registry_;
+  const SearchRunner& runner_;
+  mutable std::mutex mutex_;
+  // Notified on every change of a live job and when stopping.
+  mutable std::condition_variable changed_;
+  std::map<std::string, Live> live_;  // queued and running jobs
+  std::deque<std::string> queue_;     // the queued ones, first to run first
+  bool stopping_ = false;
+  // The running job's should_stop: set by Cancel (for it) and Stop; cleared as a job starts.
+  std::atomic<bool> stop_running_{false};
+  std::thread worker_;  // last: started once the rest exists
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_JOB_RUNNER_H_

@@ -1,0 +1,245 @@
+#include "server/propagation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// The manual labels of `descriptor`, every page.
+absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,
+                                                               const std::string& descriptor) {
+  std::vector<storage::LabelRecord> labels;
+  storage::Page page{.page_size = 1000, .page_token = ""};
+  do {
+    MOTIONDB_ASSIGN_OR_RETURN(storage::LabelPage read,
+                              database.ListLabels(page, {.descriptor = descriptor,
+                                                         .origin = storage::LabelOrigin::kManual}));
+    labels.insert(labels.end(), read.labels.begin(), read.labels.end());
+    page.page_token = read.next_page_token;
+  } while (!page.page_token.empty());
+  return labels;
+}
+
+// The search parameters as the runner would resolve them, checked once before the job is
+// queued, so that a bad parameter fails the start rather than every query.
+absl::Status CheckSearch(const SearchRequest& search, int dims) {
+  if (!search.params.clip_ids.empty()) {
+    return absl::InvalidArgumentError(
+        "search.clip_ids: a propagation searches every clip of the space (filter by tags)");
+  }
+  if (search.params.return_path) {
+    return absl::InvalidArgumentError("search.return_path: a propagation keeps no paths");
+  }
+  SearchParams params = search.params;
+  const SearchParams defaults;
+  params.ann_dims = search.ann_dims.value_or(std::min(defaults.ann_dims, dims));
+  params.dtw_dims = search.dtw_dims.value_or(std::min(defaults.dtw_dims, dims));
+  return ValidateSearchParams(params, dims);
+}
+
+// Whether `a` overlaps `b` (same clip) by more than half of a's length.
+bool OverlapsByHalf(const storage::LabelRecord& a, const storage::LabelRecord& b) {
+  const int64_t shared =
+      std::min(a.last_frame, b.last_frame) - std::max(a.first_frame, b.first_frame) + 1;
+  return 2 * shared > a.last_frame - a.first_frame + 1;
+}
+
+// A label's candidate ranges, before their values are known: value holds the label's.
+void AddCandidates(const storage::LabelRecord& label, const SearchOutcome& found, int64_t space_id,
+                   const std::string& job_id, std::vector<storage::LabelRecord>* candidates) {
+  for (const SearchHit& hit : found.hits) {
+    storage::LabelRecord& candidate = candidates->emplace_back();
+    candidate.clip_id = hit.clip_id;
+    candidate.first_frame = hit.start_frame;
+    candidate.last_frame = hit.end_frame;
+    candidate.descriptor = label.descriptor;
+    candidate.value = label.value;
+    candidate.origin = storage::LabelOrigin::kPropagated;
+    candidate.source_label_id = label.label_id;
+    candidate.space_id = space_id;
+    candidate.score = hit.score;
+    candidate.job_id = job_id;
+  }
+}
+
+// A query's failure that says the label's range cannot be a query (too short, its clip gone or
+// not indexed yet), which skips the label; other failures end the job.
+bool SkipsLabel(const absl::Status& status) {
+  return absl::IsInvalidArgument(status) || absl::IsNotFound(status) ||
+         absl::IsFailedPrecondition(status) || absl::IsUnavailable(status);
+}
+
+}  // namespace
+
+absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& database,
+                                                      const IndexRegistry& registry,
+                                                      PropagationRequest request) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(registry, request.space));
+  for (size_t i = 0; i < request.descriptors.size(); ++i) {
+    if (request.descriptors[i].empty()) {
+      return absl::InvalidArgumentError(absl::StrCat("descriptors[", i, "]: must not be empty"));
+    }
+  }
+  if (request.descriptors.empty()) {
+    MOTIONDB_ASSIGN_OR_RETURN(request.descriptors, database.ManualDescriptors());
+    if (request.descriptors.empty()) {
+      return absl::FailedPreconditionError(
+          "descriptors: none given and no manual label exists to propagate; add labels first");
+    }
+  }
+  std::sort(request.descriptors.begin(), request.descriptors.end());
+  request.descriptors.erase(std::unique(request.descriptors.begin(), request.descriptors.end()),
+                            request.descriptors.end());
+  MOTIONDB_RETURN_IF_ERROR(CheckSearch(request.search, snapshot->space->dims()));
+  return request;
+}
+
+std::string ParametersJson(const PropagationRequest& request) {
+  const SearchRequest& search = request.search;
+  const SearchParams& params = search.params;
+  Json json = {{"space", request.space},
+               {"descriptors", request.descriptors},
+               {"max_results", params.max_results},
+               {"neighbours", params.neighbours},
+               {"places", params.places},
+               {"seed_selection", params.seed_selection == SeedSelection::kDistinctPlaces
+                                      ? "distinct_places"
+                                      : "nearest_frames"},
+               {"epsilon", params.epsilon},
+               {"slope_limit", params.slope_limit},
+               {"cluster_gap_s", params.cluster_gap_s},
+               {"max_overlap", params.max_overlap},
+               {"refine", params.refine},
+               {"exact", search.exact},
+               {"tags", params.tags}};
+  if (search.ann_dims) json["ann_dims"] = *search.ann_dims;
+  if (search.dtw_dims) json["dtw_dims"] = *search.dtw_dims;
+  return json.dump();
+}
+
+PropagationTarget TargetOf(const storage::JobRecord& job) {
+  PropagationTarget target;
+  const Json json = Json::parse(job.parameters_json, nullptr, /*allow_exceptions=*/false);
+  if (!json.is_object()) return target;
+  if (const auto space = json.find("space"); space != json.end() && space->is_string()) {
+    target.space = space->get<std::string>();
+  }
+  if (const auto list = json.find("descriptors"); list != json.end() && list->is_array()) {
+    for (const Json& item : *list) {
+      if (item.is_string()) target.descriptors.push_back(item.get<std::string>());
+    }
+  }
+  return target;
+}
+
+double SimilarityFactor(double score, double scale) {
+  const double ratio = score / scale;
+  return std::exp2(-ratio * ratio);
+}
+
+double ScoreScale(std::vector<double> last_scores) {
+  if (last_scores.empty()) return 1;
+  const auto middle = last_scores.begin() + last_scores.size() / 2;
+  std::nth_element(last_scores.begin(), middle, last_scores.end());
+  return *middle > 0 ? *middle : 1;
+}
+
+std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
+                                                const std::vector<storage::LabelRecord>& manual) {
+  using Key = std::pair<std::string, int64_t>;  // descriptor, clip
+  std::map<Key, std::vector<storage::LabelRecord>> taken;
+  for (const storage::LabelRecord& label : manual) {
+    taken[{label.descriptor, label.clip_id}].push_back(label);
+  }
+  // Ties in the order of clip and frames, so that a re-run writes the same labels.
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return std::tie(b.value, a.score, a.clip_id, a.first_frame, a.last_frame, a.source_label_id) <
+           std::tie(a.value, b.score, b.clip_id, b.first_frame, b.last_frame, b.source_label_id);
+  });
+  std::vector<storage::LabelRecord> kept;
+  for (storage::LabelRecord& candidate : candidates) {
+    std::vector<storage::LabelRecord>& near = taken[{candidate.descriptor, candidate.clip_id}];
+    const bool covered = std::any_of(near.begin(), near.end(), [&](const auto& other) {
+      return OverlapsByHalf(candidate, other);
+    });
+    if (covered) continue;
+    near.push_back(candidate);
+    kept.push_back(std::move(candidate));
+  }
+  return kept;
+}
+
+absl::StatusOr<storage::PropagationOutput> RunPropagation(
+    storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
+    const PropagationRequest& request, const std::string& job_id,
+    const std::function<bool()>& should_stop,
+    const std::function<void(const PropagationProgress&)>& on_progress) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(registry, request.space));
+  std::vector<storage::LabelRecord> manual, queries;
+  for (const std::string& descriptor : request.descriptors) {
+    MOTIONDB_ASSIGN_OR_RETURN(std::vector<storage::LabelRecord> labels,
+                              ManualLabels(database, descriptor));
+    for (storage::LabelRecord& label : labels) {
+      if (snapshot->clips.contains(label.clip_id)) queries.push_back(label);
+      manual.push_back(std::move(label));
+    }
+  }
+  PropagationProgress progress{.total = static_cast<int64_t>(queries.size())};
+  on_progress(progress);
+  std::vector<storage::LabelRecord> candidates;
+  std::vector<double> last_scores;
+  for (const storage::LabelRecord& label : queries) {
+    if (should_stop()) return absl::CancelledError("the job was stopped between queries");
+    SearchRequest search = request.search;
+    search.space = request.space;
+    search.query = ClipSelection{label.clip_id, static_cast<int>(label.first_frame),
+                                 static_cast<int>(label.last_frame)};
+    search.exclude_query = true;
+    const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
+    if (found.ok()) {
+      ++progress.queries;
+      AddCandidates(label, *found, snapshot->record.space_id, job_id, &candidates);
+      if (!found->hits.empty()) last_scores.push_back(found->hits.back().score);
+    } else if (SkipsLabel(found.status())) {
+      ++progress.skipped;
+    } else {
+      return absl::Status(found.status().code(),
+                          absl::StrCat("label ", label.label_id, ": ", found.status().message()));
+    }
+    ++progress.done;
+    on_progress(progress);
+  }
+  const double scale = ScoreScale(std::move(last_scores));
+  for (storage::LabelRecord& candidate : candidates) {
+    candidate.value *= SimilarityFactor(candidate.score, scale);
+  }
+  // A zero value (a label of value 0, or a factor that underflowed) carries nothing to spread.
+  std::erase_if(candidates, [](const auto& candidate) { return !(candidate.value > 0); });
+  storage::PropagationOutput output;
+  output.space_id = snapshot->record.space_id;
+  output.descriptors = request.descriptors;
+  output.labels = KeepStrongest(std::move(candidates), manual);
+  output.job.queries = progress.queries;
+  output.job.queries_skipped = progress.skipped;
+  output.job.done = progress.done;
+  output.job.total = progress.total;
+  return output;
+}
+
+}  // namespace motiondb::server

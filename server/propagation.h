@@ -1,0 +1,84 @@
+// Markup propagation (SPEC §5, thesis 7.2.3): each manual label of the chosen descriptors, on a
+// clip of a space's skeleton, runs as a search in that space (its range the query, its own range
+// excluded), and every result range gets the descriptor with value = the label's value x
+// SimilarityFactor(score). What one propagation job computes; server/job_runner.h runs it in the
+// background and stores its output.
+//
+// Pure functions, and RunPropagation, which is thread-safe as the SearchRunner and Database are.
+#ifndef MOTIONDB_SERVER_PROPAGATION_H_
+#define MOTIONDB_SERVER_PROPAGATION_H_
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "server/index_registry.h"
+#include "server/search_runner.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+// What a propagation job is asked.
+struct PropagationRequest {
+  std::string space;
+  // Empty: every descriptor a manual label carries (FAILED_PRECONDITION when there is none).
+  std::vector<std::string> descriptors;
+  // Each query's parameters: params (max_results, neighbours, ..., tags: only clips carrying one
+  // of them are searched), ann_dims, dtw_dims, exact. Its space, query and exclude_query are
+  // the job's to set; params.clip_ids and return_path must be unset.
+  SearchRequest search;
+};
+
+// Checks `request` and fills its descriptors when empty. NOT_FOUND for an unknown space;
+// INVALID_ARGUMENT naming the field for an empty descriptor or bad search parameters;
+// FAILED_PRECONDITION for no descriptors given while no manual label exists.
+absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& database,
+                                                      const IndexRegistry& registry,
+                                                      PropagationRequest request);
+
+// The job row's parameters (JSON): the space, descriptors and the search parameters set.
+std::string ParametersJson(const PropagationRequest& request);
+// The space and descriptors of a job's parameters, for listings (empty when unreadable).
+struct PropagationTarget {
+  std::string space;
+  std::vector<std::string> descriptors;
+};
+PropagationTarget TargetOf(const storage::JobRecord& job);
+
+// The factor a result's value is scaled by: f(s) = 2^-((s / s0)^2), with s0 the space's score
+// scale (ScoreScale). f(0) = 1 (the pose sequence itself), f(s0) = 1/2, f(2 s0) = 1/16: it
+// falls slowly over near matches and fast past the scale. A score is a mean pose distance in a
+// space's own metric, which differs between spaces (their dimensions and variances), so a fixed
+// s0 would mean different things in different spaces; s0 taken from the job's own searches in
+// that space makes f(s) = 1/2 mean "as far as a typical query's last result" everywhere.
+double SimilarityFactor(double score, double scale);
+// s0: the median, over the queries that found anything, of the score of their last (k-th)
+// result; 1 when there is none or it is 0 (every result then exact and f = 1 for them).
+double ScoreScale(std::vector<double> last_scores);
+
+// Of propagated candidates (any descriptors and clips), those to write: strongest first (then
+// lowest score), a candidate is dropped when it overlaps a kept one of its descriptor and clip,
+// or a `manual` label of its descriptor, by more than half of its own length. Kept in that order.
+std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
+                                                const std::vector<storage::LabelRecord>& manual);
+
+struct PropagationProgress {
+  int64_t done = 0, total = 0;  // manual labels searched, of those to search
+  int64_t queries = 0;          // searches run
+  int64_t skipped = 0;          // labels whose range could not be a query (e.g. too short)
+};
+
+// Runs the propagation of a resolved `request` as job `job_id` and returns its output (labels
+// and counts; output.job holds only the counts). `should_stop` is polled between queries and
+// inside each search (CANCELLED); `on_progress` is called after each query.
+absl::StatusOr<storage::PropagationOutput> RunPropagation(
+    storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
+    const PropagationRequest& request, const std::string& job_id,
+    const std::function<bool()>& should_stop,
+    const std::function<void(const PropagationProgress&)>& on_progress);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_PROPAGATION_H_
