@@ -17,6 +17,10 @@ Failed calls raise motiondb.Error (.code the gRPC status name, .message the serv
 The returned objects are the API's messages (proto/motiondb/v1), whose generated modules are
 motiondb.v1.*_pb2.
 """
+# The stubs (motiondb.v1) come with the installed package; from a checkout, the package's source
+# folder and the build's build/python (generated stubs only) both on PYTHONPATH make one package.
+__path__ = __import__("pkgutil").extend_path(__path__, __name__)
+
 from motiondb.client import (Clip, Client, Error, Job, Label, SearchResult, Space, connect,
                              decode_curve, job_finished, job_state_name)
 
