@@ -251,6 +251,31 @@ class PackageTest(unittest.TestCase):
             self.assertEqual(list(rows[0]), ["clip", "start", "end", "descriptor", "value"])
 
 
+class TokenTest(unittest.TestCase):
+    def test_token_is_sent_on_every_call(self):
+        with tempfile.TemporaryDirectory() as folder:
+            token_file = pathlib.Path(folder) / "token"
+            token_file.write_text("py-secret-token\n")
+            log_path = os.path.join(folder, "server.log")
+            with open(log_path, "w") as log:
+                server = subprocess.Popen(
+                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0",
+                     "--auth-token-file", str(token_file)], stdout=subprocess.DEVNULL, stderr=log)
+                try:
+                    address = f"127.0.0.1:{logged_port(log_path, server)}"
+                    with motiondb.connect(address) as anonymous:
+                        with self.assertRaises(motiondb.Error) as raised:
+                            anonymous.server_info()
+                        self.assertEqual(raised.exception.code, "UNAUTHENTICATED")
+                    with motiondb.connect(address, token="py-secret-token") as client:
+                        self.assertTrue(client.server_info().auth_required)
+                        self.assertEqual(list(client.clips()), [[]])
+                        self.assertEqual(list(client.find_labels("anything")), [])
+                finally:
+                    server.send_signal(signal.SIGTERM)
+                    self.assertEqual(server.wait(timeout=30), 0)
+
+
 if __name__ == "__main__":
     SERVER, REPO = sys.argv[1], pathlib.Path(sys.argv[2]).resolve()
     unittest.main(argv=sys.argv[:1], verbosity=2)
