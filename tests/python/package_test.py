@@ -1,0 +1,281 @@
+#!/usr/bin/python3
+"""The motiondb Python package (client/python), installed offline and run against the server.
+
+Installs client/python with `pip install --no-index --no-deps --target DIR` (the stubs generated
+from proto/ on the way; nothing written into the source tree),
+imports motiondb from DIR only, starts the real motiondb-server on a free loopback port with a
+temporary database, and drives it through the package: ingest, a space, search, labels, a
+propagation job watched to its end, curves; then runs examples/propagate_markup.py end to end.
+usage: package_test.py SERVER_BINARY REPO_ROOT
+"""
+import csv
+import math
+import os
+import pathlib
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+SERVER = REPO = None
+motiondb = None  # imported from the installed copy in setUpModule
+WORK = None
+SITE = None
+
+
+def setUpModule():
+    global motiondb, WORK, SITE
+    WORK = tempfile.TemporaryDirectory()
+    source = REPO / "client" / "python"
+    before = sorted(str(p) for p in source.rglob("*") if "__pycache__" not in p.parts)
+    SITE = pathlib.Path(WORK.name) / "site"
+    env = dict(os.environ, MOTIONDB_PROTO_DIR=str(REPO / "proto"))
+    env.pop("PYTHONPATH", None)
+    install = subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--no-index", "--no-deps", "--no-cache-dir",
+         "--disable-pip-version-check", "--target", str(SITE), str(source)],
+        env=env, capture_output=True, text=True, timeout=300)
+    if install.returncode != 0:
+        raise RuntimeError(f"pip install failed:\n{install.stdout}\n{install.stderr}")
+    after = sorted(str(p) for p in source.rglob("*") if "__pycache__" not in p.parts)
+    assert after == before, f"the install wrote into the source tree: {set(after) - set(before)}"
+    # Import from the installed copy only: no stubs or sources from the tree on the path.
+    sys.path.insert(0, str(SITE))
+    import motiondb as installed
+    import motiondb.v1.clip_service_pb2
+    motiondb = installed
+    assert pathlib.Path(motiondb.__file__).is_relative_to(SITE), motiondb.__file__
+    assert pathlib.Path(motiondb.v1.clip_service_pb2.__file__).is_relative_to(SITE)
+
+
+def tearDownModule():
+    WORK.cleanup()
+
+
+def logged_port(log_path, server, timeout=60):
+    """The port the server picked for --listen 127.0.0.1:0, read from its log."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        match = re.search(r"\(port ([0-9]+)\)", pathlib.Path(log_path).read_text())
+        if match:
+            return int(match.group(1))
+        if server.poll() is not None:
+            raise RuntimeError(f"motiondb-server exited with {server.returncode}")
+        time.sleep(0.02)
+    raise RuntimeError("motiondb-server did not report its port")
+
+
+def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):
+    """A small 3-joint skeleton raising its arm once (as tests/python/client_test.py)."""
+    rows = []
+    for f in range(frames):
+        t = f / (frames - 1)
+        angle = lift * 120.0 * math.sin(math.pi * t) ** 2
+        rows.append(f"0 90 0 {phase:.3f} 0 0 0 {angle:.4f} 0 {angle / 3:.4f} 0 0")
+    return ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n"
+            " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+            " JOINT Shoulder\n {\n  OFFSET 10 40 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "  JOINT Elbow\n  {\n   OFFSET 25 0 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
+            "   End Site\n   {\n    OFFSET 25 0 0\n   }\n  }\n }\n}\n"
+            f"MOTION\nFrames: {frames}\nFrame Time: 0.0333333\n" + "\n".join(rows) + "\n")
+
+
+def raise_then_rest_bvh(frames=150, lift=1.0):
+    """An arm raise in the first half, then still: a clip where only a range raises."""
+    half = arm_raise_bvh(frames // 2, lift).rsplit("Frame Time: 0.0333333\n", 1)[1].splitlines()
+    rest = ["0 90 0 0 0 0 0 0 0 0 0 0"] * (frames - len(half))
+    header = arm_raise_bvh(2).split("MOTION\n")[0]
+    return (header + f"MOTION\nFrames: {len(half) + len(rest)}\nFrame Time: 0.0333333\n"
+            + "\n".join(half + rest) + "\n")
+
+
+class PackageTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        log = os.path.join(cls.dir.name, "server.log")
+        cls.log = open(log, "w")
+        cls.server = subprocess.Popen(
+            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0"],
+            stdout=subprocess.DEVNULL, stderr=cls.log)
+        cls.address = f"127.0.0.1:{logged_port(log, cls.server)}"
+        cls.client = motiondb.connect(cls.address)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        cls.server.send_signal(signal.SIGTERM)
+        code = cls.server.wait(timeout=30)
+        cls.log.close()
+        cls.dir.cleanup()
+        assert code == 0, f"motiondb-server exited with {code} after SIGTERM"
+
+    def test_1_ingest_space_search(self):
+        client = self.client
+        ids = [client.ingest(arm_raise_bvh(80 + 5 * i, 0.8 + 0.1 * i).encode(),
+                             name=f"raise_{i}", tags=["raise"]).clip.clip_id for i in range(4)]
+        ids.append(client.ingest(arm_raise_bvh(80, 0.0).encode(), name="still",
+                                 tags=["still"]).clip.clip_id)
+        with tempfile.TemporaryDirectory() as folder:  # a path, named after the file
+            path = pathlib.Path(folder) / "long_take.bvh"
+            path.write_text(raise_then_rest_bvh())
+            ids.append(client.ingest(path, tags=["take"]).clip.clip_id)
+        self.assertEqual(client.clip("long_take").clip_id, ids[-1])
+        cmu = pathlib.Path("/usr/share/assimp/models/BVH/01_01.bvh")
+        if cmu.exists():  # another skeleton beside the space's
+            self.assertEqual(client.ingest(cmu).clip.name, "01_01")
+        pages = list(client.clips(tag="raise", page_size=3))
+        self.assertEqual([[c.name for c in page] for page in pages],
+                         [["raise_0", "raise_1", "raise_2"], ["raise_3"]])
+
+        skeleton = client.clip(ids[0]).skeleton_id
+        space = client.create_space("arms", skeleton_id=skeleton)
+        self.assertGreater(space.report.dims, 0)
+        self.assertEqual([s.name for s in client.spaces()], ["arms"])
+
+        results = client.search("arms", clip="raise_1", max_results=10, exclude_query=False)
+        self.assertGreater(len(results), 0)
+        self.assertEqual((results[0].clip_id, results[0].clip_name), (ids[1], "raise_1"))
+        self.assertLessEqual(results[0].start_s, results[0].end_s)
+        self.assertGreaterEqual(results[0].score, 0.0)
+        ranged = client.search("arms", clip=ids[0], first=0, last=59, max_results=5)
+        self.assertNotIn(ids[4], [r.clip_id for r in ranged[:3]])
+        by_file = client.search("arms", bvh=arm_raise_bvh(85, 0.9).encode(), max_results=3)
+        self.assertEqual(len(by_file), 3)
+
+    def test_2_errors(self):
+        with self.assertRaises(motiondb.Error) as raised:
+            self.client.search("no-such-space", clip=1)
+        self.assertEqual(raised.exception.code, "NOT_FOUND")
+        with self.assertRaises(motiondb.Error) as raised:
+            self.client.ingest(b"HIERARCHY\nROOT a\n{\nOFFSET 0 0\n", name="bad")
+        self.assertEqual(raised.exception.code, "INVALID_ARGUMENT")
+        self.assertIn("line", raised.exception.message)
+        with self.assertRaises(motiondb.Error) as raised:
+            self.client.add_labels([{"clip": "raise_0", "first": 0, "last": 10,
+                                     "descriptor": "x", "value": 1.5}])
+        self.assertEqual(raised.exception.code, "INVALID_ARGUMENT")
+        self.assertIn("labels[0]", raised.exception.message)
+        with self.assertRaises(motiondb.Error) as raised:
+            self.client.job("job-999")
+        self.assertEqual(raised.exception.code, "NOT_FOUND")
+
+    def test_3_labels_propagation(self):
+        client = self.client
+        added = client.add_labels([
+            ("raise_0", 0, 79, "raise-arm", 1.0),
+            {"clip": "still", "start_s": 0.0, "end_s": 1.0, "descriptor": "stand", "value": 0.8},
+        ])
+        self.assertEqual([label.descriptor_name for label in added], ["raise-arm", "stand"])
+        self.assertEqual((added[0].first_frame, added[0].last_frame), (0, 79))
+        self.assertEqual(added[1].first_frame, 0)
+        manual = list(client.list_labels(origin="manual"))
+        self.assertEqual(len(manual), 2)
+        self.assertEqual([l.label_id for l in client.list_labels(descriptor="stand")],
+                         [added[1].label_id])
+
+        job = client.start_propagation("arms", ["raise-arm"], max_results=5)
+        self.assertTrue(job.job_id.startswith("job-"))
+        updates = list(client.watch(job.job_id))
+        self.assertGreaterEqual(len(updates), 1)
+        final = updates[-1]
+        self.assertTrue(motiondb.job_finished(final))
+        self.assertEqual(motiondb.job_state_name(final), "succeeded", final.error)
+        self.assertEqual((final.done, final.total), (1, 1))
+        self.assertGreater(final.labels_written, 0)
+        self.assertEqual(client.job(job.job_id).state, final.state)
+        self.assertIn(job.job_id, [j.job_id for j in client.jobs()])
+        with self.assertRaises(motiondb.Error) as raised:
+            client.cancel(job.job_id)
+        self.assertEqual(raised.exception.code, "FAILED_PRECONDITION")
+
+        found = list(client.find_labels("raise-arm", min_value=0.0))
+        self.assertGreater(len(found), 1)
+        self.assertEqual([l.value for l in found], sorted((l.value for l in found), reverse=True))
+        propagated = [l for l in found if l.job_id == job.job_id]
+        self.assertEqual(len(propagated), final.labels_written)
+        raised_clips = {"raise_1", "raise_2", "raise_3", "long_take"}
+        self.assertTrue(raised_clips & {l.clip_name for l in propagated}, propagated)
+        self.assertTrue(all(l.start_s <= l.end_s for l in propagated))
+        timeline = client.clip_labels("raise_0")
+        self.assertIn(added[0].label_id, [l.label_id for l in timeline])
+
+        self.assertEqual(client.delete_labels(descriptor="stand"), 1)
+        self.assertEqual(list(client.find_labels("stand")), [])
+
+    def test_4_curve(self):
+        curve = self.client.curve("arms", "raise_0", first=0, last=29, dims=2)
+        try:
+            import numpy
+        except ImportError:
+            print("python3-numpy is not installed: checked the curve as a list of lists only",
+                  file=sys.stderr)
+            self.assertIsInstance(curve, list)
+            self.assertEqual(len(curve[0]), 2)
+            self.assertGreater(len(curve), 20)
+            self.assertTrue(all(isinstance(v, float) for row in curve for v in row))
+            return
+        self.assertIsInstance(curve, numpy.ndarray)
+        self.assertEqual(curve.dtype, numpy.float32)
+        self.assertEqual(curve.shape[1], 2)
+        self.assertGreater(curve.shape[0], 20)
+
+    def test_5_example_propagates_markup(self):
+        with tempfile.TemporaryDirectory() as folder:
+            labels, output = pathlib.Path(folder) / "labels.csv", pathlib.Path(folder) / "out.csv"
+            labels.write_text("clip,start,end,descriptor,value\n"
+                              "raise_2,0,89,lift,0.9\n"
+                              "long_take,0,74,lift,1\n")
+            run = subprocess.run(
+                [sys.executable, str(REPO / "client" / "python" / "examples" / "propagate_markup.py"),
+                 "--server", self.address, "--space", "example-space", "--max-results", "4",
+                 str(labels), "-o", str(output)],
+                env=dict(os.environ, PYTHONPATH=str(SITE)), capture_output=True, text=True,
+                timeout=300)
+            self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+            self.assertIn("added 2 manual labels: lift", run.stdout)
+            self.assertIn("built space example-space", run.stdout)
+            self.assertRegex(run.stdout, r"job-[0-9]+ succeeded: 2/2 labels")
+            with open(output, newline="") as file:
+                rows = list(csv.DictReader(file))
+            self.assertRegex(run.stdout, rf"wrote {len(rows)} propagated labels")
+            self.assertGreater(len(rows), 0)
+            self.assertEqual({r["descriptor"] for r in rows}, {"lift"})
+            for row in rows:
+                self.assertLessEqual(int(row["start"]), int(row["end"]))
+                self.assertTrue(0.0 <= float(row["value"]) <= 1.0)
+            # The output is what `motiondb labels import` (and the example) reads back.
+            self.assertEqual(list(rows[0]), ["clip", "start", "end", "descriptor", "value"])
+
+
+class TokenTest(unittest.TestCase):
+    def test_token_is_sent_on_every_call(self):
+        with tempfile.TemporaryDirectory() as folder:
+            token_file = pathlib.Path(folder) / "token"
+            token_file.write_text("py-secret-token\n")
+            log_path = os.path.join(folder, "server.log")
+            with open(log_path, "w") as log:
+                server = subprocess.Popen(
+                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0",
+                     "--auth-token-file", str(token_file)], stdout=subprocess.DEVNULL, stderr=log)
+                try:
+                    address = f"127.0.0.1:{logged_port(log_path, server)}"
+                    with motiondb.connect(address) as anonymous:
+                        with self.assertRaises(motiondb.Error) as raised:
+                            anonymous.server_info()
+                        self.assertEqual(raised.exception.code, "UNAUTHENTICATED")
+                    with motiondb.connect(address, token="py-secret-token") as client:
+                        self.assertTrue(client.server_info().auth_required)
+                        self.assertEqual(list(client.clips()), [[]])
+                        self.assertEqual(list(client.find_labels("anything")), [])
+                finally:
+                    server.send_signal(signal.SIGTERM)
+                    self.assertEqual(server.wait(timeout=30), 0)
+
+
+if __name__ == "__main__":
+    SERVER, REPO = sys.argv[1], pathlib.Path(sys.argv[2]).resolve()
+    unittest.main(argv=sys.argv[:1], verbosity=2)
