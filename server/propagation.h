@@ -32,7 +32,8 @@ struct PropagationRequest {
 };
 
 // Checks `request` and fills its descriptors when empty. NOT_FOUND for an unknown space;
-// INVALID_ARGUMENT naming the field for an empty descriptor or bad search parameters;
+// INVALID_ARGUMENT naming the field (descriptors[i]) for a descriptor no label can carry (empty,
+// over storage::kMaxDescriptorBytes, a control character) or bad search parameters;
 // FAILED_PRECONDITION for no descriptors given while no manual label exists.
 absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& database,
                                                       const IndexRegistry& registry,
@@ -59,8 +60,10 @@ double SimilarityFactor(double score, double scale);
 double ScoreScale(std::vector<double> last_scores);
 
 // Of propagated candidates (any descriptors and clips), those to write: strongest first (then
-// lowest score), a candidate is dropped when it overlaps a kept one of its descriptor and clip,
-// or a `manual` label of its descriptor, by more than half of its own length. Kept in that order.
+// lowest score), a candidate is dropped when it shares more than half of the shorter range's
+// frames with a kept one of its descriptor and clip, or with a `manual` label of its descriptor
+// (so a long weaker range around a stronger short one, or over a manual one, is dropped too).
+// Kept in that order.
 std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
                                                 const std::vector<storage::LabelRecord>& manual);
 
@@ -72,7 +75,9 @@ struct PropagationProgress {
 
 // Runs the propagation of a resolved `request` as job `job_id` and returns its output (labels
 // and counts; output.job holds only the counts). `should_stop` is polled between queries and
-// inside each search (CANCELLED); `on_progress` is called after each query.
+// inside each search (CANCELLED); `on_progress` is called after each query. NOT_FOUND when the
+// space was deleted while the job ran; FAILED_PRECONDITION when every label was skipped (there
+// were some and none could be a query): a failed job leaves the earlier output as it was.
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
     const PropagationRequest& request, const std::string& job_id,
