@@ -219,7 +219,12 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
     if (found.ok()) {
       ++progress.queries;
       AddCandidates(label, *found, snapshot->record.space_id, job_id, &candidates);
-      if (!found->hits.empty()) last_scores.push_back(found->hits.back().score);
+      // Only full result lists with a positive last score calibrate s0: a short list's last
+      // result is not the k-th nearest, and would pull s0 toward the near matches.
+      if (static_cast<int>(found->hits.size()) == request.search.params.max_results &&
+          found->hits.back().score > 0) {
+        last_scores.push_back(found->hits.back().score);
+      }
     } else if (SkipsLabel(found.status())) {
       // A space deleted while the job ran answers NOT_FOUND too: that ends the job.
       if (absl::IsNotFound(found.status()) && !FindSpace(registry, request.space).ok()) {

@@ -55,8 +55,11 @@ PropagationTarget TargetOf(const storage::JobRecord& job);
 // s0 would mean different things in different spaces; s0 taken from the job's own searches in
 // that space makes f(s) = 1/2 mean "as far as a typical query's last result" everywhere.
 double SimilarityFactor(double score, double scale);
-// s0: the median, over the queries that found anything, of the score of their last (k-th)
-// result; 1 when there is none or it is 0 (every result then exact and f = 1 for them).
+// s0: the median, over the job's queries that returned all max_results hits with a positive
+// last score, of that last (k-th) score; 1 when there is none. It is the job's own scale: its
+// max_results, descriptors (which labels query) and tags (which clips are searched) move it, so
+// f(s) compares a result with that job's k-th results, not with a fixed distance of the space.
+
 double ScoreScale(std::vector<double> last_scores);
 
 // Of propagated candidates (any descriptors and clips), those to write: strongest first (then
