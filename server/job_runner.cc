@@ -57,8 +57,12 @@ bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b) {
 }
 
 JobRunner::JobRunner(storage::Database& database, const IndexRegistry& registry,
-                     const SearchRunner& runner)
-    : database_(database), registry_(registry), runner_(runner), worker_([this] { Work(); }) {}
+                     const SearchRunner& runner, int test_pause_after)
+    : database_(database),
+      registry_(registry),
+      runner_(runner),
+      test_pause_after_(test_pause_after),
+      worker_([this] { Work(); }) {}
 
 JobRunner::~JobRunner() { Stop(); }
 
@@ -162,7 +166,10 @@ absl::StatusOr<storage::JobRecord> JobRunner::Cancel(const std::string& job_id) 
   }
   // Live and not queued: the running job (running_id_ is set in the same locked step that takes
   // a job off the queue, and cleared in the one that ends it). Only that job is stopped.
-  if (job_id == running_id_) stop_running_ = true;
+  if (job_id == running_id_) {
+    stop_running_ = true;
+    changed_.notify_all();  // wakes a job held by test_pause_after_
+  }
   return live->second.record;
 }
 
@@ -259,6 +266,12 @@ void JobRunner::Run(const std::string& job_id) {
     if (std::chrono::steady_clock::now() - last_write >= kProgressWriteInterval) {
       last_write = std::chrono::steady_clock::now();
       WriteRow(database_, record);
+    }
+    if (test_pause_after_ >= 0 && progress.done >= test_pause_after_ &&
+        progress.done < progress.total) {
+      WriteRow(database_, record);  // its progress on disk too, for a test that kills the server
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return stopping_ || stop_running_.load(); });
     }
   };
   absl::StatusOr<storage::PropagationOutput> output = RunPropagation(

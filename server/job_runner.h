@@ -48,7 +48,11 @@ bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b);
 
 class JobRunner {
  public:
-  JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner);
+  // `test_pause_after` >= 0 (tests only): a running job with labels left waits after that many
+  // until it is cancelled or the runner stops, so that a test sees it running whatever the
+  // machine's speed.
+  JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
+            int test_pause_after = -1);
   JobRunner(const JobRunner&) = delete;
   JobRunner& operator=(const JobRunner&) = delete;
   ~JobRunner();  // Stop()
@@ -101,6 +105,7 @@ class JobRunner {
   storage::Database& database_;
   const IndexRegistry& registry_;
   const SearchRunner& runner_;
+  const int test_pause_after_;
   mutable std::mutex mutex_;
   // Notified on every change of a live job and when stopping.
   mutable std::condition_variable changed_;

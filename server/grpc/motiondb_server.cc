@@ -82,7 +82,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
           .count()));
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
-  s.jobs = std::make_unique<JobRunner>(*s.database, s.registry, *s.runner);
+  s.jobs =
+      std::make_unique<JobRunner>(*s.database, s.registry, *s.runner, options.test_job_pause_after);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.watchdog =
