@@ -232,9 +232,22 @@ void AddJobSubcommands(Commands& commands, CLI::App* job) {
   });
   add("watch", "follow a job to its end; exit 1 unless it succeeds",
       [id, &global](const auto& connection) { return Watch(connection, *id, global.json); });
-  add("cancel", "cancel a queued or running job", [id, &global](const auto& connection) {
-    return OnJob(connection, &v1::JobService::Stub::CancelJob, *id, global.json);
-  });
+  add("cancel", "cancel a queued or running job, and wait for a running one to stop",
+      [id, &global](const auto& connection) -> absl::Status {
+        v1::CancelJobRequest request;
+        request.set_job_id(*id);
+        MOTIONDB_ASSIGN_OR_RETURN(
+            const v1::Job job,
+            CallUnary(connection, &v1::JobService::Stub::CancelJob, request, {{"job_id", "ID"}}));
+        if (job.state() != v1::JOB_STATE_RUNNING && job.state() != v1::JOB_STATE_QUEUED) {
+          PrintJob(job, global.json);
+          return absl::OkStatus();
+        }
+        // The server answers at once and the job stops at its next check: watched to its end,
+        // cancelled (or its own end, when it finished first, which is no error of the cancel).
+        const absl::Status watched = Watch(connection, *id, global.json);
+        return absl::IsAborted(watched) ? absl::OkStatus() : watched;
+      });
 }
 
 }  // namespace

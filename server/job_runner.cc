@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
+#include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -17,8 +19,6 @@ namespace {
 // crash to show roughly how far it got, rarely enough that the writes (each synced to disk)
 // cost the job nothing to speak of. Watchers and GetJob see every change at once, from memory.
 constexpr std::chrono::seconds kProgressWriteInterval{1};
-// How long Cancel waits for a running job to notice.
-constexpr std::chrono::seconds kCancelWait{30};
 
 int64_t NowUnixMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -36,10 +36,17 @@ void LowerThisThreadsPriority() {
   (void)::setpriority(PRIO_PROCESS, thread, std::min(19, nice + kWorkerNiceIncrement));
 }
 
-const char* StateName(storage::JobState state) {
-  static constexpr const char* kNames[] = {"queued", "running",   "succeeded",
-                                           "failed", "cancelled", "interrupted"};
-  return kNames[static_cast<int>(state)];
+// Writes `record`'s row; a failure is logged (the job's memory copy stays right, and a row left
+// queued or running becomes interrupted at the next open).
+void WriteRow(storage::Database& database, const storage::JobRecord& record) {
+  const absl::Status written = database.UpdateJob(record);
+  if (!written.ok()) {
+    // One write of the whole line, so that it does not interleave with the request log's.
+    const std::string line =
+        absl::StrCat("motiondb-server: job ", record.job_id, ": writing its row (",
+                     storage::JobStateName(record.state), ") failed: ", written.message(), "\n");
+    std::fputs(line.c_str(), stderr);
+  }
 }
 
 }  // namespace
@@ -50,8 +57,12 @@ bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b) {
 }
 
 JobRunner::JobRunner(storage::Database& database, const IndexRegistry& registry,
-                     const SearchRunner& runner)
-    : database_(database), registry_(registry), runner_(runner), worker_([this] { Work(); }) {}
+                     const SearchRunner& runner, int test_pause_after)
+    : database_(database),
+      registry_(registry),
+      runner_(runner),
+      test_pause_after_(test_pause_after),
+      worker_([this] { Work(); }) {}
 
 JobRunner::~JobRunner() { Stop(); }
 
@@ -62,7 +73,7 @@ absl::StatusOr<storage::JobRecord> JobRunner::StartPropagation(PropagationReques
   if (stopping_) return absl::UnavailableError("the server is stopping; start the job again");
   if (const Live* running = Conflict(resolved.descriptors)) {
     return absl::FailedPreconditionError(absl::StrCat(
-        "descriptors: ", running->record.job_id, " (", StateName(running->record.state),
+        "descriptors: ", running->record.job_id, " (", storage::JobStateName(running->record.state),
         ") propagates some of them already; wait for it to end or cancel it"));
   }
   if (static_cast<int>(queue_.size()) >= kMaxQueuedJobs) {
@@ -90,10 +101,31 @@ const JobRunner::Live* JobRunner::Conflict(const std::vector<std::string>& descr
   return nullptr;
 }
 
+const storage::JobRecord* JobRunner::FindLocked(const std::string& job_id) const {
+  if (const auto live = live_.find(job_id); live != live_.end()) return &live->second.record;
+  for (const storage::JobRecord& ended : ended_) {
+    if (ended.job_id == job_id) return &ended;
+  }
+  return nullptr;
+}
+
+void JobRunner::EndLocked(const storage::JobRecord& record) {
+  live_.erase(record.job_id);
+  if (running_id_ == record.job_id) running_id_.clear();
+  ended_.push_back(record);
+  while (ended_.size() > kRecentlyEndedJobs) ended_.pop_front();
+  changed_.notify_all();
+}
+
+bool JobRunner::IsLive(const std::string& job_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return live_.contains(job_id);
+}
+
 absl::StatusOr<storage::JobRecord> JobRunner::Get(const std::string& job_id) const {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (const auto live = live_.find(job_id); live != live_.end()) return live->second.record;
+    if (const storage::JobRecord* job = FindLocked(job_id)) return *job;
   }
   return database_.GetJob(job_id);
 }
@@ -103,7 +135,7 @@ absl::StatusOr<storage::JobPage> JobRunner::List(const PageRequest& page) const 
   MOTIONDB_ASSIGN_OR_RETURN(storage::JobPage jobs, database_.ListJobs(storage_page));
   std::lock_guard<std::mutex> lock(mutex_);
   for (storage::JobRecord& job : jobs.jobs) {
-    if (const auto live = live_.find(job.job_id); live != live_.end()) job = live->second.record;
+    if (const storage::JobRecord* known = FindLocked(job.job_id)) job = *known;
   }
   return jobs;
 }
@@ -112,24 +144,33 @@ absl::StatusOr<storage::JobRecord> JobRunner::Cancel(const std::string& job_id) 
   std::unique_lock<std::mutex> lock(mutex_);
   const auto live = live_.find(job_id);
   if (live == live_.end()) {
+    const storage::JobRecord* ended = FindLocked(job_id);
+    std::optional<storage::JobRecord> known;
+    if (ended != nullptr) known = *ended;
     lock.unlock();
-    MOTIONDB_ASSIGN_OR_RETURN(const storage::JobRecord job, database_.GetJob(job_id));
+    if (!known) {
+      MOTIONDB_ASSIGN_OR_RETURN(known, database_.GetJob(job_id));
+    }
     return absl::FailedPreconditionError(
-        absl::StrCat(job_id, " has already ended (", StateName(job.state), ")"));
+        absl::StrCat(job_id, " has already ended (", storage::JobStateName(known->state), ")"));
   }
   if (const auto queued = std::find(queue_.begin(), queue_.end(), job_id); queued != queue_.end()) {
     queue_.erase(queued);
     storage::JobRecord record = live->second.record;
     record.state = storage::JobState::kCancelled;
     record.finished_unix_ms = NowUnixMs();
+    EndLocked(record);
     lock.unlock();
-    Finish(record);
+    WriteRow(database_, record);
     return record;
   }
-  stop_running_ = true;  // the job is live and not queued: it is the running one
-  changed_.wait_for(lock, kCancelWait, [&] { return !live_.contains(job_id); });
-  lock.unlock();
-  return Get(job_id);
+  // Live and not queued: the running job (running_id_ is set in the same locked step that takes
+  // a job off the queue, and cleared in the one that ends it). Only that job is stopped.
+  if (job_id == running_id_) {
+    stop_running_ = true;
+    changed_.notify_all();  // wakes a job held by test_pause_after_
+  }
+  return live->second.record;
 }
 
 absl::StatusOr<storage::JobRecord> JobRunner::WaitForChange(
@@ -141,12 +182,12 @@ absl::StatusOr<storage::JobRecord> JobRunner::WaitForChange(
       const auto live = live_.find(job_id);
       return live == live_.end() || !SameProgress(live->second.record, seen);
     });
-    if (const auto live = live_.find(job_id); live != live_.end()) return live->second.record;
+    if (const storage::JobRecord* job = FindLocked(job_id)) return *job;
   }
   return database_.GetJob(job_id);
 }
 
-void JobRunner::Stop() {
+void JobRunner::RequestStop() {
   std::vector<storage::JobRecord> queued;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -163,6 +204,10 @@ void JobRunner::Stop() {
     changed_.notify_all();
   }
   for (const storage::JobRecord& record : queued) Finish(record);
+}
+
+void JobRunner::Stop() {
+  RequestStop();
   if (worker_.joinable()) worker_.join();
 }
 
@@ -176,6 +221,7 @@ void JobRunner::Work() {
       if (stopping_) return;
       job_id = queue_.front();
       queue_.pop_front();
+      running_id_ = job_id;
       stop_running_ = false;
     }
     Run(job_id);
@@ -183,11 +229,13 @@ void JobRunner::Work() {
 }
 
 void JobRunner::Finish(const storage::JobRecord& record) {
-  // A row that cannot be written stays running, and becomes interrupted at the next open.
-  (void)database_.UpdateJob(record);
-  std::lock_guard<std::mutex> lock(mutex_);
-  live_.erase(record.job_id);
-  changed_.notify_all();
+  // Ended in memory first, so that no read sees the job live once its end is decided; a row
+  // that cannot be written is logged, and becomes interrupted at the next open.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    EndLocked(record);
+  }
+  WriteRow(database_, record);
 }
 
 void JobRunner::Run(const std::string& job_id) {
@@ -202,7 +250,7 @@ void JobRunner::Run(const std::string& job_id) {
     request = live.request;
     changed_.notify_all();
   }
-  (void)database_.UpdateJob(record);
+  WriteRow(database_, record);
   auto last_write = std::chrono::steady_clock::now();
   const auto on_progress = [&](const PropagationProgress& progress) {
     {
@@ -217,7 +265,13 @@ void JobRunner::Run(const std::string& job_id) {
     }
     if (std::chrono::steady_clock::now() - last_write >= kProgressWriteInterval) {
       last_write = std::chrono::steady_clock::now();
-      (void)database_.UpdateJob(record);
+      WriteRow(database_, record);
+    }
+    if (test_pause_after_ >= 0 && progress.done >= test_pause_after_ &&
+        progress.done < progress.total) {
+      WriteRow(database_, record);  // its progress on disk too, for a test that kills the server
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return stopping_ || stop_running_.load(); });
     }
   };
   absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
@@ -237,9 +291,9 @@ void JobRunner::Run(const std::string& job_id) {
     // The labels and the job's final row in one transaction; FinishPropagation sets the count.
     const absl::StatusOr<int64_t> written = database_.FinishPropagation(*output);
     if (written.ok()) {
+      record.labels_written = *written;
       std::lock_guard<std::mutex> lock(mutex_);
-      live_.erase(job_id);
-      changed_.notify_all();
+      EndLocked(record);
       return;
     }
     record.state = storage::JobState::kFailed;

@@ -37,15 +37,22 @@
 namespace motiondb::server {
 
 inline constexpr int kMaxQueuedJobs = 16;
+inline constexpr int kWorkerNiceIncrement = 10;
+// How many ended jobs are kept in memory: reads of a job that ended recently are answered from
+// there, so that its end is seen even when its final row could not be written (a full disk).
+inline constexpr size_t kRecentlyEndedJobs = 64;
 
 // Whether two views of a job show the same state, progress and counts (a watcher's "nothing
 // new").
 bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b);
-inline constexpr int kWorkerNiceIncrement = 10;
 
 class JobRunner {
  public:
-  JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner);
+  // `test_pause_after` >= 0 (tests only): a running job with labels left waits after that many
+  // until it is cancelled or the runner stops, so that a test sees it running whatever the
+  // machine's speed.
+  JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
+            int test_pause_after = -1);
   JobRunner(const JobRunner&) = delete;
   JobRunner& operator=(const JobRunner&) = delete;
   ~JobRunner();  // Stop()
@@ -58,10 +65,13 @@ class JobRunner {
   absl::StatusOr<storage::JobRecord> Get(const std::string& job_id) const;
   // Newest first, live jobs as Get gives them.
   absl::StatusOr<storage::JobPage> List(const PageRequest& page) const;
-  // Cancels a queued job at once, a running one at its next check (waited for, briefly), and
-  // returns the job as it ended: one that finished before the cancel reached it keeps its end.
-  // NOT_FOUND; FAILED_PRECONDITION naming the state for a job that had ended already.
+  // Cancels a queued job at once (returned cancelled) and asks a running one to stop at its next
+  // check, without waiting (returned as it is, running: watch it to see its end, cancelled, or
+  // its own end when it finished first). NOT_FOUND; FAILED_PRECONDITION naming the state for a
+  // job that had ended already.
   absl::StatusOr<storage::JobRecord> Cancel(const std::string& job_id);
+  // Whether the job is queued or running here (false once it ended, whatever its row says).
+  bool IsLive(const std::string& job_id) const;
   // The job once it differs from `seen` (progress, counts or state), or as it is after
   // `max_wait`. NOT_FOUND.
   absl::StatusOr<storage::JobRecord> WaitForChange(const std::string& job_id,
@@ -70,6 +80,9 @@ class JobRunner {
   // Ends the running job and the queued ones as interrupted, and joins the worker; new jobs are
   // refused from then on. Idempotent.
   void Stop();
+  // Stop() without the join: the running job is asked to stop and ends on its own. Stop()
+  // afterwards joins.
+  void RequestStop();
 
  private:
   struct Live {
@@ -84,17 +97,25 @@ class JobRunner {
   const Live* Conflict(const std::vector<std::string>& descriptors) const;
   // Records `record` (its end) in memory and in the database, and drops the live entry.
   void Finish(const storage::JobRecord& record);
+  // Moves the live entry of `record` to ended_ as `record`. Under mutex_.
+  void EndLocked(const storage::JobRecord& record);
+  // The job from live_ or ended_, or null. Under mutex_.
+  const storage::JobRecord* FindLocked(const std::string& job_id) const;
 
   storage::Database& database_;
   const IndexRegistry& registry_;
   const SearchRunner& runner_;
+  const int test_pause_after_;
   mutable std::mutex mutex_;
   // Notified on every change of a live job and when stopping.
   mutable std::condition_variable changed_;
-  std::map<std::string, Live> live_;  // queued and running jobs
-  std::deque<std::string> queue_;     // the queued ones, first to run first
+  std::map<std::string, Live> live_;      // queued and running jobs
+  std::deque<std::string> queue_;         // the queued ones, first to run first
+  std::deque<storage::JobRecord> ended_;  // the last kRecentlyEndedJobs ended, oldest first
+  std::string running_id_;                // the running job; empty when none runs
   bool stopping_ = false;
-  // The running job's should_stop: set by Cancel (for it) and Stop; cleared as a job starts.
+  // The running job's should_stop: set by Cancel (for running_id_ only) and Stop; cleared as a
+  // job starts.
   std::atomic<bool> stop_running_{false};
   std::thread worker_;  // last: started once the rest exists
 };

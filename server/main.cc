@@ -91,6 +91,8 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   app.add_flag("--health-needs-token", options->health_needs_token,
                "with a token file: the health service needs the token too");
   app.add_flag("--quiet", flags->quiet, "no per-request log lines");
+  // Hidden (no group): for tests only, see ServerOptions::test_job_pause_after.
+  app.add_option("--test-job-pause-after", options->test_job_pause_after)->group("");
   app.footer(
       "With --threads, further calls wait their turn (first come, first served, until their\n"
       "deadline); beyond --max-waiting they are refused with RESOURCE_EXHAUSTED. The token\n"

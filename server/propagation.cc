@@ -51,11 +51,14 @@ absl::Status CheckSearch(const SearchRequest& search, int dims) {
   return ValidateSearchParams(params, dims);
 }
 
-// Whether `a` overlaps `b` (same clip) by more than half of a's length.
+// Whether `a` and `b` (same clip) share more than half of the shorter one's frames: a long
+// range containing a short one overlaps it, whichever of the two is measured.
 bool OverlapsByHalf(const storage::LabelRecord& a, const storage::LabelRecord& b) {
   const int64_t shared =
       std::min(a.last_frame, b.last_frame) - std::max(a.first_frame, b.first_frame) + 1;
-  return 2 * shared > a.last_frame - a.first_frame + 1;
+  const int64_t shorter =
+      std::min(a.last_frame - a.first_frame + 1, b.last_frame - b.first_frame + 1);
+  return 2 * shared > shorter;
 }
 
 // A label's candidate ranges, before their values are known: value holds the label's.
@@ -91,9 +94,9 @@ absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& databas
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(registry, request.space));
   for (size_t i = 0; i < request.descriptors.size(); ++i) {
-    if (request.descriptors[i].empty()) {
-      return absl::InvalidArgumentError(absl::StrCat("descriptors[", i, "]: must not be empty"));
-    }
+    // The rules of a label's descriptor: a descriptor no label can carry has nothing to spread.
+    MOTIONDB_RETURN_IF_ERROR(
+        storage::CheckDescriptor(absl::StrCat("descriptors[", i, "]"), request.descriptors[i]));
   }
   if (request.descriptors.empty()) {
     MOTIONDB_ASSIGN_OR_RETURN(request.descriptors, database.ManualDescriptors());
@@ -204,6 +207,7 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
   on_progress(progress);
   std::vector<storage::LabelRecord> candidates;
   std::vector<double> last_scores;
+  absl::Status last_skip;
   for (const storage::LabelRecord& label : queries) {
     if (should_stop()) return absl::CancelledError("the job was stopped between queries");
     SearchRequest search = request.search;
@@ -215,15 +219,33 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
     if (found.ok()) {
       ++progress.queries;
       AddCandidates(label, *found, snapshot->record.space_id, job_id, &candidates);
-      if (!found->hits.empty()) last_scores.push_back(found->hits.back().score);
+      // Only full result lists with a positive last score calibrate s0: a short list's last
+      // result is not the k-th nearest, and would pull s0 toward the near matches.
+      if (static_cast<int>(found->hits.size()) == request.search.params.max_results &&
+          found->hits.back().score > 0) {
+        last_scores.push_back(found->hits.back().score);
+      }
     } else if (SkipsLabel(found.status())) {
+      // A space deleted while the job ran answers NOT_FOUND too: that ends the job.
+      if (absl::IsNotFound(found.status()) && !FindSpace(registry, request.space).ok()) {
+        return absl::NotFoundError(
+            absl::StrCat("space '", request.space, "' was deleted while the job ran"));
+      }
       ++progress.skipped;
+      last_skip = absl::Status(found.status().code(), absl::StrCat("label ", label.label_id, ": ",
+                                                                   found.status().message()));
     } else {
       return absl::Status(found.status().code(),
                           absl::StrCat("label ", label.label_id, ": ", found.status().message()));
     }
     ++progress.done;
     on_progress(progress);
+  }
+  if (progress.total > 0 && progress.skipped == progress.total) {
+    // Nothing was searched: an output would only delete the earlier one.
+    return absl::FailedPreconditionError(absl::StrCat(
+        "every one of the ", progress.total,
+        " labels was skipped, none could be a query (the last: ", last_skip.message(), ")"));
   }
   const double scale = ScoreScale(std::move(last_scores));
   for (storage::LabelRecord& candidate : candidates) {

@@ -32,7 +32,8 @@ struct PropagationRequest {
 };
 
 // Checks `request` and fills its descriptors when empty. NOT_FOUND for an unknown space;
-// INVALID_ARGUMENT naming the field for an empty descriptor or bad search parameters;
+// INVALID_ARGUMENT naming the field (descriptors[i]) for a descriptor no label can carry (empty,
+// over storage::kMaxDescriptorBytes, a control character) or bad search parameters;
 // FAILED_PRECONDITION for no descriptors given while no manual label exists.
 absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& database,
                                                       const IndexRegistry& registry,
@@ -54,13 +55,18 @@ PropagationTarget TargetOf(const storage::JobRecord& job);
 // s0 would mean different things in different spaces; s0 taken from the job's own searches in
 // that space makes f(s) = 1/2 mean "as far as a typical query's last result" everywhere.
 double SimilarityFactor(double score, double scale);
-// s0: the median, over the queries that found anything, of the score of their last (k-th)
-// result; 1 when there is none or it is 0 (every result then exact and f = 1 for them).
+// s0: the median, over the job's queries that returned all max_results hits with a positive
+// last score, of that last (k-th) score; 1 when there is none. It is the job's own scale: its
+// max_results, descriptors (which labels query) and tags (which clips are searched) move it, so
+// f(s) compares a result with that job's k-th results, not with a fixed distance of the space.
+
 double ScoreScale(std::vector<double> last_scores);
 
 // Of propagated candidates (any descriptors and clips), those to write: strongest first (then
-// lowest score), a candidate is dropped when it overlaps a kept one of its descriptor and clip,
-// or a `manual` label of its descriptor, by more than half of its own length. Kept in that order.
+// lowest score), a candidate is dropped when it shares more than half of the shorter range's
+// frames with a kept one of its descriptor and clip, or with a `manual` label of its descriptor
+// (so a long weaker range around a stronger short one, or over a manual one, is dropped too).
+// Kept in that order.
 std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
                                                 const std::vector<storage::LabelRecord>& manual);
 
@@ -72,7 +78,9 @@ struct PropagationProgress {
 
 // Runs the propagation of a resolved `request` as job `job_id` and returns its output (labels
 // and counts; output.job holds only the counts). `should_stop` is polled between queries and
-// inside each search (CANCELLED); `on_progress` is called after each query.
+// inside each search (CANCELLED); `on_progress` is called after each query. NOT_FOUND when the
+// space was deleted while the job ran; FAILED_PRECONDITION when every label was skipped (there
+// were some and none could be a query): a failed job leaves the earlier output as it was.
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
     const PropagationRequest& request, const std::string& job_id,

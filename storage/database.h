@@ -36,6 +36,10 @@
 
 namespace motiondb::storage {
 
+// INVALID_ARGUMENT naming `what` for a descriptor no label can carry: empty, over
+// kMaxDescriptorBytes, or holding a control character (the rules AddLabels applies).
+absl::Status CheckDescriptor(const std::string& what, const std::string& descriptor);
+
 struct DatabaseOptions {
   // Create the file (and its schema) when it does not exist.
   bool create_if_missing = true;

@@ -24,15 +24,16 @@ constexpr absl::string_view kJobColumns =
     "job_number, kind, state, parameters, done, total, queries, queries_skipped, "
     "labels_written, error, created_unix_ms, started_unix_ms, finished_unix_ms";
 
-// In the order of JobState; the schema's CHECK allows these only.
-constexpr absl::string_view kStateTexts[] = {"queued", "running",   "succeeded",
-                                             "failed", "cancelled", "interrupted"};
+absl::string_view StateText(JobState state) { return JobStateName(state); }
 
-absl::string_view StateText(JobState state) { return kStateTexts[static_cast<int>(state)]; }
-
+// The state JobStateName spells `text`; failed for any other text (the schema's CHECK allows
+// none, but a row edited by hand should not give an out-of-range enum).
 JobState StateOf(absl::string_view text) {
-  const auto* found = std::find(std::begin(kStateTexts), std::end(kStateTexts), text);
-  return static_cast<JobState>(found - std::begin(kStateTexts));
+  for (const JobState state : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
+                               JobState::kFailed, JobState::kCancelled, JobState::kInterrupted}) {
+    if (text == JobStateName(state)) return state;
+  }
+  return JobState::kFailed;
 }
 
 // The row number of "job-N"; nullopt for an id no job can have.
@@ -253,6 +254,14 @@ absl::StatusOr<int64_t> Database::FinishPropagation(const PropagationOutput& out
   }
   int64_t inserted = 0;
   MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
+    // The space may have been deleted while the job ran: its labels would then name no space.
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement space,
+                              db.Prepare("SELECT 1 FROM spaces WHERE space_id = ?1"));
+    MOTIONDB_ASSIGN_OR_RETURN(const bool space_exists, space.BindInt64(1, output.space_id).Step());
+    if (!space_exists) {
+      return absl::NotFoundError(
+          absl::StrCat("space ", output.space_id, " was deleted while the job ran"));
+    }
     MOTIONDB_RETURN_IF_ERROR(DeleteOldOutput(db, output));
     MOTIONDB_ASSIGN_OR_RETURN(inserted, InsertOutput(db, output, CreationTime(0)));
     JobRecord job = output.job;

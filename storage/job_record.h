@@ -16,6 +16,26 @@ namespace motiondb::storage {
 // process that ran the job ended first (a shutdown, a crash, kill -9).
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled, kInterrupted };
 
+// "queued", "running", "succeeded", "failed", "cancelled", "interrupted": the state as rows,
+// logs, errors and the CLI spell it.
+inline const char* JobStateName(JobState state) {
+  switch (state) {
+    case JobState::kQueued:
+      return "queued";
+    case JobState::kRunning:
+      return "running";
+    case JobState::kSucceeded:
+      return "succeeded";
+    case JobState::kFailed:
+      return "failed";
+    case JobState::kCancelled:
+      return "cancelled";
+    case JobState::kInterrupted:
+      return "interrupted";
+  }
+  return "unknown";
+}
+
 // True for the states a job never leaves.
 inline bool IsFinal(JobState state) {
   return state != JobState::kQueued && state != JobState::kRunning;

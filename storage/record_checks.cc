@@ -1,4 +1,5 @@
 #include "storage/internal/record_checks.h"
+#include "storage/database.h"
 
 #include <algorithm>
 #include <cmath>
@@ -145,6 +146,10 @@ absl::Status CheckLabel(const LabelRecord& label, size_t index) {
         absl::StrCat(item, ".score: ", label.score, " is not finite"));
   }
   return absl::OkStatus();
+}
+
+absl::Status CheckDescriptor(const std::string& what, const std::string& descriptor) {
+  return CheckName(what, descriptor, kMaxDescriptorBytes);
 }
 
 }  // namespace motiondb::storage

@@ -618,8 +618,6 @@ TEST_F(CliServerTest, SpaceListAndShowCountTheClipsIngestedSinceTheBuild) {
   EXPECT_EQ(nlohmann::json::parse(r.out)["clips"], 1);
 }
 
-// Labels on the fixture's clip (54 frames at 30 fps): added by id or name, in frames or seconds;
-// listed, found, deleted; the server's complaints told in the command's words.
 // A propagation on the fixture's clip: started and waited for, listed, shown, and the errors of
 // each job command in its own words.
 TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
@@ -681,6 +679,8 @@ TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
   }
 }
 
+// Labels on the fixture's clip (54 frames at 30 fps): added by id or name, in frames or seconds;
+// listed, found, deleted; the server's complaints told in the command's words.
 TEST_F(CliServerTest, LabelAddListFindDeleteAndTheirErrors) {
   testing::CommandResult r =
       Remote({"label", "add", "walk54:10-20", "step", "--value", "0.8", "--json"});

@@ -2266,7 +2266,8 @@ TEST_F(ServerTest, PropagationLabelsSimilarRangesAndReRunsReplaceItsOutput) {
   std::vector<v1::Job> seen;
   for (v1::Job job; reader->Read(&job);) seen.push_back(job);
   ASSERT_TRUE(reader->Finish().ok());
-  ASSERT_GE(seen.size(), 2u);
+  // One message at least (a fast job may have ended before the watch began); the last final.
+  ASSERT_FALSE(seen.empty());
   const v1::Job& ended = seen.back();
   ASSERT_EQ(ended.state(), v1::JOB_STATE_SUCCEEDED) << ended.error();
   for (size_t i = 0; i + 1 < seen.size(); ++i) EXPECT_FALSE(Ended(seen[i]));
@@ -2309,7 +2310,8 @@ TEST_F(ServerTest, PropagationLabelsSimilarRangesAndReRunsReplaceItsOutput) {
       if (other.label_id() == label.label_id() || other.clip_id() != label.clip_id()) continue;
       const int64_t shared = std::min(label.last_frame(), other.last_frame()) -
                              std::max(label.first_frame(), other.first_frame()) + 1;
-      EXPECT_LE(2 * shared, std::max(label.last_frame() - label.first_frame() + 1,
+      // Of the shorter one: a long range around a short stronger one is not kept beside it.
+      EXPECT_LE(2 * shared, std::min(label.last_frame() - label.first_frame() + 1,
                                      other.last_frame() - other.first_frame() + 1));
     }
   }
@@ -2374,6 +2376,12 @@ TEST_F(ServerTest, BadPropagationsGetTheirStatusCodes) {
   status = start(request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("descriptors[1]"));
+  // Descriptors no label could carry: too long, a control character.
+  for (const std::string& bad : {std::string(257, 'd'), std::string("st\x1b[2Jep")}) {
+    status = start(Propagation({"step", bad}));
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("descriptors[1]"));
+  }
   request = Propagation({"step"});
   request.mutable_search()->set_max_results(0);
   status = start(request);
@@ -2432,17 +2440,16 @@ bool Running(const v1::Job& job) {
 }
 
 TEST_F(ServerTest, RunningJobsRefuseOverlapsAreCancelledAndWatchedOutsideTheCallGate) {
-  // One call at a time: a watch that held its place would block every other call.
-  ServerProcess* server = StartServer({"--threads", "1"});
+  // One call at a time: a watch that held its place would block every other call. The job
+  // waits after its first label until cancelled, so it is seen running on any machine.
+  ServerProcess* server = StartServer({"--threads", "1", "--test-job-pause-after", "1"});
   ASSERT_NE(server, nullptr);
   Client client(testing::InsecureChannel(server->address()));
   const std::vector<int64_t> ids = IngestHumanoid(client);
   CreateHumanoidSpace(client);
-  LabelManyRanges(client, ids, 400);
+  LabelManyRanges(client, ids, 20);
   AddLabelsOrFail(client, {FrameLabel(ids[0], 0, 50, "calm", 1.0)});
-  v1::StartPropagationRequest request = Propagation({"long", "calm"});
-  request.mutable_search()->set_exact(true);  // slower queries: a longer job
-  const v1::Job started = StartOrFail(client, request);
+  const v1::Job started = StartOrFail(client, Propagation({"long", "calm"}));
 
   std::vector<v1::Job> watched;
   grpc::Status watch_status;
@@ -2469,8 +2476,15 @@ TEST_F(ServerTest, RunningJobsRefuseOverlapsAreCancelledAndWatchedOutsideTheCall
   v1::Job cancelled;
   const grpc::Status status = client.jobs().CancelJob(client.Context().get(), cancel, &cancelled);
   ASSERT_TRUE(status.ok()) << status.error_message();
-  EXPECT_EQ(cancelled.state(), v1::JOB_STATE_CANCELLED);
-  EXPECT_LT(cancelled.done(), cancelled.total());
+  // Answered at once, the job as it is: still running (it stops at its next check) or ended.
+  EXPECT_THAT(cancelled.state(), ::testing::AnyOf(v1::JOB_STATE_RUNNING, v1::JOB_STATE_CANCELLED));
+  const v1::Job stopped = PollJob(client, started.job_id());
+  EXPECT_EQ(stopped.state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_LT(stopped.done(), stopped.total());
+  // A second cancel finds it ended.
+  const grpc::Status again = client.jobs().CancelJob(client.Context().get(), cancel, &cancelled);
+  EXPECT_EQ(again.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(again.error_message(), HasSubstr("cancelled"));
   watcher.join();
   EXPECT_TRUE(watch_status.ok()) << watch_status.error_message();
   ASSERT_FALSE(watched.empty());
@@ -2495,6 +2509,14 @@ TEST_F(ServerTest, KillDuringAJobLeavesItInterruptedWithoutOutputAndItRunsAgain)
     ASSERT_EQ(first.state(), v1::JOB_STATE_SUCCEEDED) << first.error();
     earlier = first.labels_written();
     ASSERT_GT(earlier, 0);
+  }
+  // Again with the job held after its first label, so that the kill finds it running on any
+  // machine.
+  EXPECT_EQ(server->Stop(SIGTERM), 0);
+  server = StartServer({"--test-job-pause-after", "1"});
+  ASSERT_NE(server, nullptr);
+  {
+    Client client(testing::InsecureChannel(server->address()));
     job_id = StartOrFail(client, Propagation({"long"})).job_id();
     ASSERT_EQ(PollJob(client, job_id, Running).state(), v1::JOB_STATE_RUNNING);
   }

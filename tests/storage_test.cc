@@ -1459,8 +1459,6 @@ TEST_F(StorageTest, LabelBatchesAreAllOrNothing) {
   EXPECT_EQ(testing::ReadFileOrDie(path_), file_before);
 }
 
-// Deletes by id and by filter; a manual label takes those propagated from it, a clip its
-// labels; a stopped write changes nothing.
 StorageSpaceTest::LabelledLibrary StorageSpaceTest::InsertLabelledLibrary() {
   LabelledLibrary library;
   library.walk = Insert(Named("walk"), walk_);
@@ -1474,6 +1472,8 @@ StorageSpaceTest::LabelledLibrary StorageSpaceTest::InsertLabelledLibrary() {
   return library;
 }
 
+// Deletes by id and by filter; a manual label takes those propagated from it, a clip its
+// labels; a stopped write changes nothing.
 TEST_F(StorageSpaceTest, LabelDeletesCascadeAndStoppedLabelWritesChangeNothing) {
   const auto [walk, wave, space_id, manual] = InsertLabelledLibrary();
   LabelRecord found = Manual(wave, 5, 15, "kick", 0.7);
@@ -1659,6 +1659,14 @@ TEST_F(StorageSpaceTest, FinishPropagationReplacesItsDescriptorsOutputInOneTrans
   ASSERT_TRUE(Db().DeleteLabels(std::vector<int64_t>{manual[1]}).ok());
   EXPECT_EQ(*Db().FinishPropagation(orphan), 1);
   EXPECT_EQ(Db().ListLabels({}, {.origin = LabelOrigin::kPropagated})->labels.size(), 1u);
+
+  // A space deleted while the job ran: refused (not a foreign-key error), the job row unchanged.
+  PropagationOutput gone = output({"kick"}, 1);
+  ASSERT_TRUE(Db().DeleteSpace("body").ok());
+  const absl::Status no_space = Db().FinishPropagation(gone).status();
+  EXPECT_EQ(no_space.code(), absl::StatusCode::kNotFound) << no_space;
+  EXPECT_THAT(std::string(no_space.message()), HasSubstr("deleted while the job ran"));
+  EXPECT_EQ(Db().GetJob(gone.job.job_id)->state, JobState::kQueued);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "absl/strings/str_cat.h"
+
 #include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
 
@@ -56,6 +58,17 @@ grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
 grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context,
                                       const v1::WatchJobRequest* request,
                                       grpc::ServerWriter<v1::Job>* writer) {
+  if (watches_.fetch_add(1) >= kMaxJobWatches) {
+    watches_.fetch_sub(1);
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        absl::StrCat(kMaxJobWatches,
+                                     " job watches are open, the most the server keeps; watch "
+                                     "again later or poll GetJob"));
+  }
+  struct Release {
+    std::atomic<int>& count;
+    ~Release() { count.fetch_sub(1); }
+  } release{watches_};
   absl::StatusOr<storage::JobRecord> job;
   const grpc::Status admitted = gate_.Run(context, [&]() -> grpc::Status {
     job = jobs_.Get(request->job_id());
@@ -72,7 +85,17 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context,
     const storage::JobRecord seen = *job;
     job = jobs_.WaitForChange(request->job_id(), seen, kWatchPoll);
     if (!job.ok()) return ToGrpcStatus(job.status());
-    if (SameProgress(*job, seen)) continue;  // the wait timed out
+    if (SameProgress(*job, seen)) {
+      // The wait timed out, or the job ended here while its row could not say so (a failed
+      // write leaves it queued or running there): not live means ended.
+      if (jobs_.IsLive(request->job_id())) continue;
+      job = jobs_.Get(request->job_id());  // its end, if it came after the wait
+      if (!job.ok() || SameProgress(*job, seen)) return grpc::Status::OK;
+      message.Clear();
+      ToProto(*job, &message);
+      writer->Write(message);
+      return grpc::Status::OK;
+    }
     message.Clear();
     ToProto(*job, &message);
     if (!writer->Write(message)) {

@@ -82,7 +82,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
           .count()));
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
-  s.jobs = std::make_unique<JobRunner>(*s.database, s.registry, *s.runner);
+  s.jobs =
+      std::make_unique<JobRunner>(*s.database, s.registry, *s.runner, options.test_job_pause_after);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.watchdog =
@@ -139,9 +140,12 @@ void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
   if (grpc::HealthCheckServiceInterface* health = state_->server->GetHealthCheckService()) {
     health->SetServingStatus(false);
   }
-  // Jobs end first, as interrupted, so that their watchers see the end before the calls close.
-  state_->jobs->Stop();
+  // Jobs are asked to end first, as interrupted, so that their watchers see the end before the
+  // calls close; the worker is joined only after the server shut down, so that a job slow to
+  // notice does not hold the shutdown past its deadline.
+  state_->jobs->RequestStop();
   state_->server->Shutdown(deadline);
+  state_->jobs->Stop();
 }
 
 void MotionDbServer::Wait() { state_->server->Wait(); }

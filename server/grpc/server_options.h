@@ -35,6 +35,10 @@ struct ServerOptions {
   // With a token: the health service needs it too (--health-needs-token); by default probes
   // answer without one.
   bool health_needs_token = false;
+  // For tests only (--test-job-pause-after, hidden): a running job waits after this many of its
+  // labels until it is cancelled or the server stops, so that tests see it running whatever
+  // the machine's speed; -1: never.
+  int test_job_pause_after = -1;
   // PEM certificate chain and private key: both serve TLS, neither plain text (read from
   // --tls-cert and --tls-key).
   std::string tls_cert_pem;
