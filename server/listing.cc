@@ -32,10 +32,13 @@ absl::StatusOr<storage::Page> StoragePage(const PageRequest& page) {
   return stored;
 }
 
-absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
+absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database,
                                             const ClipListRequest& request) {
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
-  storage::ClipFilter filter{.tag = request.tag, .name_contains = request.name_contains};
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(request.page));
+  storage::ClipFilter filter{.tag = request.tag,
+                             .name_contains = request.name_contains,
+                             .skeleton_id = request.skeleton_id,
+                             .descriptor = request.descriptor};
   MOTIONDB_ASSIGN_OR_RETURN(filter.order, ClipOrderOf(request.sort));
   return database.ListClips(stored, filter);
 }

@@ -22,15 +22,18 @@ struct PageRequest {
 // `page` as storage::Database's listings take it: the size resolved as above.
 absl::StatusOr<storage::Page> StoragePage(const PageRequest& page);
 
-// A clip listing's filters and order as the API gives them: sort is "id" (or empty), "name" or
-// "created"; another is INVALID_ARGUMENT naming `sort`.
+// A clip listing's page, filters and order as the API gives them: sort is "id" (or empty),
+// "name" or "created"; another is INVALID_ARGUMENT naming `sort`.
 struct ClipListRequest {
+  PageRequest page;
   std::string tag;
   std::string name_contains;
   std::string sort;
+  int64_t skeleton_id = 0;  // 0: any
+  std::string descriptor;   // clips carrying a label of it; empty: any
 };
 
-absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database, const PageRequest& page,
+absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database,
                                             const ClipListRequest& request);
 
 // A skeleton's name for people: its root joint's and its first clip's, "Hips (01_01)"; the

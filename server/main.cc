@@ -2,7 +2,8 @@
 //
 //   motiondb-server [--db ./motiondb.sqlite] [--listen 127.0.0.1:50051] [--threads N]
 //       [--max-message-mb 256] [--max-bvh-mb 1024] [--auth-token-file FILE]
-//       [--tls-cert CERT.pem --tls-key KEY.pem] [--quiet]
+//       [--tls-cert CERT.pem --tls-key KEY.pem] [--http 127.0.0.1:8080|off] [--web-root DIR]
+//       [--quiet]
 //
 // (`--help` lists them with their defaults; they are parsed with CLI11.)
 // Runs until SIGTERM or SIGINT, then stops accepting calls, lets running ones finish (up to 10 s)
@@ -25,6 +26,7 @@
 #include "server/grpc/motiondb_server.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
+#include "server/http/http_server.h"
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
@@ -44,6 +46,17 @@ struct ServerFlags {
   std::string auth_token_file, tls_cert, tls_key;
   bool quiet = false;
 };
+
+void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http) {
+  app.add_option("--http", http->listen,
+                 "serve the JSON API, /metrics and the web UI over HTTP here (off: not at all; "
+                 "the token and TLS of gRPC apply)")
+      ->type_name("HOST:PORT")
+      ->capture_default_str();
+  app.add_option("--web-root", http->web_root, "the built web UI served at /")
+      ->type_name("DIR")
+      ->default_str(motiondb::server::DefaultWebRoot());
+}
 
 void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFlags* flags) {
   const CLI::Validator existing_file = motiondb::cli::ExistingFile();
@@ -147,6 +160,8 @@ int main(int argc, char** argv) {
   motiondb::server::ServerOptions options;
   ServerFlags flags;
   AddFlags(app, &options, &flags);
+  motiondb::server::HttpOptions http_options;
+  AddHttpFlags(app, &http_options);
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
@@ -159,11 +174,25 @@ int main(int argc, char** argv) {
     std::cerr << "motiondb-server: " << server.status().message() << "\n";
     return 1;
   }
+  std::unique_ptr<motiondb::server::HttpServer> http;
+  if (http_options.listen != "off") {
+    absl::StatusOr<std::unique_ptr<motiondb::server::HttpServer>> started =
+        motiondb::server::HttpServer::Start(http_options, **server);
+    if (!started.ok()) {
+      std::cerr << "motiondb-server: " << started.status().message() << "\n";
+      return 1;
+    }
+    http = *std::move(started);
+  }
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);
   motiondb::server::LogLine(absl::StrCat(
       "received ", signal_number == SIGTERM ? "SIGTERM" : "SIGINT", "; shutting down"));
+  // gRPC first: the HTTP face's calls in progress finish with it, and later ones are refused
+  // (UNAVAILABLE, 503) until the HTTP listener stops.
   (*server)->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
+  if (http) http->Stop();
+  http.reset();
   (*server)->Wait();
   server->reset();
   motiondb::server::LogLine("stopped");

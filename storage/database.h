@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -129,12 +130,15 @@ struct ClipFilter {
   // The {} initialisers let callers name only the fields they set without -Wextra warnings.
   std::string tag{};                 // only clips carrying it; empty: any
   std::string name_contains{};       // only clips whose name holds it (bytes, case-sensitive)
+  int64_t skeleton_id = 0;           // only clips of this skeleton; 0: any
+  std::string descriptor{};          // only clips carrying a label of it; empty: any
   ClipOrder order = ClipOrder::kId;  // ties (created) in id order
 };
 
 struct ClipPage {
   std::vector<ClipRecord> clips;
   std::string next_page_token;  // empty on the last page
+  int64_t total_size = 0;       // clips the filter takes, on every page
 };
 
 // A skeleton as a listing shows it.
@@ -188,9 +192,10 @@ class Database {
   // Clips in id order; optionally only those carrying `tag`. page_size 0 means 100; outside
   // 0-1000, or a malformed page_token: INVALID_ARGUMENT.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const std::string& tag = "");
-  // The same, filtered and ordered by `filter`, in one query. A page token holds the last
-  // clip's sort key and id, so pages stay stable while clips come and go; a token of another
-  // order is INVALID_ARGUMENT.
+  // The same, filtered and ordered by `filter`, in one read transaction, with the number of
+  // clips the filter takes. A page token holds the last clip's sort key and id, so pages stay
+  // stable while clips come and go; a token of another order is INVALID_ARGUMENT, as are a bad
+  // tag or descriptor (naming the field) and a negative skeleton_id.
   absl::StatusOr<ClipPage> ListClips(const Page& page, const ClipFilter& filter);
   // Deletes the clip, its projections and labels. NOT_FOUND when absent.
   absl::Status DeleteClip(int64_t clip_id, const WriteOptions& write = {});
@@ -256,6 +261,8 @@ class Database {
   absl::StatusOr<JobRecord> GetJob(const std::string& job_id);  // NOT_FOUND
   // Newest first; Page as ListClips takes it (its token is the last job's number).
   absl::StatusOr<JobPage> ListJobs(const Page& page);
+  // How many job rows are in each state (states without jobs are absent).
+  absl::StatusOr<std::map<JobState, int64_t>> CountJobs();
   // A propagation job's output and its final row, in one transaction: the propagated labels of
   // output.descriptors found in output.space_id are deleted, output.labels inserted (those whose
   // clip or source label was deleted meanwhile are left out), and output.job written with

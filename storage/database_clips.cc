@@ -382,33 +382,80 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const std::string
   return ListClips(page, ClipFilter{.tag = tag});
 }
 
+namespace {
+
+// The filter's conditions on the clips `c`, after a WHERE: ?3 the tag, ?4 the name part, ?6 the
+// descriptor, ?7 the skeleton ("1" for none, so that callers may always append AND ...).
+std::string ClipFilterSql(const ClipFilter& filter) {
+  std::string sql = "1";
+  if (!filter.tag.empty()) {
+    absl::StrAppend(&sql,
+                    " AND EXISTS (SELECT 1 FROM clip_tags t WHERE t.clip_id = c.clip_id "
+                    "AND t.tag = ?3)");
+  }
+  if (!filter.name_contains.empty()) absl::StrAppend(&sql, " AND instr(c.name, ?4) > 0");
+  // labels_by_clip serves the lookup per clip; labels_by_descriptor would serve the other way.
+  if (!filter.descriptor.empty()) {
+    absl::StrAppend(&sql,
+                    " AND EXISTS (SELECT 1 FROM labels l WHERE l.clip_id = c.clip_id "
+                    "AND l.descriptor = ?6)");
+  }
+  if (filter.skeleton_id != 0) absl::StrAppend(&sql, " AND c.skeleton_id = ?7");
+  return sql;
+}
+
+void BindClipFilter(const ClipFilter& filter, SqliteStatement& query) {
+  if (!filter.tag.empty()) query.BindText(3, filter.tag);
+  if (!filter.name_contains.empty()) query.BindText(4, filter.name_contains);
+  if (!filter.descriptor.empty()) query.BindText(6, filter.descriptor);
+  if (filter.skeleton_id != 0) query.BindInt64(7, filter.skeleton_id);
+}
+
+absl::Status CheckClipFilter(const ClipFilter& filter) {
+  if (!filter.tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", filter.tag, kMaxTagBytes));
+  if (!filter.descriptor.empty()) {
+    MOTIONDB_RETURN_IF_ERROR(CheckDescriptor("descriptor", filter.descriptor));
+  }
+  if (filter.skeleton_id < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("skeleton_id: ", filter.skeleton_id, " is negative (0: any skeleton)"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<int64_t> CountClips(SqliteConnection& db, const ClipFilter& filter) {
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement count,
+      db.Prepare(absl::StrCat("SELECT count(*) FROM clips c WHERE ", ClipFilterSql(filter))));
+  BindClipFilter(filter, count);
+  MOTIONDB_ASSIGN_OR_RETURN(const bool row, count.Step());
+  return row ? count.ColumnInt64(0) : 0;
+}
+
+}  // namespace
+
 absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter& filter) {
   MOTIONDB_ASSIGN_OR_RETURN(const int page_size, CheckPageSize(page.page_size));
   MOTIONDB_ASSIGN_OR_RETURN(const PageStart start, ParsePageToken(filter.order, page.page_token));
-  if (!filter.tag.empty()) MOTIONDB_RETURN_IF_ERROR(CheckName("tag", filter.tag, kMaxTagBytes));
+  MOTIONDB_RETURN_IF_ERROR(CheckClipFilter(filter));
 
-  // ?1 the last id, ?2 the limit, ?3 the tag, ?4 the name part, ?5 the last sort key. The id
-  // breaks ties of the key, so (key, id) orders every clip once.
+  // ?1 the last id, ?2 the limit, ?5 the last sort key, the filter's own (ClipFilterSql). The
+  // id breaks ties of the key, so (key, id) orders every clip once.
   const absl::string_view key = filter.order == ClipOrder::kName      ? "c.name"
                                 : filter.order == ClipOrder::kCreated ? "c.created_unix_ms"
                                                                       : "";
-  std::string sql = absl::StrCat("SELECT ", kClipRecordColumns, " FROM clips c");
-  if (!filter.tag.empty()) {
-    absl::StrAppend(&sql, " JOIN clip_tags t ON t.clip_id = c.clip_id AND t.tag = ?3");
-  }
-  absl::StrAppend(&sql, key.empty() ? " WHERE c.clip_id > ?1"
-                                    : absl::StrCat(" WHERE (", key, ", c.clip_id) > (?5, ?1)"));
-  if (!filter.name_contains.empty()) absl::StrAppend(&sql, " AND instr(c.name, ?4) > 0");
-  absl::StrAppend(&sql, " ORDER BY ", key.empty() ? "" : absl::StrCat(key, ", "),
-                  "c.clip_id LIMIT ?2");
+  const std::string sql = absl::StrCat(
+      "SELECT ", kClipRecordColumns, " FROM clips c WHERE ",
+      key.empty() ? "c.clip_id > ?1" : absl::StrCat("(", key, ", c.clip_id) > (?5, ?1)"), " AND ",
+      ClipFilterSql(filter), " ORDER BY ", key.empty() ? "" : absl::StrCat(key, ", "),
+      "c.clip_id LIMIT ?2");
 
   ClipPage result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query, db.Prepare(sql));
     // One row more than the page says whether another page follows.
     query.BindInt64(1, start.clip_id).BindInt64(2, page_size + 1);
-    if (!filter.tag.empty()) query.BindText(3, filter.tag);
-    if (!filter.name_contains.empty()) query.BindText(4, filter.name_contains);
+    BindClipFilter(filter, query);
     if (filter.order == ClipOrder::kName) query.BindText(5, start.key);
     if (filter.order == ClipOrder::kCreated) {
       // The first page starts below every time; a later one after the token's.
@@ -423,6 +470,8 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter&
       result.clips.pop_back();
       result.next_page_token = PageToken(filter.order, result.clips.back());
     }
+    // In the same read transaction: the total agrees with the page.
+    MOTIONDB_ASSIGN_OR_RETURN(result.total_size, CountClips(db, filter));
     return absl::OkStatus();
   }));
   return result;

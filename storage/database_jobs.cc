@@ -216,6 +216,21 @@ absl::StatusOr<JobRecord> Database::GetJob(const std::string& job_id) {
   return job;
 }
 
+absl::StatusOr<std::map<JobState, int64_t>> Database::CountJobs() {
+  std::map<JobState, int64_t> counts;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    // jobs_by_state serves the grouping: no scan of the parameters.
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
+                              db.Prepare("SELECT state, count(*) FROM jobs GROUP BY state"));
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
+      if (!row) return absl::OkStatus();
+      counts[StateOf(query.ColumnText(0))] += query.ColumnInt64(1);
+    }
+  }));
+  return counts;
+}
+
 absl::StatusOr<JobPage> Database::ListJobs(const Page& page) {
   MOTIONDB_ASSIGN_OR_RETURN(const int page_size, CheckPageSize(page.page_size));
   int64_t before = INT64_MAX;

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -45,7 +46,11 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
        ("motiondb_server_" + std::to_string(::getpid()) + "_" + std::to_string(starts++) + ".log"))
           .string();
   std::vector<std::string> argv_strings = {ServerPath(), "--listen", "127.0.0.1:0"};
+  const bool http_given = std::find(args.begin(), args.end(), "--http") != args.end();
+  if (!http_given) argv_strings.insert(argv_strings.end(), {"--http", "127.0.0.1:0"});
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  const auto http = std::find(argv_strings.begin(), argv_strings.end(), "--http");
+  const bool http_off = http + 1 < argv_strings.end() && http[1] == "off";
   std::vector<char*> argv;
   for (std::string& arg : argv_strings) argv.push_back(arg.data());
   argv.push_back(nullptr);
@@ -66,12 +71,15 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
     return false;
   }
   const std::regex port_line("\\(port ([0-9]+)\\)");
+  const std::regex http_port_line("\\(http port ([0-9]+)\\)");
   const auto give_up = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < give_up) {
-    std::smatch match;
+    std::smatch match, http_match;
     const std::string log = Log();
-    if (std::regex_search(log, match, port_line)) {
+    if (std::regex_search(log, match, port_line) &&
+        (http_off || std::regex_search(log, http_match, http_port_line))) {
       port_ = std::stoi(match[1]);
+      http_port_ = http_off ? 0 : std::stoi(http_match[1]);
       return true;
     }
     int status = 0;

@@ -1,6 +1,7 @@
-// Runs the real motiondb-server binary for integration tests and the server benchmark: on a
-// free loopback port (the server picks it, --listen 127.0.0.1:0, and logs it), with its stderr
-// captured to a file in the temporary directory, and stopped by a signal like an operator would.
+// Runs the real motiondb-server binary for integration tests and the server benchmark: on free
+// loopback ports (the server picks them, --listen 127.0.0.1:0 and --http 127.0.0.1:0, and logs
+// them), with its stderr captured to a file in the temporary directory, and stopped by a signal
+// like an operator would.
 #ifndef MOTIONDB_TESTING_SERVER_PROCESS_H_
 #define MOTIONDB_TESTING_SERVER_PROCESS_H_
 
@@ -23,8 +24,9 @@ class ServerProcess {
   // Kills a server still running (SIGKILL): a failed test must not leave it behind.
   ~ServerProcess();
 
-  // Starts the server with --listen 127.0.0.1:0 and `args`, and waits until it logs its port
-  // (false, with the log in `error`, when it exits or takes longer than `timeout`).
+  // Starts the server with --listen 127.0.0.1:0, --http 127.0.0.1:0 (unless `args` hold an
+  // --http of their own) and `args`, and waits until it logs its ports (false, with the log in
+  // `error`, when it exits or takes longer than `timeout`).
   bool Start(const std::vector<std::string>& args, std::string* error,
              std::chrono::seconds timeout = std::chrono::seconds(60));
   // Sends `signal` and waits for the exit; returns the exit code, or 128 + the signal that
@@ -35,12 +37,15 @@ class ServerProcess {
   pid_t pid() const { return pid_; }
   int port() const { return port_; }
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  // The HTTP face's port; 0 with --http off.
+  int http_port() const { return http_port_; }
   // Everything the server wrote to stderr so far.
   std::string Log() const;
 
  private:
   pid_t pid_ = -1;
   int port_ = 0;
+  int http_port_ = 0;
   std::string log_path_;
 };
 

@@ -5,6 +5,7 @@
 
 #include "server/clip_export.h"
 #include "server/clip_ingest.h"
+#include "server/clip_poses.h"
 #include "server/grpc/call_context.h"
 #include "server/grpc/proto_conversion.h"
 #include "server/grpc/status_conversion.h"
@@ -29,6 +30,7 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
     const absl::StatusOr<IngestOutcome> outcome =
         IngestUpload(catalog_, *ingest, request->bvh(), limits_, StopWhenCallEnds(context));
     if (!outcome.ok()) return ToGrpcStatus(ExplainStop(outcome.status(), context));
+    metrics_.CountIngest(*outcome);
     ToProto(*outcome, response);
     return grpc::Status::OK;
   });
@@ -54,6 +56,7 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
   MOTIONDB_ASSIGN_OR_RETURN(
       const IngestOutcome outcome,
       IngestUpload(catalog_, upload.request, upload.bvh, limits_, should_stop));
+  metrics_.CountIngest(outcome);
   ToProto(outcome, response);
   return absl::OkStatus();
 }
@@ -71,11 +74,20 @@ grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
                                         v1::ListClipsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::ClipPage> page =
-        server::ListClips(database_, {request->page_size(), request->page_token()},
-                          {request->tag(), request->name_contains(), request->sort()});
+        server::ListClips(database_, FromProto(*request));
     if (!page.ok()) return ToGrpcStatus(page.status());
-    for (const storage::ClipRecord& record : page->clips) ToProto(record, response->add_clips());
-    response->set_next_page_token(page->next_page_token);
+    ToProto(*page, response);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::Status ClipServiceImpl::GetClipPoses(grpc::ServerContext* context,
+                                           const v1::GetClipPosesRequest* request,
+                                           v1::ClipPoses* response) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    const absl::StatusOr<ClipPoses> poses = ReadClipPoses(database_, FromProto(*request));
+    if (!poses.ok()) return ToGrpcStatus(poses.status());
+    ToProto(*poses, response);
     return grpc::Status::OK;
   });
 }

@@ -1,4 +1,4 @@
-// motiondb.v1.ClipService: ingest, list, get, update, delete and export clips.
+// motiondb.v1.ClipService: ingest, list, get, update, delete and export clips, and their poses.
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
@@ -11,6 +11,7 @@
 #include "server/clip_ingest.h"
 #include "server/grpc/call_gate.h"
 #include "server/grpc/stream_watchdog.h"
+#include "server/server_metrics.h"
 #include "server/upload.h"
 #include "server/upload_budget.h"
 #include "storage/database.h"
@@ -22,12 +23,14 @@ class ClipServiceImpl final : public v1::ClipService::Service {
   // `budget` and `watchdog` bound the ingests in progress (server/upload_budget.h,
   // server/grpc/stream_watchdog.h).
   ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits,
-                  UploadBudget& budget, StreamWatchdog& watchdog, CallGate& gate)
+                  UploadBudget& budget, StreamWatchdog& watchdog, ServerMetrics& metrics,
+                  CallGate& gate)
       : database_(database),
         catalog_(catalog),
         limits_(limits),
         budget_(budget),
         watchdog_(watchdog),
+        metrics_(metrics),
         gate_(gate) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
@@ -45,6 +48,8 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                           v1::Clip* response) override;
   grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
                           v1::ExportClipResponse* response) override;
+  grpc::Status GetClipPoses(grpc::ServerContext* context, const v1::GetClipPosesRequest* request,
+                            v1::ClipPoses* response) override;
   grpc::Status ListSkeletons(grpc::ServerContext* context, const v1::ListSkeletonsRequest* request,
                              v1::ListSkeletonsResponse* response) override;
 
@@ -58,6 +63,7 @@ class ClipServiceImpl final : public v1::ClipService::Service {
   UploadLimits limits_;
   UploadBudget& budget_;
   StreamWatchdog& watchdog_;
+  ServerMetrics& metrics_;
   CallGate& gate_;
 };
 

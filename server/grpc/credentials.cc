@@ -16,6 +16,7 @@ absl::string_view SliceView(const grpc_slice& slice) {
 struct TokenCheck {
   std::string token;
   bool health_needs_token;
+  RequestLog* log;
 
   // grpc_auth_metadata_processor::process. Runs on a gRPC thread for each new call; it does not
   // block, so it answers at once (the core allows calling `done` synchronously).
@@ -33,15 +34,13 @@ struct TokenCheck {
         authorized |= BearerTokenMatches(SliceView(metadata[i].value), check->token);
       }
     }
-    if (!check->health_needs_token && absl::StartsWith(method, "/grpc.health.v1.Health/")) {
-      authorized = true;
-    }
+    if (!MethodNeedsToken(method, check->health_needs_token)) authorized = true;
     if (authorized) {
       done(user_data, nullptr, 0, nullptr, 0, GRPC_STATUS_OK, nullptr);
       return;
     }
     // The call never reaches a service, so the request logger's interceptor does not see it.
-    LogRequest(method, grpc::StatusCode::UNAUTHENTICATED, 0.0, "");
+    check->log->Record(kGrpcFace, method, grpc::StatusCode::UNAUTHENTICATED, 0.0, "");
     done(user_data, nullptr, 0, nullptr, 0, GRPC_STATUS_UNAUTHENTICATED,
          "missing or wrong bearer token: send the metadata 'authorization: Bearer <token>'");
   }
@@ -62,11 +61,11 @@ class CoreServerCredentials : public grpc::ServerCredentials {
     // Not used: the token check is attached in C (RequireBearerToken).
   }
 
-  void RequireBearerToken(const std::string& token, bool health_needs_token) {
+  void RequireBearerToken(const std::string& token, bool health_needs_token, RequestLog& log) {
     grpc_auth_metadata_processor processor{};
     processor.process = &TokenCheck::Process;
     processor.destroy = &TokenCheck::Destroy;
-    processor.state = new TokenCheck{token, health_needs_token};
+    processor.state = new TokenCheck{token, health_needs_token, &log};
     grpc_server_credentials_set_auth_metadata_processor(credentials_, processor);
   }
 
@@ -79,6 +78,10 @@ class CoreServerCredentials : public grpc::ServerCredentials {
 };
 
 }  // namespace
+
+bool MethodNeedsToken(absl::string_view method, bool health_needs_token) {
+  return health_needs_token || !absl::StartsWith(method, "/grpc.health.v1.Health/");
+}
 
 bool BearerTokenMatches(absl::string_view header, absl::string_view token) {
   constexpr absl::string_view kScheme = "bearer ";
@@ -99,7 +102,7 @@ bool BearerTokenMatches(absl::string_view header, absl::string_view token) {
 
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     const std::string& tls_cert_pem, const std::string& tls_key_pem,
-    const std::string& bearer_token, bool health_needs_token) {
+    const std::string& bearer_token, bool health_needs_token, RequestLog& log) {
   if (tls_cert_pem.empty() != tls_key_pem.empty()) {
     return absl::InvalidArgumentError(
         "TLS needs both a certificate and a private key (--tls-cert and --tls-key)");
@@ -117,7 +120,9 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     }
   }
   auto credentials = std::make_shared<CoreServerCredentials>(core);
-  if (!bearer_token.empty()) credentials->RequireBearerToken(bearer_token, health_needs_token);
+  if (!bearer_token.empty()) {
+    credentials->RequireBearerToken(bearer_token, health_needs_token, log);
+  }
   return credentials;
 }
 

@@ -17,6 +17,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "server/grpc/request_logger.h"
 
 namespace motiondb::server {
 
@@ -24,9 +25,14 @@ namespace motiondb::server {
 // alone); `bearer_token` empty means no authentication. With a token, the health service
 // (grpc.health.v1.Health) answers without one unless `health_needs_token`: probes
 // (Kubernetes', load balancers') carry no credentials, and health says nothing about the data.
+// Refused calls are told to `log`, which must outlive the credentials.
 absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
     const std::string& tls_cert_pem, const std::string& tls_key_pem,
-    const std::string& bearer_token, bool health_needs_token);
+    const std::string& bearer_token, bool health_needs_token, RequestLog& log);
+
+// Whether a call of `method` ("/pkg.Service/Method") needs the token: every one but the health
+// service's unless `health_needs_token`. The HTTP face's /healthz and /readyz follow it too.
+bool MethodNeedsToken(absl::string_view method, bool health_needs_token);
 
 // True when `header` is "Bearer <token>" (scheme case-insensitive, RFC 6750). Takes the same
 // time for every header of a given length, so that the comparison does not leak the token.

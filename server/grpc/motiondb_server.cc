@@ -35,6 +35,8 @@ struct MotionDbServer::State {
   std::unique_ptr<Catalog> catalog;
   std::unique_ptr<SearchRunner> runner;
   std::unique_ptr<JobRunner> jobs;  // its worker uses the runner, the registry and the database
+  std::unique_ptr<ServerMetrics> metrics;
+  std::unique_ptr<RequestLog> request_log;
   std::unique_ptr<CallGate> gate;
   std::unique_ptr<UploadBudget> uploads;
   std::unique_ptr<StreamWatchdog> watchdog;
@@ -84,21 +86,24 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
   s.jobs =
       std::make_unique<JobRunner>(*s.database, s.registry, *s.runner, options.test_job_pause_after);
+  s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database);
+  s.request_log = std::make_unique<RequestLog>(options.log_requests, *s.metrics);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.watchdog =
       std::make_unique<StreamWatchdog>(std::chrono::seconds(options.stream_idle_timeout_s));
   s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.uploads,
-                                              *s.watchdog, *s.gate);
+                                              *s.watchdog, *s.metrics, *s.gate);
   s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
-  s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.gate);
+  s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.metrics, *s.gate);
   s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
   s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
 
-  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<grpc::ServerCredentials> credentials,
-                            MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem,
-                                                  options.auth_token, options.health_needs_token));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const std::shared_ptr<grpc::ServerCredentials> credentials,
+      MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem, options.auth_token,
+                            options.health_needs_token, *s.request_log));
   // Reflection describes services from the generated descriptor pool, which holds health.proto
   // only if its generated code is linked in; naming a message of it makes sure it is.
   (void)grpc::health::v1::HealthCheckRequest::descriptor();
@@ -115,11 +120,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.job_service.get());
   builder.RegisterService(s.info.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
-  if (options.log_requests) {
-    std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;
-    loggers.push_back(std::make_unique<RequestLoggerFactory>());
-    builder.experimental().SetInterceptorCreators(std::move(loggers));
-  }
+  // Always: the metrics count every call, whether or not lines are written.
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;
+  loggers.push_back(std::make_unique<RequestLoggerFactory>(*s.request_log));
+  builder.experimental().SetInterceptorCreators(std::move(loggers));
   s.server = builder.BuildAndStart();
   if (s.server == nullptr || port == 0) {
     return absl::UnavailableError(
@@ -149,5 +153,19 @@ void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
 }
 
 void MotionDbServer::Wait() { state_->server->Wait(); }
+
+std::shared_ptr<grpc::Channel> MotionDbServer::InProcessChannel() const {
+  grpc::ChannelArguments arguments;
+  // Responses are limited by what the services make, as on the network (gRPC clients default
+  // to 4 MiB, less than a long clip's poses).
+  arguments.SetMaxReceiveMessageSize(-1);
+  return state_->server->InProcessChannel(arguments);
+}
+
+ServerMetrics& MotionDbServer::metrics() const { return *state_->metrics; }
+
+RequestLog& MotionDbServer::request_log() const { return *state_->request_log; }
+
+const ServerOptions& MotionDbServer::options() const { return state_->options; }
 
 }  // namespace motiondb::server

@@ -7,10 +7,13 @@
 #include <chrono>
 #include <memory>
 
+#include <grpcpp/channel.h>
 #include <grpcpp/server.h>
 
 #include "absl/status/statusor.h"
+#include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
+#include "server/server_metrics.h"
 
 namespace motiondb::server {
 
@@ -27,6 +30,15 @@ class MotionDbServer {
   void Shutdown(std::chrono::system_clock::time_point deadline);
   // Blocks until Shutdown() has completed.
   void Wait();
+
+  // A channel to the same services inside this process (the HTTP face's): no network, no
+  // credentials (the caller checks the token), the calls logged and counted as any other, with
+  // the caller's x-motiondb-http-peer metadata as their peer. Calls fail with UNAVAILABLE once
+  // Shutdown() has begun.
+  std::shared_ptr<grpc::Channel> InProcessChannel() const;
+  ServerMetrics& metrics() const;
+  RequestLog& request_log() const;
+  const ServerOptions& options() const;
 
  private:
   struct State;

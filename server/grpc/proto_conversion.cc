@@ -262,6 +262,19 @@ CurveRequest FromProto(const v1::GetCurveRequest& request) {
   return {request.space(), FromProto(request.clip()), Optional(request.has_dims(), request.dims())};
 }
 
+ClipListRequest FromProto(const v1::ListClipsRequest& request) {
+  return {.page = {request.page_size(), request.page_token()},
+          .tag = request.tag(),
+          .name_contains = request.name_contains(),
+          .sort = request.sort(),
+          .skeleton_id = request.skeleton_id(),
+          .descriptor = request.descriptor_name()};
+}
+
+PosesRequest FromProto(const v1::GetClipPosesRequest& request) {
+  return {FromProto(request.clip()), Optional(request.has_max_rate(), request.max_rate())};
+}
+
 std::vector<NewLabel> FromProto(const v1::AddLabelsRequest& request) {
   std::vector<NewLabel> labels;
   labels.reserve(request.labels_size());
@@ -447,6 +460,23 @@ void ToProto(const Curve& curve, v1::GetCurveResponse* response) {
                  response->mutable_coordinates());
   response->set_first_frame(curve.frames.first);
   response->set_last_frame(curve.frames.last);
+}
+
+void ToProto(const storage::ClipPage& page, v1::ListClipsResponse* response) {
+  for (const storage::ClipRecord& record : page.clips) ToProto(record, response->add_clips());
+  response->set_next_page_token(page.next_page_token);
+  response->set_total_size(page.total_size);
+}
+
+void ToProto(const ClipPoses& poses, v1::ClipPoses* response) {
+  response->set_clip_id(poses.clip_id);
+  for (const std::string& name : poses.joint_names) response->add_joint_names(name);
+  for (const int parent : poses.parents) response->add_parents(parent);
+  response->set_sample_rate(poses.sample_rate);
+  response->set_frames(static_cast<int32_t>(poses.positions.rows()));
+  response->set_first_frame(poses.frames.first);
+  response->set_last_frame(poses.frames.last);
+  AppendFloat32s(poses.positions.data(), poses.positions.size(), response->mutable_positions());
 }
 
 void ToProto(const storage::LabelRecord& record, v1::Label* label) {

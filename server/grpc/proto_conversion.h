@@ -14,9 +14,11 @@
 #include "motiondb/v1/space_service.pb.h"
 #include "server/clip_export.h"
 #include "server/clip_ingest.h"
+#include "server/clip_poses.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/label_catalog.h"
+#include "server/listing.h"
 #include "server/propagation.h"
 #include "server/search_runner.h"
 #include "server/space_builder.h"
@@ -35,6 +37,8 @@ storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request);
 absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request);
 absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request);
 CurveRequest FromProto(const v1::GetCurveRequest& request);
+ClipListRequest FromProto(const v1::ListClipsRequest& request);
+PosesRequest FromProto(const v1::GetClipPosesRequest& request);
 std::vector<NewLabel> FromProto(const v1::AddLabelsRequest& request);
 absl::StatusOr<storage::LabelFilter> FromProto(const v1::ListLabelsRequest& request);
 absl::StatusOr<LabelDeletion> FromProto(const v1::DeleteLabelsRequest& request);
@@ -44,6 +48,9 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
 
 // Results.
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
+void ToProto(const storage::ClipPage& page, v1::ListClipsResponse* response);
+// Positions as little-endian float32, as the API promises.
+void ToProto(const ClipPoses& poses, v1::ClipPoses* response);
 void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton);
 void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);

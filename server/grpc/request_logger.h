@@ -1,7 +1,12 @@
-// One line per call on stderr: time, method, status code name, latency and peer, e.g.
+// Every call, told once: a line on stderr (unless --quiet) and the server's metrics
+// (server/server_metrics.h). A line holds the time, method, status code name, latency and peer:
 //   2024-05-01T12:00:00.123Z /motiondb.v1.SearchService/Search OK 3.21ms ipv4:127.0.0.1:53422
+// A call of the HTTP face (server/http/) reaches the services in-process; its peer is shown as
+// http:<the HTTP client's address> and its metrics carry face="http".
+//
 // A gRPC server interceptor sees every call that reaches a service (ours, health, reflection);
-// calls refused before that (a bad token) are logged by server/credentials.cc.
+// calls refused before that (a bad token) are told by server/grpc/credentials.cc, and the HTTP
+// face tells its own refusals.
 #ifndef MOTIONDB_SERVER_GRPC_REQUEST_LOGGER_H_
 #define MOTIONDB_SERVER_GRPC_REQUEST_LOGGER_H_
 
@@ -9,20 +14,51 @@
 #include <grpcpp/support/status.h>
 
 #include "absl/strings/string_view.h"
+#include "server/server_metrics.h"
 
 namespace motiondb::server {
 
-// Writes one line in a single write(2), so that lines of concurrent calls do not interleave.
-void LogRequest(absl::string_view method, grpc::StatusCode code, double latency_ms,
-                absl::string_view peer);
+// The faces, as metrics label them.
+inline constexpr absl::string_view kGrpcFace = "grpc";
+inline constexpr absl::string_view kHttpFace = "http";
+// The metadata by which the HTTP face names its client to the request log; believed only on
+// in-process calls, which only the HTTP face makes.
+inline constexpr char kHttpPeerMetadata[] = "x-motiondb-http-peer";
 
-// Writes a free-form line (startup, shutdown) with the same time stamp.
+// Writes a free-form line (startup, shutdown) with the time stamp of the request lines, in a
+// single write(2), so that lines of concurrent calls do not interleave.
 void LogLine(absl::string_view text);
+
+// Thread-safe.
+class RequestLog {
+ public:
+  // `metrics` must outlive this.
+  RequestLog(bool write_lines, ServerMetrics& metrics)
+      : write_lines_(write_lines), metrics_(metrics) {}
+
+  // A call of `method` on `face` that ended with `code` after `latency_ms`. Metrics name a
+  // method that no service of this process has as "unknown" (a refused call's path is the
+  // client's to choose).
+  void Record(absl::string_view face, absl::string_view method, grpc::StatusCode code,
+              double latency_ms, absl::string_view peer);
+  // The line alone, for what is no call of a method (the HTTP face's own refusals, counted in
+  // its own metrics): `what` in the method's place and `outcome` in the code's.
+  void WriteLine(absl::string_view what, absl::string_view outcome, double latency_ms,
+                 absl::string_view peer);
+
+ private:
+  const bool write_lines_;
+  ServerMetrics& metrics_;
+};
 
 class RequestLoggerFactory : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:
+  explicit RequestLoggerFactory(RequestLog& log) : log_(log) {}
   grpc::experimental::Interceptor* CreateServerInterceptor(
       grpc::experimental::ServerRpcInfo* info) override;
+
+ private:
+  RequestLog& log_;
 };
 
 }  // namespace motiondb::server

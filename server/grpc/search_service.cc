@@ -19,6 +19,7 @@ absl::StatusOr<v1::SearchResponse> SearchServiceImpl::SearchOne(
     const v1::SearchRequest& request, const std::function<bool()>& should_stop) const {
   MOTIONDB_ASSIGN_OR_RETURN(const SearchRequest search, FromProto(request));
   MOTIONDB_ASSIGN_OR_RETURN(const SearchOutcome outcome, runner_.Run(search, should_stop));
+  metrics_.CountSearch(outcome);
   v1::SearchResponse response;
   ToProto(outcome, &response);
   return response;

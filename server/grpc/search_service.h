@@ -8,12 +8,14 @@
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "server/grpc/call_gate.h"
 #include "server/search_runner.h"
+#include "server/server_metrics.h"
 
 namespace motiondb::server {
 
 class SearchServiceImpl final : public v1::SearchService::Service {
  public:
-  SearchServiceImpl(const SearchRunner& runner, CallGate& gate) : runner_(runner), gate_(gate) {}
+  SearchServiceImpl(const SearchRunner& runner, ServerMetrics& metrics, CallGate& gate)
+      : runner_(runner), metrics_(metrics), gate_(gate) {}
 
   grpc::Status Search(grpc::ServerContext* context, const v1::SearchRequest* request,
                       v1::SearchResponse* response) override;
@@ -29,6 +31,7 @@ class SearchServiceImpl final : public v1::SearchService::Service {
                                                const std::function<bool()>& should_stop) const;
 
   const SearchRunner& runner_;
+  ServerMetrics& metrics_;
   CallGate& gate_;
 };
 

@@ -1,0 +1,37 @@
+#include "server/clip_poses.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "core/motion/forward_kinematics.h"
+#include "core/motion/resample.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+absl::StatusOr<ClipPoses> ReadClipPoses(storage::Database& database, const PosesRequest& request) {
+  const double max_rate = request.max_rate.value_or(kDefaultPoseRate);
+  if (!(max_rate >= 0) || !std::isfinite(max_rate)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_rate: ", max_rate, " must be 0 (the clip's own rate) or a positive rate"));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored,
+                            database.GetClip(request.clip.clip_id));
+  ClipPoses poses;
+  poses.clip_id = request.clip.clip_id;
+  MOTIONDB_ASSIGN_OR_RETURN(poses.frames,
+                            ResolveFrameRange(request.clip, stored.clip.frame_count(), "clip"));
+  MOTIONDB_ASSIGN_OR_RETURN(Clip range, stored.clip.Slice(poses.frames));
+  if (max_rate > 0 && max_rate < range.fps()) {
+    MOTIONDB_ASSIGN_OR_RETURN(range, Resample(range, max_rate));
+  }
+  poses.sample_rate = range.fps();
+  for (const Joint& joint : range.skeleton().joints()) {
+    poses.joint_names.push_back(joint.name);
+    poses.parents.push_back(joint.parent);
+  }
+  poses.positions = ForwardKinematics(range).cast<float>();
+  return poses;
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,132 @@
+#include "server/http/api_transcoder.h"
+
+#include <future>
+
+#include <grpcpp/client_context.h>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "grpc/health/v1/health.pb.h"
+#include "motiondb/v1/clip_service.pb.h"
+#include "server/grpc/request_logger.h"
+#include "server/http/http_status.h"
+#include "server/http/json_transcoding.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+using google::protobuf::Message;
+using google::protobuf::MethodDescriptor;
+
+std::unique_ptr<Message> NewMessage(const google::protobuf::Descriptor* type) {
+  return std::unique_ptr<Message>(
+      google::protobuf::MessageFactory::generated_factory()->GetPrototype(type)->New());
+}
+
+HttpReply ErrorReply(grpc::StatusCode code, absl::string_view message) {
+  HttpReply reply;
+  reply.status = HttpStatusOf(code);
+  reply.body = ErrorJson(code, message);
+  return reply;
+}
+
+// Content-Disposition for a download: the plain-ASCII name for old clients and the exact one
+// percent-encoded (RFC 6266, 5987).
+std::string Attachment(absl::string_view file_name) {
+  std::string ascii, encoded;
+  for (const unsigned char c : file_name) {
+    const bool plain = absl::ascii_isalnum(c) || c == '.' || c == '_' || c == '-';
+    ascii += plain ? static_cast<char>(c) : '_';
+    absl::StrAppend(&encoded,
+                    plain ? std::string(1, static_cast<char>(c)) : absl::StrFormat("%%%02X", c));
+  }
+  return absl::StrCat("attachment; filename=\"", ascii, "\"; filename*=UTF-8''", encoded);
+}
+
+HttpReply FileReply(const Message& response) {
+  const auto& exported = dynamic_cast<const v1::ExportClipResponse&>(response);
+  HttpReply reply;
+  reply.content_type = "text/plain; charset=utf-8";
+  reply.body = exported.bvh();
+  reply.headers.push_back({"Content-Disposition", Attachment(exported.file_name())});
+  return reply;
+}
+
+}  // namespace
+
+ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel) : stub_(std::move(channel)) {}
+
+absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
+    std::shared_ptr<grpc::Channel> channel) {
+  auto transcoder = std::unique_ptr<ApiTranscoder>(new ApiTranscoder(std::move(channel)));
+  for (const ApiRoute& route : ApiRoutes()) {
+    const MethodDescriptor* method =
+        google::protobuf::DescriptorPool::generated_pool()->FindMethodByName(route.rpc);
+    if (method == nullptr) {
+      return absl::InternalError(absl::StrCat("route ", route.Name(), ": no method ", route.rpc));
+    }
+    transcoder->methods_[route.rpc] = method;
+  }
+  return transcoder;
+}
+
+grpc::Status ApiTranscoder::Invoke(const MethodDescriptor& method, const Message& request,
+                                   Message* response, absl::string_view peer) const {
+  grpc::ClientContext context;
+  context.AddMetadata(kHttpPeerMetadata, std::string(peer));
+  std::promise<grpc::Status> done;
+  stub_.UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),
+                  grpc::StubOptions(), &request, response,
+                  [&done](grpc::Status status) { done.set_value(std::move(status)); });
+  return done.get_future().get();
+}
+
+absl::Status ApiTranscoder::FillRequest(const ApiRoute& route, const HttpCall& call,
+                                        Message* request) const {
+  if (route.json_body) MOTIONDB_RETURN_IF_ERROR(MergeJson(call.body, request));
+  // A name the route gives a field of its own, or the field's own dotted name.
+  const auto field_of = [&route](const std::string& name) {
+    for (const auto& [alias, field] : route.fields) {
+      if (alias == name) return field;
+    }
+    return name;
+  };
+  const std::vector<std::string> names = route.PathNames();
+  for (size_t i = 0; i < names.size() && i < call.path_values.size(); ++i) {
+    MOTIONDB_RETURN_IF_ERROR(SetField(field_of(names[i]), call.path_values[i], request));
+  }
+  for (const auto& [name, value] : call.query) {
+    MOTIONDB_RETURN_IF_ERROR(SetField(field_of(name), value, request));
+  }
+  return absl::OkStatus();
+}
+
+HttpReply ApiTranscoder::Call(const ApiRoute& route, const HttpCall& call) const {
+  const MethodDescriptor& method = *methods_.at(route.rpc);
+  const std::unique_ptr<Message> request = NewMessage(method.input_type());
+  if (const absl::Status filled = FillRequest(route, call, request.get()); !filled.ok()) {
+    return ErrorReply(grpc::StatusCode::INVALID_ARGUMENT, filled.message());
+  }
+  const std::unique_ptr<Message> response = NewMessage(method.output_type());
+  const grpc::Status status = Invoke(method, *request, response.get(), call.peer);
+  if (!status.ok()) return ErrorReply(status.error_code(), status.error_message());
+  if (route.bvh_file) return FileReply(*response);
+  HttpReply reply;
+  reply.body = ToJson(*response);
+  return reply;
+}
+
+bool ApiTranscoder::Ready(absl::string_view peer) const {
+  const MethodDescriptor* check = grpc::health::v1::HealthCheckRequest::descriptor()
+                                      ->file()
+                                      ->FindServiceByName("Health")
+                                      ->FindMethodByName("Check");
+  grpc::health::v1::HealthCheckRequest request;  // "": the server as a whole
+  grpc::health::v1::HealthCheckResponse response;
+  return Invoke(*check, request, &response, peer).ok() &&
+         response.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,74 @@
+// The JSON API's calls: an HTTP request on a route (server/http/api_routes.h) becomes the
+// route's gRPC request message, which goes to the server's own services in-process, and the
+// answer comes back as JSON (or a file), so that an answer here is the gRPC answer.
+//
+// Thread-safe.
+#ifndef MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_
+#define MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_
+
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/message.h>
+#include <grpcpp/channel.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/impl/codegen/proto_utils.h>  // serializes google::protobuf::Message for the stub
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "server/http/api_routes.h"
+
+namespace motiondb::server {
+
+struct HttpReply {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;  // beyond Content-Type
+};
+
+// What an HTTP request carries, as the HTTP library parsed it.
+struct HttpCall {
+  std::vector<std::string> path_values;  // one per placeholder of the route, decoded
+  std::multimap<std::string, std::string> query;
+  std::string body;
+  std::string peer;  // the client's address, for the request log
+};
+
+class ApiTranscoder {
+ public:
+  // INTERNAL when a route names a method that no linked service has.
+  static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
+      std::shared_ptr<grpc::Channel> channel);
+
+  // The route's call: its request from the path values, query parameters and (json_body) the
+  // body; 400 with the error body for a request that does not convert, else the call's
+  // status mapped (server/http/http_status.h) with the answer or the error body.
+  HttpReply Call(const ApiRoute& route, const HttpCall& call) const;
+
+  // Whether the server serves (the standard health service's overall status is SERVING).
+  bool Ready(absl::string_view peer) const;
+
+ private:
+  using GenericStub =
+      grpc::TemplatedGenericStub<google::protobuf::Message, google::protobuf::Message>;
+
+  explicit ApiTranscoder(std::shared_ptr<grpc::Channel> channel);
+  // Calls `method` in-process and waits for its answer.
+  grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
+                      const google::protobuf::Message& request, google::protobuf::Message* response,
+                      absl::string_view peer) const;
+  absl::Status FillRequest(const ApiRoute& route, const HttpCall& call,
+                           google::protobuf::Message* request) const;
+
+  mutable GenericStub stub_;  // UnaryCall is not const, but the stub keeps no per-call state
+  std::map<std::string, const google::protobuf::MethodDescriptor*> methods_;  // by rpc name
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_

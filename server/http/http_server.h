@@ -1,0 +1,53 @@
+// The HTTP face of the server (server/grpc/motiondb_server.h assembles the gRPC one): the JSON
+// API transcoded to the same services in-process (server/http/api_transcoder.h), GET /metrics
+// (Prometheus), /healthz and /readyz, and the web UI's built files at /. HTTPS with the gRPC
+// port's certificate and key when TLS is on; the API and the metrics need the gRPC token
+// (Authorization: Bearer), the health routes as the gRPC health service does, the web UI's
+// files never (they hold no data). cpp-httplib parses the requests and runs them on its own
+// thread pool.
+//
+// Thread-safe.
+#ifndef MOTIONDB_SERVER_HTTP_HTTP_SERVER_H_
+#define MOTIONDB_SERVER_HTTP_HTTP_SERVER_H_
+
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "server/grpc/motiondb_server.h"
+
+namespace motiondb::server {
+
+struct HttpOptions {
+  // host:port to serve HTTP on (--http); "off": no HTTP face. Port 0 picks a free one,
+  // reported by HttpServer::port() and logged.
+  std::string listen = "127.0.0.1:8080";
+  // The built web UI served at / (--web-root); empty: DefaultWebRoot().
+  std::string web_root;
+};
+
+// The web/dist folder of the source tree this binary was built from.
+std::string DefaultWebRoot();
+
+class HttpServer {
+ public:
+  // Starts serving `server`'s HTTP face; it must outlive the HttpServer. UNAVAILABLE when the
+  // address cannot be listened on, INVALID_ARGUMENT for a malformed one or a TLS certificate or
+  // key that does not load.
+  static absl::StatusOr<std::unique_ptr<HttpServer>> Start(const HttpOptions& options,
+                                                           MotionDbServer& server);
+  ~HttpServer();  // Stop()
+
+  int port() const;
+  // Stops listening, lets requests in progress finish, and returns (idempotent).
+  void Stop();
+
+ private:
+  struct State;
+  explicit HttpServer(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_HTTP_HTTP_SERVER_H_

@@ -1,0 +1,39 @@
+// The one place where the HTTP face converts between proto messages and JSON or query
+// parameters: protobuf's own proto3 JSON mapping (field names as in the .proto files, int64 as
+// strings, bytes as base64, enums by name; input also in lowerCamelCase).
+#ifndef MOTIONDB_SERVER_HTTP_JSON_TRANSCODING_H_
+#define MOTIONDB_SERVER_HTTP_JSON_TRANSCODING_H_
+
+#include <string>
+
+#include <google/protobuf/message.h>
+#include <grpcpp/support/status.h>
+
+#include "absl/status/status.h"
+#include "absl/strings/string_view.h"
+
+namespace motiondb::server {
+
+// Merges a request body into `message`; an empty or blank body sets nothing. INVALID_ARGUMENT
+// ("request body: ...", protobuf's reason) for malformed JSON, unknown fields and values of the
+// wrong type.
+absl::Status MergeJson(absl::string_view json, google::protobuf::Message* message);
+
+// Sets the field `path` names ("clip.clip_id": fields of nested messages joined by dots, each
+// by its .proto name or its JSON name) from a query parameter's text: numbers in decimal, bools
+// true/false (or 1/0), enums by name or number, bytes in base64. A repeated field gains the
+// value. INVALID_ARGUMENT naming the parameter for an unknown field or a value its type cannot
+// hold.
+absl::Status SetField(absl::string_view path, absl::string_view text,
+                      google::protobuf::Message* message);
+
+// `message` as proto3 JSON, every field present (zero values too, so that clients need no
+// defaults of their own).
+std::string ToJson(const google::protobuf::Message& message);
+
+// The error body: {"code": <gRPC code number>, "message": "..."}.
+std::string ErrorJson(grpc::StatusCode code, absl::string_view message);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_HTTP_JSON_TRANSCODING_H_

@@ -1,0 +1,56 @@
+// The server's metrics, as GET /metrics shows them: calls per method and status code on each
+// face with their latencies, HTTP exchanges per route, search stage times, frames ingested,
+// and, read when scraped, each space index's clips and frames, jobs per state and the process's
+// resident memory. Fed where calls are already timed (server/grpc/request_logger.h, the search
+// and clip services, the HTTP face); it knows no proto.
+//
+// Thread-safe.
+#ifndef MOTIONDB_SERVER_SERVER_METRICS_H_
+#define MOTIONDB_SERVER_SERVER_METRICS_H_
+
+#include <string>
+
+#include "absl/strings/string_view.h"
+#include "server/clip_ingest.h"
+#include "server/index_registry.h"
+#include "server/metrics_registry.h"
+#include "server/search_runner.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+class ServerMetrics {
+ public:
+  // `indices` and `database` are read at each Render() and must outlive this.
+  ServerMetrics(const IndexRegistry& indices, storage::Database& database);
+  ServerMetrics(const ServerMetrics&) = delete;
+  ServerMetrics& operator=(const ServerMetrics&) = delete;
+
+  // A call of `method` ("/motiondb.v1.SearchService/Search") that ended with `code` ("OK") after
+  // `seconds`, arriving on `face` ("grpc", or "http" for the HTTP face's transcoded calls).
+  void CountCall(absl::string_view face, absl::string_view method, absl::string_view code,
+                 double seconds);
+  // An HTTP exchange: `route` as the route table names it ("GET /v1/clips/{id}"), the status
+  // sent and the seconds it took, JSON conversion included.
+  void CountHttp(absl::string_view route, int status, double seconds);
+  // A search's stage times (the stages it ran; an exact search has only warps).
+  void CountSearch(const SearchOutcome& outcome);
+  // Frames stored by an ingest (none when it was skipped).
+  void CountIngest(const IngestOutcome& outcome);
+
+  // Every metric in Prometheus' text format 0.0.4.
+  std::string Render() const;
+
+ private:
+  MetricsRegistry registry_;
+  MetricsRegistry::Counter& calls_;
+  MetricsRegistry::Histogram& call_seconds_;
+  MetricsRegistry::Counter& http_exchanges_;
+  MetricsRegistry::Histogram& http_seconds_;
+  MetricsRegistry::Histogram& search_stage_seconds_;
+  MetricsRegistry::Counter& ingested_frames_;
+};
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_SERVER_METRICS_H_
