@@ -26,7 +26,8 @@ def main():
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     server = subprocess.Popen([args.server, "--db", f"{work}/db.sqlite", "--listen",
-                               f"127.0.0.1:{port}", "--threads", str(args.threads), "--quiet"],
+                               f"127.0.0.1:{port}", "--http", "off", "--threads", str(args.threads),
+                               "--quiet"],
                               stderr=subprocess.DEVNULL)
     try:
         channel = grpc.insecure_channel(f"127.0.0.1:{port}")

@@ -25,9 +25,13 @@ server="$build/server/motiondb-server"
 cli="$build/client/motiondb"
 # The CLI talks to wherever the server was told to listen (a wildcard host is reached locally).
 listen="127.0.0.1:50051"
+http="127.0.0.1:8080"
+scheme=http
 args=("$@")
 for ((i = 0; i + 1 < ${#args[@]}; i++)); do
   [[ "${args[i]}" == "--listen" ]] && listen="${args[i + 1]}"
+  [[ "${args[i]}" == "--http" ]] && http="${args[i + 1]}"
+  [[ "${args[i]}" == "--tls-cert" ]] && scheme=https
 done
 address="${listen/#0.0.0.0:/127.0.0.1:}"
 
@@ -61,5 +65,6 @@ if ((demo)); then
   echo "Try: $cli search --space demo --clip 1 --server $address"
 fi
 echo
+[[ "$http" == "off" ]] || echo "Web UI and JSON API: $scheme://${http/#0.0.0.0:/127.0.0.1:}"
 echo "motiondb-server is running (pid $pid). Use $cli help; Ctrl-C stops the server."
 wait "$pid"

@@ -62,7 +62,7 @@ class ServerTest(unittest.TestCase):
         # Port 0: the server picks a free port itself and logs it, so no other process can take
         # it between choosing and binding.
         cls.server = subprocess.Popen(
-            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0"],
+            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0", "--http", "off"],
             stdout=subprocess.DEVNULL, stderr=open(log, "w"))
         cls.port = logged_port(log, cls.server)
         cls.address = f"127.0.0.1:{cls.port}"

@@ -99,7 +99,7 @@ class PackageTest(unittest.TestCase):
         log = os.path.join(cls.dir.name, "server.log")
         cls.log = open(log, "w")
         cls.server = subprocess.Popen(
-            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0"],
+            [SERVER, "--db", os.path.join(cls.dir.name, "test.sqlite"), "--listen", "127.0.0.1:0", "--http", "off"],
             stdout=subprocess.DEVNULL, stderr=cls.log)
         cls.address = f"127.0.0.1:{logged_port(log, cls.server)}"
         cls.client = motiondb.connect(cls.address)
@@ -259,7 +259,7 @@ class TokenTest(unittest.TestCase):
             log_path = os.path.join(folder, "server.log")
             with open(log_path, "w") as log:
                 server = subprocess.Popen(
-                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0",
+                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0", "--http", "off",
                      "--auth-token-file", str(token_file)], stdout=subprocess.DEVNULL, stderr=log)
                 try:
                     address = f"127.0.0.1:{logged_port(log_path, server)}"

@@ -3,11 +3,12 @@
 
     readme_examples_test.py REPO BUILD_DIR
 
-The README's first command starts the server: this test runs scripts/start.sh itself (on a free
-loopback port, a fresh database and log in a temporary folder), then each ```sh block in order
-in a temporary working folder (with build/, client/, scripts/ and proto/ linked to the real
-ones), with the built `motiondb` on PATH and MOTIONDB_SERVER naming the test's server. A block
-preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must say which other
+The README's first command starts the server: this test runs scripts/start.sh itself (on free
+loopback ports for gRPC and HTTP, a fresh database and log in a temporary folder), then each
+```sh block in order in a temporary working folder (with build/, client/, scripts/ and proto/
+linked to the real ones), with the built `motiondb` on PATH and MOTIONDB_SERVER naming the
+test's server; the README's default addresses (127.0.0.1:50051, and 127.0.0.1:8080 for HTTP)
+are replaced by the test server's. A block preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must say which other
 check runs it. `<!-- readme-test: requires: TOOL -->` runs the block when TOOL is on PATH and
 says so when it is not (npx: Node.js is not among the Debian packages this project installs). Last, `scripts/start.sh --demo` must load its demo library into a fresh database.
 """
@@ -25,6 +26,7 @@ import time
 BLOCK = re.compile(r"(?:<!--\s*readme-test:\s*(?P<directive>.*?)\s*-->\s*\n)?```sh\n(?P<body>.*?)```",
                    re.S)
 DEFAULT_ADDRESS = "127.0.0.1:50051"
+DEFAULT_HTTP_ADDRESS = "127.0.0.1:8080"
 
 
 def free_port():
@@ -39,11 +41,13 @@ class StartedServer:
     def __init__(self, repo, build, work, demo):
         self.port = free_port()
         self.address = f"127.0.0.1:{self.port}"
+        self.http_address = f"127.0.0.1:{free_port()}"
         env = dict(os.environ, BUILD_DIR=str(build), MOTIONDB_DB=str(work / "motiondb.sqlite"),
                    MOTIONDB_LOG=str(work / "motiondb-server.log"))
         command = [str(repo / "scripts" / "start.sh")] + (["--demo"] if demo else [])
         self.output = open(work / "start.out", "w+")
-        self.process = subprocess.Popen(command + ["--listen", self.address], cwd=work, env=env,
+        self.process = subprocess.Popen(command + ["--listen", self.address,
+                                                   "--http", self.http_address], cwd=work, env=env,
                                         stdout=self.output, stderr=subprocess.STDOUT,
                                         start_new_session=True)
         deadline = time.monotonic() + 900
@@ -102,7 +106,9 @@ def main():
                     skipped += 1
                     continue
                 ran += 1
-                if run_block(body.replace(DEFAULT_ADDRESS, server.address), env, work) != 0:
+                body = body.replace(DEFAULT_ADDRESS, server.address)
+                if run_block(body.replace(DEFAULT_HTTP_ADDRESS, server.http_address), env,
+                             work) != 0:
                     failed.append(body.strip().splitlines()[0])
         finally:
             server.stop()
