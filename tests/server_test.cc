@@ -13,6 +13,7 @@
 
 #include <gmock/gmock.h>
 #include <google/protobuf/descriptor.pb.h>
+#include <google/protobuf/text_format.h>
 #include <google/protobuf/unknown_field_set.h>
 #include <google/protobuf/util/json_util.h>
 #include <grpcpp/generic/generic_stub.h>
@@ -21,6 +22,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
+#include "core/motion/forward_kinematics.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/job_service.grpc.pb.h"
@@ -33,6 +35,7 @@
 #include "testing/synthetic_corpus.h"
 #include "tests/clip_builder.h"
 #include "tests/test_data.h"
+#include "util/byte_coding.h"
 
 namespace motiondb {
 namespace {
@@ -334,6 +337,117 @@ TEST_F(ServerTest, IngestListGetExportRoundTrip) {
   // One log line per call: method, status, latency.
   EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ClipService/IngestClip OK "));
   EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.ClipService/GetClip NOT_FOUND "));
+}
+
+TEST_F(ServerTest, ClipPosesAreTheForwardKinematicsOfTheStoredClip) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const Clip walk = ChainClip();  // 61 frames at 30 fps
+  const int64_t id = client.IngestOrFail("walk.bvh", BvhText(walk));
+  const RowMatrixXd world = ForwardKinematics(walk);
+  const auto poses = [&](const std::string& text, v1::ClipPoses* out) {
+    v1::GetClipPosesRequest request;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &request)) << text;
+    request.mutable_clip()->set_clip_id(request.clip().clip_id() == 0 ? id
+                                                                      : request.clip().clip_id());
+    return client.clips().GetClipPoses(client.Context().get(), request, out);
+  };
+  // Position of `joint` on pose `k` of `answer`.
+  const auto at = [](const v1::ClipPoses& answer, int k, int joint) {
+    float xyz[3];
+    const size_t joints = answer.joint_names_size();
+    ReadFloat32s(absl::string_view(answer.positions()).substr(12 * (k * joints + joint), 12), 3,
+                 xyz);
+    return Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+  };
+
+  v1::ClipPoses whole;
+  ASSERT_TRUE(poses("", &whole).ok());
+  EXPECT_EQ(whole.clip_id(), id);
+  EXPECT_THAT(whole.joint_names(), ::testing::ElementsAre("root", "child", "leaf"));
+  EXPECT_THAT(whole.parents(), ::testing::ElementsAre(-1, 0, 1));
+  EXPECT_NEAR(whole.sample_rate(), 30, 1e-6);  // at 30 fps already: kept
+  EXPECT_EQ(whole.frames(), 61);
+  EXPECT_EQ(whole.first_frame(), 0);
+  EXPECT_EQ(whole.last_frame(), 60);
+  ASSERT_EQ(whole.positions().size(), 61u * 3 * 3 * 4);
+  for (int f = 0; f < 61; f += 10) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_LT((at(whole, f, j) - world.block<1, 3>(f, 3 * j).transpose()).norm(), 1e-3)
+          << f << " " << j;
+    }
+  }
+  // A range, resampled to 10 Hz: pose k is frame 12 + 3k.
+  v1::ClipPoses slow;
+  ASSERT_TRUE(poses("clip { first_frame: 12 last_frame: 42 } max_rate: 10", &slow).ok());
+  EXPECT_NEAR(slow.sample_rate(), 10, 1e-9);
+  EXPECT_EQ(slow.frames(), 11);
+  EXPECT_EQ(slow.first_frame(), 12);
+  EXPECT_EQ(slow.last_frame(), 42);
+  for (int k = 0; k < 11; ++k) {
+    EXPECT_LT((at(slow, k, 2) - world.block<1, 3>(12 + 3 * k, 6).transpose()).norm(), 1e-3) << k;
+  }
+  // 0: the clip's own rate; a higher limit than the clip's too.
+  v1::ClipPoses full;
+  ASSERT_TRUE(poses("max_rate: 0", &full).ok());
+  EXPECT_EQ(full.frames(), 61);
+  ASSERT_TRUE(poses("max_rate: 1000", &full).ok());
+  EXPECT_EQ(full.frames(), 61);
+
+  EXPECT_EQ(poses("clip { clip_id: 999 }", &full).error_code(), grpc::StatusCode::NOT_FOUND);
+  const grpc::Status past_end = poses("clip { last_frame: 61 }", &full);
+  EXPECT_EQ(past_end.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(past_end.error_message(), HasSubstr("clip.last_frame"));
+  const grpc::Status negative = poses("max_rate: -5", &full);
+  EXPECT_EQ(negative.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(negative.error_message(), HasSubstr("max_rate"));
+}
+
+TEST_F(ServerTest, ListClipsFiltersBySkeletonAndDescriptorWithTheirTotal) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const int64_t walk = client.IngestOrFail("walk.bvh", BvhText(ChainClip()));
+  const int64_t turn = client.IngestOrFail("turn.bvh", BvhText(ChainClip(0.05)));
+  const Clip humanoid = Humanoid().clips[0];
+  const int64_t other = client.IngestOrFail("humanoid.bvh", BvhText(humanoid));
+  v1::AddLabelsRequest labels;
+  v1::NewLabel* label = labels.add_labels();
+  label->set_clip_id(turn);
+  label->set_descriptor_name("spin");
+  v1::AddLabelsResponse added;
+  ASSERT_TRUE(client.labels().AddLabels(client.Context().get(), labels, &added).ok());
+
+  const auto listed = [&](const std::string& text) {
+    v1::ListClipsRequest request;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &request)) << text;
+    v1::ListClipsResponse response;
+    const grpc::Status status =
+        client.clips().ListClips(client.Context().get(), request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    std::vector<int64_t> ids;
+    for (const v1::Clip& clip : response.clips()) ids.push_back(clip.clip_id());
+    return std::make_pair(ids, response.total_size());
+  };
+  v1::GetClipRequest get;
+  get.set_clip_id(walk);
+  v1::Clip walk_clip;
+  ASSERT_TRUE(client.clips().GetClip(client.Context().get(), get, &walk_clip).ok());
+  const std::string chain = absl::StrCat("skeleton_id: ", walk_clip.skeleton_id());
+  using Ids = std::vector<int64_t>;
+  EXPECT_EQ(listed(""), std::make_pair(Ids{walk, turn, other}, int64_t{3}));
+  EXPECT_EQ(listed("page_size: 1"), std::make_pair(Ids{walk}, int64_t{3}));
+  EXPECT_EQ(listed(chain), std::make_pair(Ids{walk, turn}, int64_t{2}));
+  EXPECT_EQ(listed("descriptor_name: 'spin'"), std::make_pair(Ids{turn}, int64_t{1}));
+  EXPECT_EQ(listed(chain + " descriptor_name: 'none'"), std::make_pair(Ids{}, int64_t{0}));
+
+  v1::ListClipsRequest bad;
+  bad.set_skeleton_id(-2);
+  v1::ListClipsResponse response;
+  const grpc::Status refused = client.clips().ListClips(client.Context().get(), bad, &response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("skeleton_id"));
 }
 
 TEST_F(ServerTest, IngestsRealBvhFilesStreamedInChunks) {
@@ -1628,16 +1742,11 @@ TEST_F(ServerTest, BearerTokenIsRequiredOnEveryCall) {
 }
 
 TEST_F(ServerTest, ServesTls) {
-  if (std::system("command -v openssl >/dev/null 2>&1") != 0) {
-    GTEST_SKIP() << "openssl is not installed; the TLS test needs it to make a certificate";
-  }
-  const std::string cert = (dir_ / "cert.pem").string();
-  const std::string key = (dir_ / "key.pem").string();
-  const std::string command =
-      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
-      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout '" +
-      key + "' -out '" + cert + "' >/dev/null 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const absl::StatusOr<testing::TlsFiles> tls = testing::MakeTlsCertificate(dir_);
+  if (absl::IsNotFound(tls.status())) GTEST_SKIP() << tls.status().message();
+  ASSERT_TRUE(tls.ok()) << tls.status();
+  const std::string& cert = tls->cert;
+  const std::string& key = tls->key;
   const std::string token_file = WriteFile("token", "tls-token");
   ServerProcess* server =
       StartServer({"--tls-cert", cert, "--tls-key", key, "--auth-token-file", token_file},

@@ -1250,6 +1250,49 @@ std::vector<int64_t> IdsOf(const std::vector<LabelRecord>& labels) {
   return ids;
 }
 
+TEST_F(StorageTest, ListClipsFiltersBySkeletonAndDescriptorAndCountsTheMatches) {
+  const int64_t chain_a = Insert(Named("chain_a", {"t"}), Motion(testing::ChainSkeleton(), 20, 1));
+  const int64_t humanoid =
+      Insert(Named("humanoid", {"t"}), Motion(testing::HumanoidSkeleton(true), 20, 2));
+  const int64_t chain_b = Insert(Named("chain_b"), Motion(testing::ChainSkeleton(), 20, 3));
+  const int64_t chain_skeleton = Db().GetClipRecord(chain_a)->skeleton_id;
+  const int64_t humanoid_skeleton = Db().GetClipRecord(humanoid)->skeleton_id;
+  ASSERT_NE(chain_skeleton, humanoid_skeleton);
+  // Two labels of one descriptor on one clip count it once.
+  ASSERT_TRUE(
+      Db().AddLabels({Manual(chain_b, 0, 4, "kick", 1), Manual(chain_b, 10, 14, "kick", 1),
+                      Manual(humanoid, 0, 4, "kick", 0.5), Manual(chain_a, 0, 4, "wave", 1)})
+          .ok());
+  const auto listed = [&](const ClipFilter& filter, int page_size = 100) {
+    const absl::StatusOr<ClipPage> page = Db().ListClips(Sized(page_size), filter);
+    EXPECT_TRUE(page.ok()) << page.status();
+    std::vector<int64_t> ids;
+    for (const ClipRecord& record : page.value_or(ClipPage{}).clips) ids.push_back(record.clip_id);
+    return std::make_pair(ids, page.ok() ? page->total_size : -1);
+  };
+  using Ids = std::vector<int64_t>;
+  EXPECT_EQ(listed({}), std::make_pair(Ids{chain_a, humanoid, chain_b}, int64_t{3}));
+  EXPECT_EQ(listed({.skeleton_id = chain_skeleton}),
+            std::make_pair(Ids{chain_a, chain_b}, int64_t{2}));
+  EXPECT_EQ(listed({.skeleton_id = humanoid_skeleton}), std::make_pair(Ids{humanoid}, int64_t{1}));
+  EXPECT_EQ(listed({.descriptor = "kick"}), std::make_pair(Ids{humanoid, chain_b}, int64_t{2}));
+  EXPECT_EQ(listed({.skeleton_id = chain_skeleton, .descriptor = "kick"}),
+            std::make_pair(Ids{chain_b}, int64_t{1}));
+  EXPECT_EQ(listed({.tag = "t", .descriptor = "wave"}), std::make_pair(Ids{chain_a}, int64_t{1}));
+  EXPECT_EQ(listed({.descriptor = "jump"}), std::make_pair(Ids{}, int64_t{0}));
+  EXPECT_EQ(listed({.skeleton_id = 999}), std::make_pair(Ids{}, int64_t{0}));
+  // The total counts every page's clips, whatever the page holds; names in name order too.
+  EXPECT_EQ(listed({}, 1), std::make_pair(Ids{chain_a}, int64_t{3}));
+  EXPECT_EQ(listed({.name_contains = "chain", .order = ClipOrder::kName}, 1),
+            std::make_pair(Ids{chain_a}, int64_t{2}));
+
+  EXPECT_EQ(Db().ListClips({}, ClipFilter{.skeleton_id = -1}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  const absl::Status bad_descriptor = Db().ListClips({}, ClipFilter{.descriptor = "a\nb"}).status();
+  EXPECT_EQ(bad_descriptor.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad_descriptor.message(), ::testing::HasSubstr("descriptor"));
+}
+
 TEST_F(StorageTest, LabelsAreListedFoundAndTimelinedAndPagedOnce) {
   const int64_t walk = Insert(Named("walk", {"gait"}), Motion(testing::ChainSkeleton(), 50, 1));
   const int64_t kick = Insert(Named("kick", {"fight"}), Motion(testing::ChainSkeleton(), 30, 2));
@@ -1582,6 +1625,24 @@ TEST_F(StorageTest, JobsAreCreatedUpdatedListedNewestFirstAndPaged) {
 
 // A database opened with jobs still queued or running was left by a process that died (or
 // stopped) first: those jobs are interrupted, the finished ones stay as they were.
+TEST_F(StorageTest, JobsAreCountedByState) {
+  EXPECT_TRUE(Db().CountJobs()->empty());
+  JobRecord job;
+  const JobRecord first = *Db().CreateJob(job);
+  Db().CreateJob(job).IgnoreError();
+  JobRecord failed = *Db().CreateJob(job);
+  failed.state = JobState::kFailed;
+  failed.error = "why";
+  ASSERT_TRUE(Db().UpdateJob(failed).ok());
+  JobRecord running = first;
+  running.state = JobState::kRunning;
+  ASSERT_TRUE(Db().UpdateJob(running).ok());
+  const absl::StatusOr<std::map<JobState, int64_t>> counts = Db().CountJobs();
+  ASSERT_TRUE(counts.ok()) << counts.status();
+  EXPECT_EQ(*counts, (std::map<JobState, int64_t>{
+                         {JobState::kQueued, 1}, {JobState::kRunning, 1}, {JobState::kFailed, 1}}));
+}
+
 TEST_F(StorageTest, OpenInterruptsTheJobsADeadProcessLeftUnfinished) {
   const JobRecord queued = *Db().CreateJob({});
   JobRecord running = *Db().CreateJob({});

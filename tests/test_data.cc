@@ -25,6 +25,19 @@ std::optional<std::filesystem::path> AssimpBvhDir() { return ExistingDir(MOTIOND
 
 std::string CliPath() { return MOTIONDB_CLI_PATH; }
 
+absl::StatusOr<TlsFiles> MakeTlsCertificate(const std::filesystem::path& dir) {
+  if (std::system("command -v openssl >/dev/null 2>&1") != 0) {
+    return absl::NotFoundError("openssl is not installed; TLS tests need it to make a certificate");
+  }
+  const TlsFiles files{(dir / "cert.pem").string(), (dir / "key.pem").string()};
+  const std::string command =
+      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout '" +
+      files.key + "' -out '" + files.cert + "' >/dev/null 2>&1";
+  if (std::system(command.c_str()) != 0) return absl::InternalError("failed: " + command);
+  return files;
+}
+
 CommandResult RunCli(const std::vector<std::string>& args) {
   static int calls = 0;
   const std::string err_path = ::testing::TempDir() + "/cli_stderr_" + std::to_string(::getpid()) +

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "core/motion/clip.h"
 #include "testing/corpus_paths.h"  // MocapDir()
 
@@ -25,6 +26,15 @@ struct CommandResult {
 };
 // Runs the built CLI with `args` (each shell-quoted here) and captures its output.
 CommandResult RunCli(const std::vector<std::string>& args);
+
+// A self-signed certificate for localhost and 127.0.0.1, a day long, and its key: cert.pem and
+// key.pem written into `dir` by the openssl command. NOT_FOUND when openssl is not installed
+// (tests skip then), INTERNAL when it fails.
+struct TlsFiles {
+  std::string cert;
+  std::string key;
+};
+absl::StatusOr<TlsFiles> MakeTlsCertificate(const std::filesystem::path& dir);
 
 // Every *.bvh below `dir`, sorted.
 std::vector<std::filesystem::path> BvhFilesUnder(const std::filesystem::path& dir);

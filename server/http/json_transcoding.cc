@@ -18,6 +18,9 @@ using google::protobuf::Message;
 const FieldDescriptor* FindField(const Message& message, absl::string_view name) {
   const google::protobuf::Descriptor& type = *message.GetDescriptor();
   if (const FieldDescriptor* field = type.FindFieldByName(std::string(name))) return field;
+  if (const FieldDescriptor* field = type.FindFieldByCamelcaseName(std::string(name))) {
+    return field;
+  }
   for (int i = 0; i < type.field_count(); ++i) {
     if (type.field(i)->json_name() == name) return type.field(i);
   }
@@ -120,7 +123,7 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
   for (size_t i = 0; i < names.size(); ++i) {
     const FieldDescriptor* field = FindField(*owner, names[i]);
     if (field == nullptr) {
-      return absl::InvalidArgumentError(absl::StrCat("query parameter '", path,
+      return absl::InvalidArgumentError(absl::StrCat("parameter '", path,
                                                      "': ", owner->GetDescriptor()->full_name(),
                                                      " has no field '", names[i], "'"));
     }
@@ -128,7 +131,7 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
     if (field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
       if (last || field->is_repeated()) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "query parameter '", path, "': a query parameter names one value, and '", names[i],
+            "parameter '", path, "': a query parameter names one value, and '", names[i],
             "' is a message", field->is_repeated() ? " list" : "", "; send it in a JSON body"));
       }
       owner = owner->GetReflection()->MutableMessage(owner, field);
@@ -136,10 +139,10 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
     }
     if (!last) {
       return absl::InvalidArgumentError(
-          absl::StrCat("query parameter '", path, "': '", names[i], "' has no fields"));
+          absl::StrCat("parameter '", path, "': '", names[i], "' has no fields"));
     }
     if (!SetScalar(*field, text, owner)) {
-      return absl::InvalidArgumentError(absl::StrCat("query parameter '", path, "': '",
+      return absl::InvalidArgumentError(absl::StrCat("parameter '", path, "': '",
                                                      text.substr(0, 64), "' is not a valid ",
                                                      field->type_name(), " value"));
     }

@@ -20,10 +20,10 @@ namespace motiondb::server {
 absl::Status MergeJson(absl::string_view json, google::protobuf::Message* message);
 
 // Sets the field `path` names ("clip.clip_id": fields of nested messages joined by dots, each
-// by its .proto name or its JSON name) from a query parameter's text: numbers in decimal, bools
-// true/false (or 1/0), enums by name or number, bytes in base64. A repeated field gains the
-// value. INVALID_ARGUMENT naming the parameter for an unknown field or a value its type cannot
-// hold.
+// by its .proto name, its lowerCamelCase or its JSON name) from a path or query parameter's text:
+// numbers in decimal, bools true/false (or 1/0), enums by name or number, bytes in base64. A
+// repeated field gains the value. INVALID_ARGUMENT naming the parameter for an unknown field or a
+// value its type cannot hold.
 absl::Status SetField(absl::string_view path, absl::string_view text,
                       google::protobuf::Message* message);
 
