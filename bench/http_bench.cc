@@ -1,11 +1,11 @@
 // The HTTP face beside gRPC (issue 14), on one real motiondb-server over loopback with the demo
-// library (every BVH file of Debian's assimp-testmodels, the space "demo" on the first one's
-// skeleton, as scripts/start.sh --demo loads it):
+// library as scripts/start.sh --demo loads it (Debian's assimp-testmodels BVH files with the
+// space "demo", and ../shared/mocap/bandai2-normal with the space "bandai" when it is there):
 //  1. searches per second and client-side p50/p99 latency over gRPC and over HTTP (POST
 //     /v1/search, JSON both ways, parsed into the response message as a client would), with 1
-//     and 4 clients each on its own connection, every clip of the space in turn as the query
-//     (its first 2 s); the two faces measured in alternating turns, so that both see the same
-//     machine;
+//     and 4 clients each on its own connection, every clip of the larger space in turn as the
+//     query (its first 2 s); the two faces measured in alternating turns, so that both see the
+//     same machine;
 //  2. the time of a GET /metrics scrape, one connection, one scrape after another.
 //
 // usage: http_bench [--seconds S] [--turns N] [--scrapes N]
@@ -45,19 +45,21 @@ using bench::Percentile;
 using bench::Throughput;
 
 constexpr char kDemoFolder[] = "/usr/share/assimp/models/BVH";
+constexpr char kBandaiFolder[] = "bandai2-normal";  // in the shared mocap folder, when there
 constexpr double kQuerySeconds = 2;
 
-// Ingests every BVH file of the demo folder and builds the space "demo" on the first one's
-// skeleton; returns a query per clip of that skeleton (its first kQuerySeconds).
-absl::StatusOr<std::vector<v1::SearchRequest>> LoadDemo(
-    const std::shared_ptr<grpc::Channel>& channel) {
+// Ingests every BVH file of `folder` and builds the space `name` on the first one's skeleton, as
+// scripts/start.sh --demo does; returns a query per clip of that skeleton (its first
+// kQuerySeconds).
+absl::StatusOr<std::vector<v1::SearchRequest>> LoadSpace(
+    const std::shared_ptr<grpc::Channel>& channel, const std::filesystem::path& folder,
+    const std::string& name) {
   auto clips = v1::ClipService::NewStub(channel);
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(kDemoFolder)) {
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (entry.path().extension() == ".bvh") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
-  if (files.empty()) return absl::NotFoundError(absl::StrCat(kDemoFolder, ": no BVH files"));
   int64_t skeleton = 0;
   for (const std::filesystem::path& file : files) {
     v1::IngestClipRequest request;
@@ -71,8 +73,9 @@ absl::StatusOr<std::vector<v1::SearchRequest>> LoadDemo(
       skeleton = response.clip().skeleton_id();
     }
   }
+  if (skeleton == 0) return absl::NotFoundError(absl::StrCat(folder.string(), ": no BVH files"));
   v1::CreateSpaceRequest space;
-  space.set_name("demo");
+  space.set_name(name);
   space.set_skeleton_id(skeleton);
   v1::Space created;
   grpc::ClientContext space_context;
@@ -88,14 +91,15 @@ absl::StatusOr<std::vector<v1::SearchRequest>> LoadDemo(
   std::vector<v1::SearchRequest> queries;
   for (const v1::Clip& clip : listed.clips()) {
     v1::SearchRequest& query = queries.emplace_back();
-    query.set_space("demo");
+    query.set_space(name);
     query.mutable_clip()->set_clip_id(clip.clip_id());
     query.mutable_clip()->set_first_frame(0);
     query.mutable_clip()->set_last_frame(
         std::min(clip.frame_count() - 1, static_cast<int>(kQuerySeconds * clip.fps())));
   }
-  std::printf("demo library: %zu files, %d clips of the space's skeleton, %lld frames indexed\n",
-              files.size(), listed.clips_size(), static_cast<long long>(created.index().frames()));
+  std::printf("space %s: %zu files of %s, %d clips, %lld frames indexed at %.0f Hz\n", name.c_str(),
+              files.size(), folder.string().c_str(), listed.clips_size(),
+              static_cast<long long>(created.index().frames()), created.report().sample_rate());
   return queries;
 }
 
@@ -118,6 +122,7 @@ absl::StatusOr<Throughput> MeasureHttp(int port, int clients, double seconds,
   for (int c = 0; c < clients; ++c) {
     connections.push_back(std::make_unique<httplib::Client>("127.0.0.1", port));
     connections.back()->set_keep_alive(true);
+    connections.back()->set_tcp_nodelay(true);  // as browsers do
   }
   return bench::Measure(clients, seconds, [&](int worker, int64_t k) -> absl::Status {
     const std::string& body = bodies[(worker * 7919 + k) % bodies.size()];
@@ -140,6 +145,7 @@ void PrintRow(const std::string& label, const Throughput& t) {
 absl::Status MeasureScrapes(int port, int scrapes) {
   httplib::Client client("127.0.0.1", port);
   client.set_keep_alive(true);
+  client.set_tcp_nodelay(true);
   std::vector<double> ms;
   size_t bytes = 0;
   for (int i = 0; i < scrapes; ++i) {
@@ -165,15 +171,21 @@ absl::Status Run(double seconds, int turns, int scrapes) {
   if (!server.Start({"--db", (work / "db.sqlite").string(), "--quiet"}, &error)) {
     return absl::InternalError(error);
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<v1::SearchRequest> queries,
-                            LoadDemo(testing::InsecureChannel(server.address())));
+  // The demo library of scripts/start.sh --demo; searches in its larger space when it has two.
+  const auto channel = testing::InsecureChannel(server.address());
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<v1::SearchRequest> queries,
+                            LoadSpace(channel, kDemoFolder, "demo"));
+  if (std::filesystem::is_directory(bench::MocapRoot() / kBandaiFolder)) {
+    MOTIONDB_ASSIGN_OR_RETURN(queries,
+                              LoadSpace(channel, bench::MocapRoot() / kBandaiFolder, "bandai"));
+  }
   std::vector<std::string> bodies;
   google::protobuf::util::JsonPrintOptions compact;
   for (const v1::SearchRequest& query : queries) {
     (void)google::protobuf::util::MessageToJsonString(query, &bodies.emplace_back(), compact);
   }
-  std::printf("\n## Search over gRPC and over HTTP, %d turns of %.1f s each way\n\n", turns,
-              seconds / turns);
+  std::printf("\n## Search in %s over gRPC and over HTTP, %d turns of %.1f s each way\n\n",
+              queries.front().space().c_str(), turns, seconds / turns);
   std::printf("| face, clients | searches/s | p50 ms | p99 ms |\n|---|---:|---:|---:|\n");
   for (const int clients : {1, 4}) {
     Throughput grpc_total, http_total;

@@ -249,6 +249,10 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
     const int yes = 1;
     setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
   });
+  // httplib writes a response's headers and body apart; with Nagle's algorithm the body waits
+  // for the client's delayed ACK, 40 ms on Linux (measured: every search and scrape took 44 ms
+  // more).
+  http.set_tcp_nodelay(true);
   http.set_keep_alive_max_count(kKeepAliveRequests);
   // A JSON body carries a BVH file in base64: 4/3 of the largest message, and room for the rest.
   http.set_payload_max_length((size_t{static_cast<size_t>(server.options().max_message_mb)} << 20) /
