@@ -33,8 +33,8 @@ struct HttpReply {
 
 // What an HTTP request carries, as the HTTP library parsed it.
 struct HttpCall {
-  std::vector<std::string> path_values;  // one per placeholder of the route, decoded
-  std::multimap<std::string, std::string> query;
+  std::vector<std::string> path_values;           // one per placeholder of the route, decoded
+  std::multimap<std::string, std::string> query;  // GET and DELETE routes
   std::string body;
   std::string peer;  // the client's address, for the request log
 };
@@ -45,8 +45,8 @@ class ApiTranscoder {
   static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
       std::shared_ptr<grpc::Channel> channel);
 
-  // The route's call: its request from the path values, query parameters and (json_body) the
-  // body; 400 with the error body for a request that does not convert, else the call's
+  // The route's call: its request from the path values and the query parameters, or the body
+  // (json_body); 400 with the error body for a request that does not convert, else the call's
   // status mapped (server/http/http_status.h) with the answer or the error body.
   HttpReply Call(const ApiRoute& route, const HttpCall& call) const;
 

@@ -72,6 +72,8 @@ void SendError(grpc::StatusCode code, absl::string_view message, httplib::Respon
   response.set_content(ErrorJson(code, message), kJson);
 }
 
+bool IsApiPath(const std::string& path) { return path == "/v1" || absl::StartsWith(path, "/v1/"); }
+
 // Whether the path needs the token: the API and the metrics hold data; health as the gRPC
 // health service; the web UI's files never.
 bool NeedsToken(const ServerOptions& options, const std::string& path) {
@@ -79,7 +81,7 @@ bool NeedsToken(const ServerOptions& options, const std::string& path) {
   if (path == "/healthz" || path == "/readyz") {
     return MethodNeedsToken("/grpc.health.v1.Health/Check", options.health_needs_token);
   }
-  return path == "/metrics" || path == "/v1" || absl::StartsWith(path, "/v1/");
+  return path == "/metrics" || IsApiPath(path);
 }
 
 bool Authorized(const ServerOptions& options, const httplib::Request& request) {
@@ -123,9 +125,8 @@ namespace {
 void AddHooks(MotionDbServer& server, httplib::Server& http) {
   http.set_pre_routing_handler([&server](const httplib::Request& request,
                                          httplib::Response& response) {
-    exchange = {std::chrono::steady_clock::now(), "static"};
-    if (request.path == "/v1" || absl::StartsWith(request.path, "/v1/"))
-      exchange.route = "unmatched";
+    // Until a route's handler names itself.
+    exchange = {std::chrono::steady_clock::now(), IsApiPath(request.path) ? "unmatched" : "static"};
     if (!NeedsToken(server.options(), request.path) || Authorized(server.options(), request)) {
       return httplib::Server::HandlerResponse::Unhandled;
     }
@@ -171,7 +172,9 @@ void AddApiRoutes(const ApiTranscoder& api, httplib::Server& http) {
       for (size_t i = 1; i < request.matches.size(); ++i) {
         call.path_values.push_back(request.matches[i].str());
       }
-      call.query.insert(request.params.begin(), request.params.end());
+      // A body route's request is its JSON; httplib also parses a body sent as a form (curl -d
+      // without a Content-Type) into the parameters, which would then name no field.
+      if (!route.json_body) call.query.insert(request.params.begin(), request.params.end());
       call.body = request.body;
       call.peer = Peer(request);
       Send(api.Call(route, call), response);
