@@ -1,0 +1,75 @@
+// A clip range's joint positions (GetClipPoses), decoded once: frames x joints x 3 floats.
+import { base64ToFloat32 } from "../api/packed";
+import type { ClipPosesJson } from "../api/types";
+
+export class Poses {
+  readonly jointNames: string[];
+  readonly parents: number[];
+  readonly sampleRate: number;
+  readonly frames: number;
+  readonly firstFrame: number;
+  readonly lastFrame: number;
+  readonly positions: Float32Array;
+
+  constructor(json: ClipPosesJson) {
+    this.jointNames = json.joint_names;
+    this.parents = json.parents;
+    this.sampleRate = json.sample_rate;
+    this.frames = json.frames;
+    this.firstFrame = json.first_frame;
+    this.lastFrame = json.last_frame;
+    this.positions = base64ToFloat32(json.positions);
+    const expected = this.frames * this.joints * 3;
+    if (this.positions.length !== expected) {
+      throw new Error(`poses: ${this.positions.length} floats, expected ${expected}`);
+    }
+  }
+
+  get joints(): number {
+    return this.parents.length;
+  }
+
+  /** Seconds from the first to the last sample. */
+  get duration(): number {
+    return this.frames > 1 ? (this.frames - 1) / this.sampleRate : 0;
+  }
+
+  /** The sample shown at `seconds` after the range's start (clamped). */
+  sampleAt(seconds: number): number {
+    const k = Math.round(seconds * this.sampleRate);
+    return Math.min(Math.max(k, 0), this.frames - 1);
+  }
+
+  /** Offset of joint j of sample k in `positions`. */
+  offset(k: number, j: number): number {
+    return (k * this.joints + j) * 3;
+  }
+
+  /** The extent of every joint over every frame: [min xyz, max xyz]. */
+  bounds(): [number[], number[]] {
+    const min = [Infinity, Infinity, Infinity];
+    const max = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < this.positions.length; i++) {
+      const axis = i % 3;
+      min[axis] = Math.min(min[axis], this.positions[i]);
+      max[axis] = Math.max(max[axis], this.positions[i]);
+    }
+    return [min, max];
+  }
+
+  /** The tallest single pose, for framing the figure (units of the BVH). */
+  height(): number {
+    let tallest = 0;
+    for (let k = 0; k < this.frames; k += Math.max(1, Math.floor(this.frames / 50))) {
+      let low = Infinity;
+      let high = -Infinity;
+      for (let j = 0; j < this.joints; j++) {
+        const y = this.positions[this.offset(k, j) + 1];
+        low = Math.min(low, y);
+        high = Math.max(high, y);
+      }
+      tallest = Math.max(tallest, high - low);
+    }
+    return tallest || 1;
+  }
+}
