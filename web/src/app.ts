@@ -8,7 +8,7 @@ import { loadSide, wholeClip } from "./controller/side_loader";
 import { readDeepLink, showDeepLink, formatDeepLink, type DeepLink } from "./model/deep_link";
 import { straightFrames, warpedFrames } from "./model/frame_map";
 import { Clock } from "./player/clock";
-import { StagePlayer } from "./player/stage_player";
+import { StagePlayer, type Side } from "./player/stage_player";
 import { ClipPane } from "./view/clip_pane";
 import { CurvePlot } from "./view/curve_plot";
 import { byId, fill, h } from "./view/dom";
@@ -76,6 +76,7 @@ export class App {
     if (!spaces.length) fill(this.spaceSelect, h("option", { value: "" }, "no space"));
     this.library.showSkeletons(skeletons);
     document.body.dataset.ready = "true";
+    performance.mark("motiondb-ready");
     await this.follow(readDeepLink(window.location.search));
   }
 
@@ -171,39 +172,51 @@ export class App {
     const space = this.space;
     if (!hit || !this.query || !space?.report) return;
     const hitClip = await api.clip(hit.clip_id);
-    const hitRange = { clipId: hit.clip_id, first: hit.start_frame, last: hit.end_frame };
-    const warp = warpedFrames(hit.path, space.report.sample_rate);
-    const sides = [
+    const span = { first: hit.start_frame, last: hit.end_frame };
+    const [query, hitSide] = await Promise.all([
+      this.querySide(this.query, space.name),
       loadSide(
         {
           clip: hitClip,
-          range: hitRange,
-          frames: warp,
-          highlight: { first: hit.start_frame, last: hit.end_frame },
+          range: { clipId: hit.clip_id, ...span },
+          frames: warpedFrames(hit.path, space.report.sample_rate),
+          highlight: span,
           role: `hit ${index + 1}`,
         },
         space.name,
       ),
-    ];
-    const query = this.query;
-    if (query.kind === "range") {
-      const { first, last } = query.range;
-      sides.unshift(
-        loadSide(
-          {
-            clip: query.clip,
-            range: query.range,
-            frames: straightFrames(first, last, query.clip.fps),
-            highlight: { first, last },
-            role: "query",
-          },
-          space.name,
-        ),
-      );
-    }
-    this.player.play(await Promise.all(sides), true);
+    ]);
+    this.player.play([query, hitSide], true);
     this.search.highlight(index);
-    this.status.info(`hit ${index + 1}: ${hit.clip_name} beside ${describe(query)}`);
+    this.status.info(`hit ${index + 1}: ${hit.clip_name} beside ${describe(this.query)}`);
+  }
+
+  /** The query's side: a stored range from the server, an uploaded file from the file. */
+  private querySide(query: Query, space: string): Promise<Side> {
+    const { clip } = query;
+    if (query.kind === "file") {
+      const last = clip.frame_count - 1;
+      return Promise.resolve({
+        clip,
+        poses: query.poses,
+        labels: [],
+        curve: null,
+        frames: straightFrames(0, last, clip.fps),
+        highlight: { first: 0, last },
+        role: "query",
+      });
+    }
+    const { first, last } = query.range;
+    return loadSide(
+      {
+        clip,
+        range: query.range,
+        frames: straightFrames(first, last, clip.fps),
+        highlight: { first, last },
+        role: "query",
+      },
+      space,
+    );
   }
 
   private async addLabel(descriptor: string, value: number): Promise<void> {

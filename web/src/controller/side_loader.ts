@@ -5,7 +5,7 @@ import { api, type FrameRange } from "../api/routes";
 import type { Clip } from "../api/types";
 import { Curve } from "../model/curve";
 import type { FrameMap } from "../model/frame_map";
-import { Poses } from "../model/poses";
+import { decodePoses } from "../model/poses";
 import type { Side } from "../player/stage_player";
 import type { FrameSpan } from "../view/timeline";
 
@@ -30,7 +30,7 @@ export async function loadSide(request: SideRequest, space: string | null): Prom
   ]);
   return {
     ...request,
-    poses: new Poses(poses),
+    poses: decodePoses(poses),
     labels: labels.labels,
     curve: curve ? new Curve(curve) : null,
   };

@@ -11,7 +11,8 @@ export function duration(value: number): string {
 }
 
 export function rate(fps: number): string {
-  return `${Number.isInteger(fps) ? fps : fps.toFixed(2)} fps`;
+  const rounded = Math.round(fps);
+  return `${Math.abs(fps - rounded) < 0.01 ? rounded : fps.toFixed(2)} fps`;
 }
 
 export function score(value: number): string {

@@ -2,7 +2,32 @@
 import { base64ToFloat32 } from "../api/packed";
 import type { ClipPosesJson } from "../api/types";
 
-export class Poses {
+/** Joint positions of consecutive samples of a clip range. */
+export interface PoseData {
+  jointNames: string[];
+  parents: number[];
+  sampleRate: number;
+  frames: number;
+  /** The range covered, at the clip's own rate, inclusive. */
+  firstFrame: number;
+  lastFrame: number;
+  /** frames x joints x 3, world positions in the clip's units. */
+  positions: Float32Array;
+}
+
+export function decodePoses(json: ClipPosesJson): Poses {
+  return new Poses({
+    jointNames: json.joint_names,
+    parents: json.parents,
+    sampleRate: json.sample_rate,
+    frames: json.frames,
+    firstFrame: json.first_frame,
+    lastFrame: json.last_frame,
+    positions: base64ToFloat32(json.positions),
+  });
+}
+
+export class Poses implements PoseData {
   readonly jointNames: string[];
   readonly parents: number[];
   readonly sampleRate: number;
@@ -11,14 +36,14 @@ export class Poses {
   readonly lastFrame: number;
   readonly positions: Float32Array;
 
-  constructor(json: ClipPosesJson) {
-    this.jointNames = json.joint_names;
-    this.parents = json.parents;
-    this.sampleRate = json.sample_rate;
-    this.frames = json.frames;
-    this.firstFrame = json.first_frame;
-    this.lastFrame = json.last_frame;
-    this.positions = base64ToFloat32(json.positions);
+  constructor(data: PoseData) {
+    this.jointNames = data.jointNames;
+    this.parents = data.parents;
+    this.sampleRate = data.sampleRate;
+    this.frames = data.frames;
+    this.firstFrame = data.firstFrame;
+    this.lastFrame = data.lastFrame;
+    this.positions = data.positions;
     const expected = this.frames * this.joints * 3;
     if (this.positions.length !== expected) {
       throw new Error(`poses: ${this.positions.length} floats, expected ${expected}`);

@@ -42,7 +42,11 @@ export class ClipPane {
       this.title,
       h("b", { class: "role" }, content.role),
       ` ${clip.name} `,
-      h("small", {}, `#${clip.clip_id} · ${duration(clip.duration_s)} · ${rate(clip.fps)}`),
+      h(
+        "small",
+        {},
+        `${clip.clip_id ? `#${clip.clip_id}` : "not stored"} · ${duration(clip.duration_s)} · ${rate(clip.fps)}`,
+      ),
     );
     this.element.dataset.clipId = clip.clip_id;
     this.figure.show(content.poses);

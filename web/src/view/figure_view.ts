@@ -35,7 +35,7 @@ export class FigureView {
     this.followed = this.figure.root(0);
     const target = this.followed.clone();
     target.y = min[1] + height / 2;
-    this.stage.frame(target, height * 2.6);
+    this.stage.frame(target, height * 1.9);
   }
 
   /** Shows sample k of the poses last shown. */

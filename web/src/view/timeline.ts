@@ -104,7 +104,7 @@ export class Timeline {
   private bar(label: Label): HTMLElement {
     const origin = label.origin === "LABEL_ORIGIN_PROPAGATED" ? "propagated" : "manual";
     const bar = h("div", {
-      class: `bar ${origin}`,
+      class: `label-bar ${origin}`,
       title: `${label.descriptor_name} ${label.value.toFixed(2)} (${origin}) frames ${label.first_frame}-${label.last_frame}`,
       style: `opacity:${0.35 + 0.65 * label.value}`,
     });
