@@ -43,10 +43,10 @@ export class App {
   constructor() {
     new Transport(byId("transport"), this.clock);
     this.library.onOpen = (clip) => this.run(this.open(clip));
-    this.search.onSearch = () =>
-      this.selection &&
-      this.openClip &&
-      this.run(this.runSearch({ kind: "range", clip: this.openClip, range: this.selection }));
+    this.search.onSearch = () => {
+      const query = this.selectionQuery() ?? this.query;
+      if (query) this.run(this.runSearch(query));
+    };
     this.search.onFile = (file) => this.run(fileQuery(file).then((query) => this.runSearch(query)));
     this.search.onOpenHit = (index) => this.run(this.openHit(index));
     this.labels.onLabel = (descriptor, value) => this.run(this.addLabel(descriptor, value));
@@ -129,9 +129,18 @@ export class App {
   private select(range: FrameRange | null): void {
     this.selection = range;
     this.labels.setSelection(range !== null);
-    const clip = range && this.openClip?.clip_id === range.clipId ? this.openClip : null;
-    this.search.setQuery(range && clip ? describe({ kind: "range", clip, range }) : null);
+    const query = this.selectionQuery() ?? this.query;
+    this.search.setQuery(query ? describe(query) : null);
     this.showLink();
+  }
+
+  /** A search with the selected range, when it is of a clip the page knows. */
+  private selectionQuery(): Query | null {
+    const range = this.selection;
+    const clip = [this.openClip, this.query?.clip].find(
+      (c) => c && range && c.clip_id === range.clipId,
+    );
+    return range && clip ? { kind: "range", clip, range } : null;
   }
 
   private showLink(): void {
@@ -148,6 +157,7 @@ export class App {
     const space = this.space;
     if (!space) throw new Error("no space to search in: create one with `motiondb space create`");
     this.query = query;
+    this.search.setQuery(describe(query));
     this.search.busy(`Searching ${describe(query)} in ${space.name}…`);
     const started = performance.now();
     const response = await api.search(space.name, toSearchQuery(query), MAX_RESULTS);

@@ -50,6 +50,7 @@ export class ClipPane {
     );
     this.element.dataset.clipId = clip.clip_id;
     this.figure.show(content.poses);
+    this.timeline.select(null);
     this.timeline.show({
       frameCount: clip.frame_count,
       fps: clip.fps,

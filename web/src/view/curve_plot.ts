@@ -50,7 +50,7 @@ export class CurvePlot {
       this.group.add(line, marker);
       this.drawn.push({ curve, line, marker });
     }
-    this.stage.frame(new THREE.Vector3(), 4.2, new THREE.Vector3(1.2, 0.8, 1.5));
+    this.stage.frame(new THREE.Vector3(), 3.4, new THREE.Vector3(1.2, 0.8, 1.5));
     this.mark(this.drawn.map(() => 0));
   }
 

@@ -26,8 +26,13 @@ export class FigureView {
     const [min, max] = poses.bounds();
     this.figure = new StickFigure(poses, this.color, height / 45);
     this.stage.scene.add(this.figure.object);
-    const floorSize = Math.max(max[0] - min[0], max[2] - min[2], height) * 1.6;
-    this.grid = new THREE.GridHelper(floorSize, 16, 0x3a4350, 0x262c35);
+    // Cells a third of the figure's height, over the whole floor the motion covers.
+    const cell = height / 3;
+    const cells = Math.min(
+      400,
+      Math.ceil((Math.max(max[0] - min[0], max[2] - min[2]) + 4 * height) / cell),
+    );
+    this.grid = new THREE.GridHelper(cells * cell, cells, 0x3a4350, 0x262c35);
     this.grid.position.set((min[0] + max[0]) / 2, min[1], (min[2] + max[2]) / 2);
     this.stage.scene.add(this.grid);
     this.shownSample = -1;

@@ -20,6 +20,7 @@ export class Timeline {
   onSelect: (span: FrameSpan) => void = () => {};
   onSeek: (frame: number) => void = () => {};
   private model: TimelineModel = { frameCount: 1, fps: 30, labels: [], highlight: null };
+  private selected: FrameSpan | null = null;
   private readonly ruler = h("div", { class: "ruler" });
   private readonly highlight = h("div", { class: "span highlight" });
   private readonly selection = h("div", { class: "span selection" });
@@ -45,10 +46,11 @@ export class Timeline {
     this.drawRuler();
     this.drawLabels();
     this.place(this.highlight, model.highlight);
-    this.select(null);
+    this.place(this.selection, this.selected);
   }
 
   select(span: FrameSpan | null): void {
+    this.selected = span;
     this.place(this.selection, span);
     this.element.dataset.selection = span ? `${span.first}-${span.last}` : "";
   }
