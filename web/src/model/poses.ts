@@ -82,19 +82,25 @@ export class Poses implements PoseData {
     return [min, max];
   }
 
-  /** The tallest single pose, for framing the figure (units of the BVH). */
+  /**
+   * The figure's size, for framing it (units of the BVH): the largest extent of a single pose,
+   * upwards or across, over a sample of the poses, so that a crouch does not zoom in.
+   */
   height(): number {
-    let tallest = 0;
+    let largest = 0;
     for (let k = 0; k < this.frames; k += Math.max(1, Math.floor(this.frames / 50))) {
-      let low = Infinity;
-      let high = -Infinity;
+      const min = [Infinity, Infinity, Infinity];
+      const max = [-Infinity, -Infinity, -Infinity];
       for (let j = 0; j < this.joints; j++) {
-        const y = this.positions[this.offset(k, j) + 1];
-        low = Math.min(low, y);
-        high = Math.max(high, y);
+        for (let axis = 0; axis < 3; axis++) {
+          const value = this.positions[this.offset(k, j) + axis];
+          min[axis] = Math.min(min[axis], value);
+          max[axis] = Math.max(max[axis], value);
+        }
       }
-      tallest = Math.max(tallest, high - low);
+      const across = Math.hypot(max[0] - min[0], max[2] - min[2]);
+      largest = Math.max(largest, max[1] - min[1], across);
     }
-    return tallest || 1;
+    return largest || 1;
   }
 }
