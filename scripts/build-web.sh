@@ -9,6 +9,9 @@ set -euo pipefail
 web="$(cd "$(dirname "${BASH_SOURCE[0]}")/../web" && pwd)"
 command -v npm >/dev/null || { echo "build-web: npm is missing (scripts/install-deps.sh)" >&2; exit 1; }
 cd "$web"
+# One build at a time (start.sh and the browser tests may start together).
+exec 9>.build-web.lock
+flock 9
 if [[ ! -f node_modules/.package-lock.json || package-lock.json -nt node_modules/.package-lock.json ]]; then
   echo "build-web: npm ci"
   npm ci --no-audit --no-fund --loglevel=error
