@@ -11,12 +11,7 @@ import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { Browser } from "../testing/web/browser.mjs";
-import {
-  ASSIMP_BVH,
-  cli,
-  loadCopies,
-  loadDemoLibrary,
-} from "../testing/web/library.mjs";
+import { ASSIMP_BVH, cliOffline, loadCopies, loadDemoLibrary } from "../testing/web/library.mjs";
 import { ServerProcess } from "../testing/web/server.mjs";
 
 const args = process.argv.slice(2);
@@ -26,9 +21,7 @@ const option = (name, fallback) => {
 };
 const build = args[0];
 if (!build)
-  throw new Error(
-    "usage: node bench/web_page_bench.mjs BUILD_DIR [--loads N] [--searches N]",
-  );
+  throw new Error("usage: node bench/web_page_bench.mjs BUILD_DIR [--loads N] [--searches N]");
 const SERVER = join(build, "server", "motiondb-server");
 const CLI = join(build, "client", "motiondb");
 const LOADS = option("--loads", 10);
@@ -36,8 +29,7 @@ const SEARCHES = option("--searches", 30);
 
 function summary(name, values) {
   const sorted = [...values].sort((a, b) => a - b);
-  const at = (q) =>
-    sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))];
+  const at = (q) => sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))];
   const text = `${name}: median ${at(0.5).toFixed(1)} ms, p90 ${at(0.9).toFixed(1)} ms, max ${sorted[sorted.length - 1].toFixed(1)} ms (n=${values.length})`;
   console.log(text);
   return text;
@@ -55,14 +47,11 @@ async function pageReady(server, expectedCount) {
       else await page.reload();
       await page.waitForSelector("body[data-ready=true]");
       into.push(
-        await page.evaluate(
-          () => performance.getEntriesByName("motiondb-ready")[0].startTime,
-        ),
+        await page.evaluate(() => performance.getEntriesByName("motiondb-ready")[0].startTime),
       );
     }
     const count = await page.textContent("[data-testid=clip-count]");
-    if (!count.endsWith(`of ${expectedCount}`))
-      throw new Error(`the page shows "${count}"`);
+    if (!count.endsWith(`of ${expectedCount}`)) throw new Error(`the page shows "${count}"`);
     if (browser.errors.length) throw new Error(browser.errors.join("\n"));
     await browser.close();
   }
@@ -73,9 +62,7 @@ async function pageReady(server, expectedCount) {
 async function pageSearches(server, clipId) {
   const browser = await Browser.launch();
   const page = await browser.page();
-  await page.goto(
-    `${server.baseUrl}/?space=demo&clip=${clipId}&from=40&to=124`,
-  );
+  await page.goto(`${server.baseUrl}/?space=demo&clip=${clipId}&from=40&to=124`);
   await page.waitForSelector("[data-testid=hit]", { timeout: 60_000 });
   const times = [];
   for (let i = 0; i < SEARCHES; i++) {
@@ -94,9 +81,7 @@ async function pageSearches(server, clipId) {
         const start = performance.now();
         document.querySelector("[data-testid=search]").click();
         await rendered;
-        await new Promise((resolve) =>
-          requestAnimationFrame(() => setTimeout(resolve)),
-        );
+        await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve)));
         return performance.now() - start;
       }),
     );
@@ -134,17 +119,10 @@ try {
   const demo = await ServerProcess.start(SERVER, ["--quiet"]);
   const clips = loadDemoLibrary(CLI, demo);
   const demoReady = await pageReady(demo, 3);
+  lines.push(summary("page ready, demo library (3 clips), cold", demoReady.cold));
+  lines.push(summary("page ready, demo library (3 clips), warm", demoReady.warm));
   lines.push(
-    summary("page ready, demo library (3 clips), cold", demoReady.cold),
-  );
-  lines.push(
-    summary("page ready, demo library (3 clips), warm", demoReady.warm),
-  );
-  lines.push(
-    summary(
-      "search, bare POST /v1/search",
-      await bareSearches(demo, clips["01_01"].clip_id),
-    ),
+    summary("search, bare POST /v1/search", await bareSearches(demo, clips["01_01"].clip_id)),
   );
   lines.push(
     summary(
@@ -156,17 +134,7 @@ try {
 
   const big = await ServerProcess.start(SERVER, ["--quiet"]);
   const short = join(work, "short.bvh");
-  cli(
-    CLI,
-    big,
-    "convert",
-    join(ASSIMP_BVH, "01_01.bvh"),
-    short,
-    "--from",
-    "0",
-    "--to",
-    "119",
-  );
+  cliOffline(CLI, "convert", join(ASSIMP_BVH, "01_01.bvh"), short, "--from", "0", "--to", "119");
   await loadCopies(big, short, 1000, "bench");
   const bigReady = await pageReady(big, 1000);
   lines.push(summary("page ready, 1,000 clips, cold", bigReady.cold));

@@ -9,9 +9,7 @@ import { fileURLToPath } from "node:url";
 
 export const CHROMIUM = "/usr/bin/chromium";
 const WEB = join(dirname(fileURLToPath(import.meta.url)), "..", "..", "web");
-const { chromium } = createRequire(join(WEB, "package.json"))(
-  "playwright-core",
-);
+const { chromium } = createRequire(join(WEB, "package.json"))("playwright-core");
 
 const ARGS = [
   "--headless",
@@ -47,8 +45,7 @@ export class Browser {
   async page() {
     const page = await this.context.newPage();
     page.on("console", (message) => {
-      if (message.type() === "error")
-        this.errors.push(`console: ${message.text()}`);
+      if (message.type() === "error") this.errors.push(`console: ${message.text()}`);
     });
     page.on("pageerror", (error) => this.errors.push(`page: ${error.message}`));
     return page;

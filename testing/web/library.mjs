@@ -14,6 +14,14 @@ export function cli(cliBin, server, ...args) {
   });
 }
 
+/** An offline command (no server): convert, inspect. */
+export function cliOffline(cliBin, ...args) {
+  return execFileSync(cliBin, args, {
+    encoding: "utf8",
+    stdio: ["ignore", "pipe", "pipe"],
+  });
+}
+
 export function cliJson(cliBin, server, ...args) {
   return JSON.parse(cli(cliBin, server, ...args, "--json"));
 }
@@ -38,15 +46,7 @@ export function loadDemoLibrary(cliBin, server) {
   );
   const clips = cliJson(cliBin, server, "clips").clips;
   const byName = Object.fromEntries(clips.map((c) => [c.name, c]));
-  cli(
-    cliBin,
-    server,
-    "space",
-    "create",
-    "demo",
-    "--skeleton",
-    String(byName["01_01"].skeleton_id),
-  );
+  cli(cliBin, server, "space", "create", "demo", "--skeleton", String(byName["01_01"].skeleton_id));
   return byName;
 }
 
@@ -60,7 +60,6 @@ export async function loadCopies(server, bvhPath, count, tag) {
       headers: { "Content-Type": "application/json" },
       body: JSON.stringify({ file_name: `${name}.bvh`, bvh, tags: [tag] }),
     });
-    if (!response.ok)
-      throw new Error(`POST /v1/clips ${name}: ${await response.text()}`);
+    if (!response.ok) throw new Error(`POST /v1/clips ${name}: ${await response.text()}`);
   }
 }

@@ -4,7 +4,11 @@ import { spawn } from "node:child_process";
 import { mkdtempSync, openSync, readFileSync, rmSync } from "node:fs";
 import { createServer } from "node:net";
 import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { dirname, join } from "node:path";
+import { fileURLToPath } from "node:url";
+
+/** The page the tests load: this checkout's build (run_browser_tests.sh builds it first). */
+const WEB_DIST = join(dirname(fileURLToPath(import.meta.url)), "..", "..", "web", "dist");
 
 /** A loopback port nothing listens on (bound and released; the server binds it next). */
 export function freePort() {
@@ -35,6 +39,8 @@ export class ServerProcess {
         grpc,
         "--http",
         http,
+        "--web-root",
+        WEB_DIST,
         ...extraArgs,
       ],
       { stdio: ["ignore", out, out] },

@@ -8,11 +8,7 @@ import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { after, before, test } from "node:test";
 import { Browser } from "../../testing/web/browser.mjs";
-import {
-  ASSIMP_BVH,
-  cli,
-  loadDemoLibrary,
-} from "../../testing/web/library.mjs";
+import { ASSIMP_BVH, cli, cliOffline, loadDemoLibrary } from "../../testing/web/library.mjs";
 import { ServerProcess } from "../../testing/web/server.mjs";
 
 const SERVER = process.env.MOTIONDB_SERVER_BIN;
@@ -39,9 +35,8 @@ before(async () => {
   cli(CLI, server, "label", "add", "01_03:10-100", "kick", "--value", "0.8");
   // An upload query: two seconds of 01_03 cut out as a file of its own.
   queryFile = join(work, "query_01_03.bvh");
-  cli(
+  cliOffline(
     CLI,
-    server,
     "convert",
     join(ASSIMP_BVH, "01_03.bvh"),
     queryFile,
@@ -75,9 +70,9 @@ async function expectListed(page, names) {
   await page.waitForFunction(
     (expected) =>
       JSON.stringify(
-        [
-          ...document.querySelectorAll("[data-testid=clip-list] .clip-name"),
-        ].map((e) => e.textContent),
+        [...document.querySelectorAll("[data-testid=clip-list] .clip-name")].map(
+          (e) => e.textContent,
+        ),
       ) === JSON.stringify(expected),
     names,
     WAIT,
@@ -88,10 +83,7 @@ async function expectListed(page, names) {
 /** The frame a pane's counter shows. */
 async function frameOf(page, pane) {
   return Number(
-    await page.getAttribute(
-      `[data-testid=${pane}] [data-testid=frame-counter]`,
-      "data-frame",
-    ),
+    await page.getAttribute(`[data-testid=${pane}] [data-testid=frame-counter]`, "data-frame"),
   );
 }
 
@@ -99,13 +91,9 @@ async function frameOf(page, pane) {
 async function expectAdvances(page, pane, frame) {
   await page.waitForFunction(
     ({ pane, frame }) => {
-      const counter = document.querySelector(
-        `[data-testid=${pane}] [data-testid=frame-counter]`,
-      );
+      const counter = document.querySelector(`[data-testid=${pane}] [data-testid=frame-counter]`);
       return (
-        counter &&
-        counter.dataset.frame !== undefined &&
-        Number(counter.dataset.frame) !== frame
+        counter && counter.dataset.frame !== undefined && Number(counter.dataset.frame) !== frame
       );
     },
     { pane, frame },
@@ -119,10 +107,7 @@ test("the library lists every clip with its duration, rate and tags", async () =
   assert.equal(await page.textContent("[data-testid=clip-count]"), "1–3 of 3");
   const boxing = page.locator(".clip-row", { hasText: "Boxing_Toes" });
   assert.match(await boxing.textContent(), /30\.7 s · 100 fps/);
-  assert.deepEqual(await boxing.locator(".tag").allTextContents(), [
-    "demo",
-    "boxing",
-  ]);
+  assert.deepEqual(await boxing.locator(".tag").allTextContents(), ["boxing", "demo"]);
   await page.screenshot({ path: join(OUT, "library.png") });
   await page.close();
 });
@@ -135,20 +120,14 @@ test("the name, tag, skeleton and label filters narrow the list", async () => {
   await page.fill("[data-testid=filter-tag]", "boxing");
   await expectListed(page, ["Boxing_Toes"]);
   await page.fill("[data-testid=filter-tag]", "");
-  await page.selectOption(
-    "[data-testid=filter-skeleton]",
-    String(clips["01_01"].skeleton_id),
-  );
+  await page.selectOption("[data-testid=filter-skeleton]", String(clips["01_01"].skeleton_id));
   await expectListed(page, ["01_01", "01_03"]);
   await page.selectOption("[data-testid=filter-skeleton]", "");
   await page.fill("[data-testid=filter-label]", "kick");
   await expectListed(page, ["01_03"]);
   await page.fill("[data-testid=filter-label]", "no-such-label");
   await expectListed(page, []);
-  assert.equal(
-    await page.textContent("[data-testid=clip-count]"),
-    "no clips match",
-  );
+  assert.equal(await page.textContent("[data-testid=clip-count]"), "no clips match");
   await page.close();
 });
 
@@ -160,9 +139,7 @@ test("a clip opens with its figure, labels and curve, and plays", async () => {
     WAIT,
   );
   assert.equal(
-    await page
-      .locator("[data-testid=pane-query] .label-row .descriptor")
-      .textContent(),
+    await page.locator("[data-testid=pane-query] .label-row .descriptor").textContent(),
     "kick",
   );
   assert.equal(await page.locator("[data-testid=curves] canvas").count(), 1);
@@ -178,19 +155,10 @@ test("a deep link opens its search and shows the ranked hits", async () => {
   await page.waitForSelector("[data-testid=hit]", WAIT);
   const hits = page.locator("[data-testid=hit]");
   assert.ok((await hits.count()) >= 1);
-  assert.match(
-    await hits.first().textContent(),
-    /\d+\.\d+ s – \d+\.\d+ s · frames \d+–\d+/,
-  );
-  assert.match(
-    await page.textContent("[data-testid=query]"),
-    /01_01, frames 40–124/,
-  );
+  assert.match(await hits.first().textContent(), /\d+\.\d+ s – \d+\.\d+ s · frames \d+–\d+/);
+  assert.match(await page.textContent("[data-testid=query]"), /01_01, frames 40–124/);
   assert.equal(
-    await page.getAttribute(
-      "[data-testid=pane-query] .timeline",
-      "data-selection",
-    ),
+    await page.getAttribute("[data-testid=pane-query] .timeline", "data-selection"),
     "40-124",
   );
   assert.match(
@@ -212,17 +180,13 @@ test("a hit plays beside its query, in step", async () => {
   const queryFrame = await frameOf(page, "pane-query");
   await expectAdvances(page, "pane-hit", hitFrame);
   await expectAdvances(page, "pane-query", queryFrame);
-  assert.equal(
-    await page.getAttribute("[data-testid=play]", "data-state"),
-    "playing",
-  );
+  assert.equal(await page.getAttribute("[data-testid=play]", "data-state"), "playing");
   // A moment into the motion, for the picture in the README.
   await page.waitForFunction(
     () =>
       Number(
-        document.querySelector(
-          "[data-testid=pane-query] [data-testid=frame-counter]",
-        ).dataset.frame,
+        document.querySelector("[data-testid=pane-query] [data-testid=frame-counter]").dataset
+          .frame,
       ) >= 90,
     null,
     WAIT,
@@ -235,14 +199,9 @@ test("an uploaded BVH file searches, chosen or dropped", async () => {
   const page = await openPage();
   await page.setInputFiles("[data-testid=bvh-input]", queryFile);
   await page.waitForSelector("[data-testid=hit]", WAIT);
-  assert.match(
-    await page.textContent("[data-testid=search-summary]"),
-    /^\d+ hits/,
-  );
+  assert.match(await page.textContent("[data-testid=search-summary]"), /^\d+ hits/);
   assert.match(await page.textContent("[data-testid=hits]"), /01_03/);
-  await page.evaluate(() =>
-    document.querySelector("[data-testid=hits]").replaceChildren(),
-  );
+  await page.evaluate(() => document.querySelector("[data-testid=hits]").replaceChildren());
   const text = readFileSync(queryFile, "utf8");
   await page.evaluate((bvh) => {
     const transfer = new DataTransfer();
@@ -274,19 +233,14 @@ test("a selected range is labelled and the label propagated", async () => {
     "[data-testid=pane-query][data-clip-id] .title:has-text('01_01')",
     WAIT,
   );
-  const track = await page
-    .locator("[data-testid=pane-query] .track")
-    .boundingBox();
+  const track = await page.locator("[data-testid=pane-query] .track").boundingBox();
   const y = track.y + track.height / 2;
   await page.mouse.move(track.x + track.width * 0.1, y);
   await page.mouse.down();
   await page.mouse.move(track.x + track.width * 0.2, y, { steps: 5 });
   await page.mouse.up();
   assert.match(
-    await page.getAttribute(
-      "[data-testid=pane-query] .timeline",
-      "data-selection",
-    ),
+    await page.getAttribute("[data-testid=pane-query] .timeline", "data-selection"),
     /^\d+-\d+$/,
   );
   await page.fill("[data-testid=descriptor]", "walk-start");
@@ -296,14 +250,8 @@ test("a selected range is labelled and the label propagated", async () => {
     WAIT,
   );
   await page.click("[data-testid=propagate]");
-  await page.waitForSelector(
-    "[data-testid=job-state][data-state=succeeded]",
-    WAIT,
-  );
-  assert.match(
-    await page.textContent("[data-testid=job-state]"),
-    /job-\d+ succeeded 1\/1/,
-  );
+  await page.waitForSelector("[data-testid=job-state][data-state=succeeded]", WAIT);
+  assert.match(await page.textContent("[data-testid=job-state]"), /job-\d+ succeeded 1\/1/);
   await page.screenshot({ path: join(OUT, "labels.png") });
   await page.close();
 });

@@ -15,6 +15,8 @@ export class CurvePlot {
   private readonly stage: ThreeStage;
   private readonly group = new THREE.Group();
   private drawn: Drawn[] = [];
+  /** From the space's coordinates to the plot's cube [-1, 1]^3. */
+  private toPlot = (p: THREE.Vector3) => p;
 
   constructor(container: HTMLElement) {
     this.stage = new ThreeStage(container);
@@ -25,32 +27,27 @@ export class CurvePlot {
     this.clear();
     const box = new THREE.Box3();
     for (const { curve } of curves) {
-      for (let k = 0; k < curve.frames; k++) {
-        box.expandByPoint(new THREE.Vector3(curve.at(k, 0), curve.at(k, 1), curve.at(k, 2)));
-      }
+      for (let k = 0; k < curve.frames; k++) box.expandByPoint(pointOf(curve, k));
     }
-    const size = box.getSize(new THREE.Vector3());
-    const scale = 2 / Math.max(size.x, size.y, size.z, 1e-6);
-    const center = box.getCenter(new THREE.Vector3());
-    this.group.scale.setScalar(scale);
-    this.group.position.copy(center).multiplyScalar(-scale);
+    // Each dimension stretched to the plot's cube: the space's later dimensions carry less
+    // variance, and would otherwise look flat.
+    const size = box.getSize(new THREE.Vector3()).max(new THREE.Vector3(1e-6, 1e-6, 1e-6));
+    this.toPlot = (p) => p.sub(box.getCenter(new THREE.Vector3())).divide(size).multiplyScalar(2);
     for (const { curve, color } of curves) {
       const points: THREE.Vector3[] = [];
-      for (let k = 0; k < curve.frames; k++) {
-        points.push(new THREE.Vector3(curve.at(k, 0), curve.at(k, 1), curve.at(k, 2)));
-      }
+      for (let k = 0; k < curve.frames; k++) points.push(this.toPlot(pointOf(curve, k)));
       const line = new THREE.Line(
         new THREE.BufferGeometry().setFromPoints(points),
         new THREE.LineBasicMaterial({ color }),
       );
       const marker = new THREE.Mesh(
-        new THREE.SphereGeometry(0.045 / scale, 12, 8),
+        new THREE.SphereGeometry(0.05, 12, 8),
         new THREE.MeshBasicMaterial({ color: 0xffffff }),
       );
       this.group.add(line, marker);
       this.drawn.push({ curve, line, marker });
     }
-    this.stage.frame(new THREE.Vector3(), 3.4, new THREE.Vector3(1.2, 0.8, 1.5));
+    this.stage.frame(new THREE.Vector3(), 3.6, new THREE.Vector3(1.4, 0.9, 1.6));
     this.mark(this.drawn.map(() => 0));
   }
 
@@ -58,7 +55,7 @@ export class CurvePlot {
   mark(samples: number[]): void {
     this.drawn.forEach(({ curve, marker }, i) => {
       const k = Math.min(Math.max(samples[i] ?? 0, 0), curve.frames - 1);
-      marker.position.set(curve.at(k, 0), curve.at(k, 1), curve.at(k, 2));
+      marker.position.copy(this.toPlot(pointOf(curve, k)));
     });
     this.stage.requestRender();
   }
@@ -74,6 +71,10 @@ export class CurvePlot {
     this.drawn = [];
     this.stage.requestRender();
   }
+}
+
+function pointOf(curve: Curve, k: number): THREE.Vector3 {
+  return new THREE.Vector3(curve.at(k, 0), curve.at(k, 1), curve.at(k, 2));
 }
 
 /** The first three dimensions as red, green and blue axes through the plot's centre. */
