@@ -7,20 +7,15 @@ import { describe, fileQuery, toSearchQuery, type Query } from "./controller/sea
 import { loadSide, wholeClip } from "./controller/side_loader";
 import { readDeepLink, showDeepLink, formatDeepLink, type DeepLink } from "./model/deep_link";
 import { straightFrames, warpedFrames } from "./model/frame_map";
-import { Clock } from "./player/clock";
-import { StagePlayer, type Side } from "./player/stage_player";
-import { ClipPane } from "./view/clip_pane";
-import { CurvePlot } from "./view/curve_plot";
+import type { Side } from "./player/stage_player";
+import type { Stage } from "./stage";
 import { byId, fill, h } from "./view/dom";
 import { LabelPanel } from "./view/label_panel";
 import { LibraryPanel } from "./view/library_panel";
 import { SearchPanel } from "./view/search_panel";
 import { StatusLine } from "./view/status_line";
-import { Transport } from "./view/transport";
 
 const MAX_RESULTS = 20;
-const QUERY_COLOR = 0x4fb3ff;
-const HIT_COLOR = 0xff9f43;
 
 export class App {
   private readonly status = new StatusLine(byId("status"));
@@ -28,12 +23,7 @@ export class App {
   private readonly search = new SearchPanel(byId("search"));
   private readonly labels = new LabelPanel(byId("labels"));
   private readonly spaceSelect = byId<HTMLSelectElement>("space");
-  private readonly clock = new Clock();
-  private readonly panes = [
-    new ClipPane(byId("pane-a"), QUERY_COLOR),
-    new ClipPane(byId("pane-b"), HIT_COLOR),
-  ];
-  private readonly player = new StagePlayer(this.clock, this.panes, new CurvePlot(byId("curves")));
+  private stageLoad: Promise<Stage> | null = null;
   private spaces: Space[] = [];
   private openClip: Clip | null = null;
   private selection: FrameRange | null = null;
@@ -41,7 +31,6 @@ export class App {
   private results: SearchResult[] = [];
 
   constructor() {
-    new Transport(byId("transport"), this.clock);
     this.library.onOpen = (clip) => this.run(this.open(clip));
     this.search.onSearch = () => {
       const query = this.selectionQuery() ?? this.query;
@@ -51,13 +40,6 @@ export class App {
     this.search.onOpenHit = (index) => this.run(this.openHit(index));
     this.labels.onLabel = (descriptor, value) => this.run(this.addLabel(descriptor, value));
     this.labels.onPropagate = (descriptor, max) => this.run(this.propagate(descriptor, max));
-    this.panes.forEach((pane) => {
-      pane.timeline.onSelect = (span) => {
-        const clipId = pane.element.dataset.clipId;
-        if (clipId) this.select({ clipId, first: span.first, last: span.last });
-      };
-    });
-    this.panes[0].timeline.onSeek = (frame) => this.player.seekFrame(frame);
     this.spaceSelect.addEventListener("change", () => this.showLink());
   }
 
@@ -77,6 +59,7 @@ export class App {
     this.library.showSkeletons(skeletons);
     document.body.dataset.ready = "true";
     performance.mark("motiondb-ready");
+    void this.stage();
     await this.follow(readDeepLink(window.location.search));
   }
 
@@ -87,10 +70,26 @@ export class App {
     await this.open(clip, !link.space);
     if (link.from === undefined || link.to === undefined) return;
     this.select({ clipId: clip.clip_id, first: link.from, last: link.to });
-    this.panes[0].timeline.select({ first: link.from, last: link.to });
+    (await this.stage()).panes[0].timeline.select({ first: link.from, last: link.to });
     await this.runSearch({ kind: "range", clip, range: this.selection! });
     if (link.hit !== undefined && link.hit >= 1 && link.hit <= this.results.length)
       await this.openHit(link.hit - 1);
+  }
+
+  /** The stage, loaded on first use (three.js comes with it), its timelines wired to the page. */
+  private stage(): Promise<Stage> {
+    this.stageLoad ??= import("./stage").then(({ Stage }) => {
+      const stage = new Stage();
+      stage.panes.forEach((pane) => {
+        pane.timeline.onSelect = (span) => {
+          const clipId = pane.element.dataset.clipId;
+          if (clipId) this.select({ clipId, first: span.first, last: span.last });
+        };
+      });
+      stage.panes[0].timeline.onSeek = (frame) => stage.player.seekFrame(frame);
+      return stage;
+    });
+    return this.stageLoad;
   }
 
   private get space(): Space | null {
@@ -118,7 +117,7 @@ export class App {
     this.openClip = clip;
     this.select(null);
     this.library.highlight(clip.clip_id);
-    this.player.play([side], false);
+    (await this.stage()).player.play([side], false);
     this.status.info(
       side.curve
         ? `${clip.name}: drag on the timeline to select a range`
@@ -196,7 +195,7 @@ export class App {
         space.name,
       ),
     ]);
-    this.player.play([query, hitSide], true);
+    (await this.stage()).player.play([query, hitSide], true);
     this.search.highlight(index);
     this.status.info(`hit ${index + 1}: ${hit.clip_name} beside ${describe(this.query)}`);
   }
@@ -249,7 +248,7 @@ export class App {
   }
 
   private async refreshLabels(): Promise<void> {
-    for (const pane of this.panes) {
+    for (const pane of (await this.stage()).panes) {
       const clipId = pane.element.dataset.clipId;
       if (clipId && !pane.element.hidden) pane.setLabels((await api.clipLabels(clipId)).labels);
     }
