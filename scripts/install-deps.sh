@@ -7,10 +7,15 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 lists=("$here/packages-build.txt")
 [[ "${1:-}" == "--build-only" ]] || lists+=("$here/packages-dev.txt")
-mapfile -t wanted < <(grep -hv '^\s*#' "${lists[@]}" | awk 'NF {print $1}')
+# A line is a package name, optionally followed by `command=NAME`: then the package also counts
+# as present when NAME is on PATH (another source installed it, e.g. a nodejs that bundles npm,
+# which Debian's npm package would conflict with).
+mapfile -t wanted < <(grep -hv '^\s*#' "${lists[@]}" | awk 'NF {print $1, $2}')
 
 missing=()
-for pkg in "${wanted[@]}"; do
+for line in "${wanted[@]}"; do
+  read -r pkg marker <<<"$line"
+  [[ "$marker" == command=* ]] && command -v "${marker#command=}" >/dev/null && continue
   status="$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)"
   [[ "$status" == "install ok installed" ]] || missing+=("$pkg")
 done

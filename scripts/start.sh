@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # One command for a newcomer: installs missing Debian packages, builds, and starts the
-# motiondb server with its embedded default storage (./motiondb.sqlite, 127.0.0.1:50051).
+# motiondb server with its embedded default storage (./motiondb.sqlite, gRPC on 127.0.0.1:50051)
+# and its web asset browser (HTTP on 127.0.0.1:8080).
 #
 #   scripts/start.sh           start the server (Ctrl-C stops it gracefully)
 #   scripts/start.sh --demo    ... and load a small demo library into it first: the BVH files of
@@ -9,8 +10,9 @@
 #                              with a space "bandai"
 # Extra arguments after the options go to motiondb-server (e.g. --listen 0.0.0.0:50051).
 # Only the server and the CLI are built here (scripts/test.sh builds the rest), in $BUILD_DIR
-# (default build/). The server's log (one line per request) goes to $MOTIONDB_LOG, default
-# ./motiondb-server.log, so that this terminal stays free for the CLI.
+# (default build/), and the web page into web/dist when its sources changed (build-web.sh).
+# The server's log (one line per request) goes to $MOTIONDB_LOG, default ./motiondb-server.log,
+# so that this terminal stays free for the CLI.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 demo=0
@@ -21,9 +23,11 @@ fi
 "$root/scripts/install-deps.sh"
 build="${BUILD_DIR:-$root/build}"
 BUILD_DIR="$build" "$root/scripts/build.sh" motiondb-server motiondb
+"$root/scripts/build-web.sh"
 server="$build/server/motiondb-server"
 cli="$build/client/motiondb"
-# The CLI talks to wherever the server was told to listen (a wildcard host is reached locally).
+# The CLI talks to wherever the server was told to listen, and the page is where it serves HTTP
+# (a wildcard host is reached locally).
 listen="127.0.0.1:50051"
 http="127.0.0.1:8080"
 scheme=http
@@ -65,6 +69,6 @@ if ((demo)); then
   echo "Try: $cli search --space demo --clip 1 --server $address"
 fi
 echo
-[[ "$http" == "off" ]] || echo "Web UI and JSON API: $scheme://${http/#0.0.0.0:/127.0.0.1:}"
+[[ "$http" == "off" ]] || echo "open $scheme://${http/#0.0.0.0:/127.0.0.1:} (web asset browser and JSON API)"
 echo "motiondb-server is running (pid $pid). Use $cli help; Ctrl-C stops the server."
 wait "$pid"

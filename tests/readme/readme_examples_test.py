@@ -10,7 +10,8 @@ linked to the real ones), with the built `motiondb` on PATH and MOTIONDB_SERVER 
 test's server; the README's default addresses (127.0.0.1:50051, and 127.0.0.1:8080 for HTTP)
 are replaced by the test server's. A block preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must say which other
 check runs it. `<!-- readme-test: requires: TOOL -->` runs the block when TOOL is on PATH and
-says so when it is not (npx: Node.js is not among the Debian packages this project installs). Last, `scripts/start.sh --demo` must load its demo library into a fresh database.
+says so when it is not. Last, `scripts/start.sh --demo` must load its demo library into a fresh database, say where its
+web page is, and serve it there.
 """
 import os
 import pathlib
@@ -119,8 +120,12 @@ def main():
         try:
             demo_env = dict(env, MOTIONDB_SERVER=demo.address)
             ran += 1
+            page = f"http://{demo.http_address}"
+            if f"open {page}" not in demo.text():
+                failed.append(f"scripts/start.sh --demo did not say: open {page}")
             if run_block("motiondb clips --tag demo | grep -q 01_01\n"
-                         "motiondb search --space demo --clip 1 --max 3\n", demo_env, work) != 0:
+                         "motiondb search --space demo --clip 1 --max 3\n"
+                         f"curl -sf {page}/ | grep -q '<title>motiondb'\n", demo_env, work) != 0:
                 failed.append("scripts/start.sh --demo")
         finally:
             demo.stop()

@@ -1,0 +1,261 @@
+// The web asset browser in a real browser (issue 14): Debian's Chromium, headless, driven by
+// Playwright against a real motiondb-server (fresh database, free ports) holding the demo
+// library. Run by run_browser_tests.sh (ctest Web.BrowserTests), which says how it is invoked.
+// Screenshots go to $MOTIONDB_WEB_TEST_OUT.
+import assert from "node:assert/strict";
+import { mkdirSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { after, before, test } from "node:test";
+import { Browser } from "../../testing/web/browser.mjs";
+import { ASSIMP_BVH, cli, cliOffline, loadDemoLibrary } from "../../testing/web/library.mjs";
+import { ServerProcess } from "../../testing/web/server.mjs";
+
+const SERVER = process.env.MOTIONDB_SERVER_BIN;
+const CLI = process.env.MOTIONDB_CLI_BIN;
+const OUT = process.env.MOTIONDB_WEB_TEST_OUT;
+/** Long enough for a search or a clip's poses on a loaded 2-core machine. */
+const WAIT = { timeout: 30_000 };
+
+let server;
+let browser;
+let clips;
+let work;
+let queryFile;
+
+before(async () => {
+  assert.ok(
+    SERVER && CLI && OUT,
+    "MOTIONDB_SERVER_BIN, MOTIONDB_CLI_BIN and MOTIONDB_WEB_TEST_OUT",
+  );
+  mkdirSync(OUT, { recursive: true });
+  work = mkdtempSync(join(tmpdir(), "motiondb_web_test_"));
+  server = await ServerProcess.start(SERVER);
+  clips = loadDemoLibrary(CLI, server);
+  cli(CLI, server, "label", "add", "01_03:10-100", "kick", "--value", "0.8");
+  // An upload query: two seconds of 01_03 cut out as a file of its own.
+  queryFile = join(work, "query_01_03.bvh");
+  cliOffline(
+    CLI,
+    "convert",
+    join(ASSIMP_BVH, "01_03.bvh"),
+    queryFile,
+    "--from",
+    "100",
+    "--to",
+    "340",
+  );
+  browser = await Browser.launch();
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+  if (work) rmSync(work, { recursive: true, force: true });
+});
+
+async function openPage(path = "/") {
+  const page = await browser.page();
+  await page.goto(server.baseUrl + path);
+  await page.waitForSelector("body[data-ready=true]", WAIT);
+  return page;
+}
+
+async function listedNames(page) {
+  return page.locator("[data-testid=clip-list] .clip-name").allTextContents();
+}
+
+/** Waits until the list shows exactly `names` (filters apply after a short typing pause). */
+async function expectListed(page, names) {
+  await page.waitForFunction(
+    (expected) =>
+      JSON.stringify(
+        [...document.querySelectorAll("[data-testid=clip-list] .clip-name")].map(
+          (e) => e.textContent,
+        ),
+      ) === JSON.stringify(expected),
+    names,
+    WAIT,
+  );
+  assert.deepEqual(await listedNames(page), names);
+}
+
+/** The frame a pane's counter shows. */
+async function frameOf(page, pane) {
+  return Number(
+    await page.getAttribute(`[data-testid=${pane}] [data-testid=frame-counter]`, "data-frame"),
+  );
+}
+
+/** Waits until a pane's frame counter shows a frame other than `frame`: the figure plays. */
+async function expectAdvances(page, pane, frame) {
+  await page.waitForFunction(
+    ({ pane, frame }) => {
+      const counter = document.querySelector(`[data-testid=${pane}] [data-testid=frame-counter]`);
+      return (
+        counter && counter.dataset.frame !== undefined && Number(counter.dataset.frame) !== frame
+      );
+    },
+    { pane, frame },
+    WAIT,
+  );
+}
+
+test("the library lists every clip with its duration, rate and tags", async () => {
+  const page = await openPage();
+  await expectListed(page, ["01_01", "01_03", "Boxing_Toes"]);
+  assert.equal(await page.textContent("[data-testid=clip-count]"), "1–3 of 3");
+  const boxing = page.locator(".clip-row", { hasText: "Boxing_Toes" });
+  assert.match(await boxing.textContent(), /30\.7 s · 100 fps/);
+  assert.deepEqual(await boxing.locator(".tag").allTextContents(), ["boxing", "demo"]);
+  await page.screenshot({ path: join(OUT, "library.png") });
+  await page.close();
+});
+
+test("the name, tag, skeleton and label filters narrow the list", async () => {
+  const page = await openPage();
+  await page.fill("[data-testid=filter-name]", "01_");
+  await expectListed(page, ["01_01", "01_03"]);
+  await page.fill("[data-testid=filter-name]", "");
+  await page.fill("[data-testid=filter-tag]", "boxing");
+  await expectListed(page, ["Boxing_Toes"]);
+  await page.fill("[data-testid=filter-tag]", "");
+  await page.selectOption("[data-testid=filter-skeleton]", String(clips["01_01"].skeleton_id));
+  await expectListed(page, ["01_01", "01_03"]);
+  await page.selectOption("[data-testid=filter-skeleton]", "");
+  await page.fill("[data-testid=filter-label]", "kick");
+  await expectListed(page, ["01_03"]);
+  await page.fill("[data-testid=filter-label]", "no-such-label");
+  await expectListed(page, []);
+  assert.equal(await page.textContent("[data-testid=clip-count]"), "no clips match");
+  await page.close();
+});
+
+test("a clip opens with its figure, labels and curve, and plays", async () => {
+  const page = await openPage();
+  await page.click(".clip-row:has-text('01_03')");
+  await page.waitForSelector(
+    "[data-testid=pane-query][data-clip-id] .title:has-text('01_03')",
+    WAIT,
+  );
+  assert.equal(
+    await page.locator("[data-testid=pane-query] .label-row .descriptor").textContent(),
+    "kick",
+  );
+  assert.equal(await page.locator("[data-testid=curves] canvas").count(), 1);
+  assert.equal(await frameOf(page, "pane-query"), 0);
+  await page.click("[data-testid=play]");
+  await expectAdvances(page, "pane-query", 0);
+  await page.close();
+});
+
+test("a deep link opens its search and shows the ranked hits", async () => {
+  const id = clips["01_01"].clip_id;
+  const page = await openPage(`/?space=demo&clip=${id}&from=40&to=124`);
+  await page.waitForSelector("[data-testid=hit]", WAIT);
+  const hits = page.locator("[data-testid=hit]");
+  assert.ok((await hits.count()) >= 1);
+  assert.match(await hits.first().textContent(), /\d+\.\d+ s – \d+\.\d+ s · frames \d+–\d+/);
+  assert.match(await page.textContent("[data-testid=query]"), /01_01, frames 40–124/);
+  assert.equal(
+    await page.getAttribute("[data-testid=pane-query] .timeline", "data-selection"),
+    "40-124",
+  );
+  assert.match(
+    await page.getAttribute("[data-testid=search-link]", "href"),
+    new RegExp(`clip=${id}&from=40&to=124`),
+  );
+  await page.close();
+});
+
+test("a hit plays beside its query, in step", async () => {
+  const id = clips["01_01"].clip_id;
+  const page = await openPage(`/?space=demo&clip=${id}&from=40&to=124`);
+  await page.click("[data-testid=hit] >> nth=0", WAIT);
+  await page.waitForSelector(
+    "[data-testid=pane-hit]:not([hidden]) [data-testid=frame-counter][data-frame]",
+    WAIT,
+  );
+  const hitFrame = await frameOf(page, "pane-hit");
+  const queryFrame = await frameOf(page, "pane-query");
+  await expectAdvances(page, "pane-hit", hitFrame);
+  await expectAdvances(page, "pane-query", queryFrame);
+  assert.equal(await page.getAttribute("[data-testid=play]", "data-state"), "playing");
+  // A moment into the motion, for the picture in the README.
+  await page.waitForFunction(
+    () =>
+      Number(
+        document.querySelector("[data-testid=pane-query] [data-testid=frame-counter]").dataset
+          .frame,
+      ) >= 90,
+    null,
+    WAIT,
+  );
+  await page.screenshot({ path: join(OUT, "hit-beside-query.png") });
+  await page.close();
+});
+
+test("an uploaded BVH file searches, chosen or dropped", async () => {
+  const page = await openPage();
+  await page.setInputFiles("[data-testid=bvh-input]", queryFile);
+  await page.waitForSelector("[data-testid=hit]", WAIT);
+  assert.match(await page.textContent("[data-testid=search-summary]"), /^\d+ hits/);
+  assert.match(await page.textContent("[data-testid=hits]"), /01_03/);
+  await page.evaluate(() => document.querySelector("[data-testid=hits]").replaceChildren());
+  const text = readFileSync(queryFile, "utf8");
+  await page.evaluate((bvh) => {
+    const transfer = new DataTransfer();
+    transfer.items.add(new File([bvh], "dropped.bvh"));
+    const drop = document.querySelector("[data-testid=drop]");
+    drop.dispatchEvent(
+      new DragEvent("drop", {
+        dataTransfer: transfer,
+        bubbles: true,
+        cancelable: true,
+      }),
+    );
+  }, text);
+  await page.waitForSelector("[data-testid=hit]", WAIT);
+  assert.match(await page.textContent("[data-testid=query]"), /./);
+  await page.click("[data-testid=hit] >> nth=0");
+  await page.waitForSelector(
+    "[data-testid=pane-query] [data-testid=frame-counter][data-frame]",
+    WAIT,
+  );
+  await page.screenshot({ path: join(OUT, "upload-search.png") });
+  await page.close();
+});
+
+test("a selected range is labelled and the label propagated", async () => {
+  const id = clips["01_01"].clip_id;
+  const page = await openPage(`/?space=demo&clip=${id}`);
+  await page.waitForSelector(
+    "[data-testid=pane-query][data-clip-id] .title:has-text('01_01')",
+    WAIT,
+  );
+  const track = await page.locator("[data-testid=pane-query] .track").boundingBox();
+  const y = track.y + track.height / 2;
+  await page.mouse.move(track.x + track.width * 0.1, y);
+  await page.mouse.down();
+  await page.mouse.move(track.x + track.width * 0.2, y, { steps: 5 });
+  await page.mouse.up();
+  assert.match(
+    await page.getAttribute("[data-testid=pane-query] .timeline", "data-selection"),
+    /^\d+-\d+$/,
+  );
+  await page.fill("[data-testid=descriptor]", "walk-start");
+  await page.click("[data-testid=add-label]");
+  await page.waitForSelector(
+    "[data-testid=pane-query] .label-row:has-text('walk-start') .label-bar.manual",
+    WAIT,
+  );
+  await page.click("[data-testid=propagate]");
+  await page.waitForSelector("[data-testid=job-state][data-state=succeeded]", WAIT);
+  assert.match(await page.textContent("[data-testid=job-state]"), /job-\d+ succeeded 1\/1/);
+  await page.screenshot({ path: join(OUT, "labels.png") });
+  await page.close();
+});
+
+test("no page logged an error", () => {
+  assert.deepEqual(browser.errors, []);
+});

@@ -1,0 +1,261 @@
+// The page: wires the library, the stage (panes, transport, curve plot), search and labels to
+// the state they share: the space, the open clip, the selected range, the last search.
+import { api, type FrameRange } from "./api/routes";
+import type { Clip, SearchResult, Space } from "./api/types";
+import { isLive, watchJob } from "./controller/job_watch";
+import { describe, fileQuery, toSearchQuery, type Query } from "./controller/search_query";
+import { loadSide, wholeClip } from "./controller/side_loader";
+import { readDeepLink, showDeepLink, formatDeepLink, type DeepLink } from "./model/deep_link";
+import { straightFrames, warpedFrames } from "./model/frame_map";
+import type { Side } from "./player/stage_player";
+import type { Stage } from "./stage";
+import { byId, fill, h } from "./view/dom";
+import { LabelPanel } from "./view/label_panel";
+import { LibraryPanel } from "./view/library_panel";
+import { SearchPanel } from "./view/search_panel";
+import { StatusLine } from "./view/status_line";
+
+const MAX_RESULTS = 20;
+
+export class App {
+  private readonly status = new StatusLine(byId("status"));
+  private readonly library = new LibraryPanel(byId("library"), this.status);
+  private readonly search = new SearchPanel(byId("search"));
+  private readonly labels = new LabelPanel(byId("labels"));
+  private readonly spaceSelect = byId<HTMLSelectElement>("space");
+  private stageLoad: Promise<Stage> | null = null;
+  private spaces: Space[] = [];
+  private openClip: Clip | null = null;
+  private selection: FrameRange | null = null;
+  private query: Query | null = null;
+  private results: SearchResult[] = [];
+
+  constructor() {
+    this.library.onOpen = (clip) => this.run(this.open(clip));
+    this.search.onSearch = () => {
+      const query = this.selectionQuery() ?? this.query;
+      if (query) this.run(this.runSearch(query));
+    };
+    this.search.onFile = (file) => this.run(fileQuery(file).then((query) => this.runSearch(query)));
+    this.search.onOpenHit = (index) => this.run(this.openHit(index));
+    this.labels.onLabel = (descriptor, value) => this.run(this.addLabel(descriptor, value));
+    this.labels.onPropagate = (descriptor, max) => this.run(this.propagate(descriptor, max));
+    this.spaceSelect.addEventListener("change", () => this.showLink());
+  }
+
+  /** Loads the library and follows the page's address (a deep link). */
+  async start(): Promise<void> {
+    const [spaces, skeletons] = await Promise.all([
+      api.spaces(),
+      api.skeletons(),
+      this.library.reload(),
+    ]);
+    this.spaces = spaces;
+    fill(
+      this.spaceSelect,
+      ...spaces.map((s) => h("option", { value: s.name }, `${s.name} · skeleton ${s.skeleton_id}`)),
+    );
+    if (!spaces.length) fill(this.spaceSelect, h("option", { value: "" }, "no space"));
+    this.library.showSkeletons(skeletons);
+    document.body.dataset.ready = "true";
+    performance.mark("motiondb-ready");
+    void this.stage();
+    await this.follow(readDeepLink(window.location.search));
+  }
+
+  private async follow(link: DeepLink): Promise<void> {
+    if (link.space) this.spaceSelect.value = link.space;
+    if (!link.clipId) return;
+    const clip = await api.clip(link.clipId);
+    await this.open(clip, !link.space);
+    if (link.from === undefined || link.to === undefined) return;
+    this.select({ clipId: clip.clip_id, first: link.from, last: link.to });
+    (await this.stage()).panes[0].timeline.select({ first: link.from, last: link.to });
+    await this.runSearch({ kind: "range", clip, range: this.selection! });
+    if (link.hit !== undefined && link.hit >= 1 && link.hit <= this.results.length)
+      await this.openHit(link.hit - 1);
+  }
+
+  /** The stage, loaded on first use (three.js comes with it), its timelines wired to the page. */
+  private stage(): Promise<Stage> {
+    this.stageLoad ??= import("./stage").then(({ Stage }) => {
+      const stage = new Stage();
+      stage.panes.forEach((pane) => {
+        pane.timeline.onSelect = (span) => {
+          const clipId = pane.element.dataset.clipId;
+          if (clipId) this.select({ clipId, first: span.first, last: span.last });
+        };
+      });
+      stage.panes[0].timeline.onSeek = (frame) => stage.player.seekFrame(frame);
+      return stage;
+    });
+    return this.stageLoad;
+  }
+
+  private get space(): Space | null {
+    return this.spaces.find((s) => s.name === this.spaceSelect.value) ?? null;
+  }
+
+  /** Opens a clip alone on the stage; picks a space of its skeleton when the current one is not. */
+  private async open(clip: Clip, pickSpace = true): Promise<void> {
+    if (pickSpace && this.space?.skeleton_id !== clip.skeleton_id) {
+      const fitting = this.spaces.find((s) => s.skeleton_id === clip.skeleton_id);
+      if (fitting) this.spaceSelect.value = fitting.name;
+    }
+    this.status.info(`Opening ${clip.name}…`);
+    const range = wholeClip(clip);
+    const side = await loadSide(
+      {
+        clip,
+        range,
+        frames: straightFrames(range.first, range.last, clip.fps),
+        highlight: null,
+        role: "clip",
+      },
+      this.space?.name ?? null,
+    );
+    this.openClip = clip;
+    this.select(null);
+    this.library.highlight(clip.clip_id);
+    (await this.stage()).player.play([side], false);
+    this.status.info(
+      side.curve
+        ? `${clip.name}: drag on the timeline to select a range`
+        : `${clip.name}: no curve in space ${this.space?.name ?? "(none)"}`,
+    );
+  }
+
+  private select(range: FrameRange | null): void {
+    this.selection = range;
+    this.labels.setSelection(range !== null);
+    const query = this.selectionQuery() ?? this.query;
+    this.search.setQuery(query ? describe(query) : null);
+    this.showLink();
+  }
+
+  /** A search with the selected range, when it is of a clip the page knows. */
+  private selectionQuery(): Query | null {
+    const range = this.selection;
+    const clip = [this.openClip, this.query?.clip].find(
+      (c) => c && range && c.clip_id === range.clipId,
+    );
+    return range && clip ? { kind: "range", clip, range } : null;
+  }
+
+  private showLink(): void {
+    const range = this.selection;
+    showDeepLink({
+      space: this.space?.name,
+      clipId: range?.clipId ?? this.openClip?.clip_id,
+      from: range?.first,
+      to: range?.last,
+    });
+  }
+
+  private async runSearch(query: Query): Promise<void> {
+    const space = this.space;
+    if (!space) throw new Error("no space to search in: create one with `motiondb space create`");
+    this.query = query;
+    this.search.setQuery(describe(query));
+    this.search.busy(`Searching ${describe(query)} in ${space.name}…`);
+    const started = performance.now();
+    const response = await api.search(space.name, toSearchQuery(query), MAX_RESULTS);
+    this.results = response.results;
+    const link =
+      query.kind === "range"
+        ? formatDeepLink({
+            space: space.name,
+            clipId: query.range.clipId,
+            from: query.range.first,
+            to: query.range.last,
+          })
+        : null;
+    this.search.showResults(response.results, response.timings?.request_ms, link);
+    document.body.dataset.searchMs = (performance.now() - started).toFixed(1);
+    this.status.info(`${response.results.length} hits for ${describe(query)}`);
+  }
+
+  /** Opens hit `index` beside its query, both playing in step through the hit's warp path. */
+  private async openHit(index: number): Promise<void> {
+    const hit = this.results[index];
+    const space = this.space;
+    if (!hit || !this.query || !space?.report) return;
+    const hitClip = await api.clip(hit.clip_id);
+    const span = { first: hit.start_frame, last: hit.end_frame };
+    const [query, hitSide] = await Promise.all([
+      this.querySide(this.query, space.name),
+      loadSide(
+        {
+          clip: hitClip,
+          range: { clipId: hit.clip_id, ...span },
+          frames: warpedFrames(hit.path, space.report.sample_rate),
+          highlight: span,
+          role: `hit ${index + 1}`,
+        },
+        space.name,
+      ),
+    ]);
+    (await this.stage()).player.play([query, hitSide], true);
+    this.search.highlight(index);
+    this.status.info(`hit ${index + 1}: ${hit.clip_name} beside ${describe(this.query)}`);
+  }
+
+  /** The query's side: a stored range from the server, an uploaded file from the file. */
+  private querySide(query: Query, space: string): Promise<Side> {
+    const { clip } = query;
+    if (query.kind === "file") {
+      const last = clip.frame_count - 1;
+      return Promise.resolve({
+        clip,
+        poses: query.poses,
+        labels: [],
+        curve: null,
+        frames: straightFrames(0, last, clip.fps),
+        highlight: { first: 0, last },
+        role: "query",
+      });
+    }
+    const { first, last } = query.range;
+    return loadSide(
+      {
+        clip,
+        range: query.range,
+        frames: straightFrames(first, last, clip.fps),
+        highlight: { first, last },
+        role: "query",
+      },
+      space,
+    );
+  }
+
+  private async addLabel(descriptor: string, value: number): Promise<void> {
+    if (!this.selection) return;
+    await api.addLabel(this.selection, descriptor, value);
+    this.status.info(
+      `labelled frames ${this.selection.first}–${this.selection.last} ${descriptor}`,
+    );
+    await this.refreshLabels();
+  }
+
+  private async propagate(descriptor: string, maxResults: number): Promise<void> {
+    const space = this.space;
+    if (!space) throw new Error("no space to propagate in");
+    const job = await watchJob(
+      await api.startPropagation(space.name, descriptor, maxResults),
+      (j) => this.labels.showJob(j),
+    );
+    if (!isLive(job)) await this.refreshLabels();
+  }
+
+  private async refreshLabels(): Promise<void> {
+    for (const pane of (await this.stage()).panes) {
+      const clipId = pane.element.dataset.clipId;
+      if (clipId && !pane.element.hidden) pane.setLabels((await api.clipLabels(clipId)).labels);
+    }
+  }
+
+  /** Runs an action, telling its failure in the status line. */
+  private run(action: Promise<unknown>): void {
+    action.catch((error) => this.status.error(error));
+  }
+}
