@@ -36,7 +36,7 @@ struct QualityFlags {
   std::string neutral = "mean";
   bool keep_heading = false, no_refine = false;
   int places = 0;
-  double root_velocity = 0;
+  double root_velocity = SpaceOptions().root_velocity_weight;
   SpaceOptions space;
   RetrievalOptions retrieval;
 };
@@ -140,10 +140,10 @@ absl::Status Run(QualityFlags& flags) {
               static_cast<long long>(library.index->total_frames()), library.space->sample_rate(),
               library.space->dims(), setup_s);
   std::printf(
-      "metric %s, weights %s, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
+      "metric %s, weights %s, root velocity %g, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
       "neutral %s%s%s\n",
       metric.c_str(), std::string(WeightPresetName(space_options.weights.preset)).c_str(),
-      flags.places > 0 ? "distinct places" : "neighbours",
+      flags.root_velocity, flags.places > 0 ? "distinct places" : "neighbours",
       flags.places > 0 ? flags.places : params.neighbours, params.ann_dims, params.dtw_dims,
       params.slope_limit, neutral.c_str(),
       space_options.pose.remove_heading ? "" : ", heading kept",
