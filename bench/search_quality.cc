@@ -1,10 +1,13 @@
-// Retrieval quality of the search on real labelled data (issue 4): every clip of a labelled
-// folder (default ../shared/mocap/bandai2-normal; label = the file name's content field) is a
-// query against the library of all the others, in a space trained on the folder. Prints mean
-// precision@5 of the label for the fast and the exact search, the fast search's recall@10
-// against the exact search, query latency and the mean stage times.
+// Retrieval quality of the search on real labelled data (issues 4 and 12): the clips of labelled
+// folders (default ../shared/mocap/bandai2-normal; label = the file name's content field, style
+// = its style field) in a space trained on them all. `--split one`: every clip a query against
+// all the others; `--split style`: against the clips of other styles only; `--split dataset`:
+// the first folder's clips against the other folders' (on the contents they share). Prints
+// mean precision@5 of the label for the fast and the exact search (per label, and per style or
+// folder), the fast search's recall@10 against the exact search, latency and stage times.
 //
-// usage: search_quality [--folder DIR] [--metric unit|eigen] [--weights mass|uniform]
+// usage: search_quality [--folder DIR]... [--split one|style|dataset] [--metric unit|eigen]
+//          [--weights mass|uniform]
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
 //          [--no-refine]
@@ -12,7 +15,9 @@
 #include <cstdio>
 #include <string>
 #include <tuple>
+#include <vector>
 
+#include "absl/strings/str_join.h"
 #include "bench/measure.h"
 #include "testing/labelled_index.h"
 #include "testing/retrieval_evaluation.h"
@@ -24,19 +29,24 @@ namespace {
 
 // The flags, with the defaults of the space and the search.
 struct QualityFlags {
-  std::string folder = (bench::MocapRoot() / "bandai2-normal").string();
+  std::vector<std::string> folders = {(bench::MocapRoot() / "bandai2-normal").string()};
+  std::string split = "one";
   std::string metric = "unit";
   std::string weights = "mass";
   std::string neutral = "mean";
   bool keep_heading = false, no_refine = false;
   int places = 0;
+  double root_velocity = SpaceOptions().root_velocity_weight;
   SpaceOptions space;
   RetrievalOptions retrieval;
 };
 
 void AddFlags(CLI::App& app, QualityFlags* flags) {
-  app.add_option("--folder", flags->folder, "labelled BVH folder")
+  app.add_option("--folder", flags->folders, "labelled BVH folders (repeat for several)")
       ->type_name("DIR")
+      ->capture_default_str();
+  cli::OneOf(app.add_option("--split", flags->split, "what each query searches"),
+             {"one", "style", "dataset"})
       ->capture_default_str();
   cli::OneOf(app.add_option("--metric", flags->metric, "the space's metric"), {"unit", "eigen"})
       ->capture_default_str();
@@ -51,6 +61,11 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
       ->type_name("W")
       ->capture_default_str()
       ->check(cli::NumberAbove(0));
+  app.add_option("--root-velocity", flags->root_velocity,
+                 "the root-velocity dimensions' weight (0: no such dimensions)")
+      ->type_name("W")
+      ->capture_default_str()
+      ->check(cli::NumberAtLeast(0));
   app.add_flag("--keep-heading", flags->keep_heading, "keep the body's facing in the pose");
   SearchParams& params = flags->retrieval.params;
   for (auto [name, field, what, min] :
@@ -72,19 +87,35 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
   app.add_flag("--no-refine", flags->no_refine, "the thesis's search as is");
 }
 
+// Groups and queries of `split` (see the file comment).
+void SetSplit(const testing::LabelledIndex& library, const std::string& split,
+              RetrievalOptions* options) {
+  if (split == "style") options->groups = library.styles;
+  if (split != "dataset") return;
+  options->groups = library.sources;
+  for (const std::string& source : library.sources) {
+    options->queries.push_back(source == library.sources.front());
+  }
+}
+
 absl::Status Run(QualityFlags& flags) {
-  const std::filesystem::path folder = flags.folder;
-  if (!std::filesystem::is_directory(folder)) {
-    std::printf("search_quality: %s is absent; nothing measured\n", folder.c_str());
-    return absl::OkStatus();
+  std::vector<std::filesystem::path> folders;
+  for (const std::string& folder : flags.folders) {
+    if (!std::filesystem::is_directory(folder)) {
+      std::printf("search_quality: %s is absent; nothing measured\n", folder.c_str());
+      return absl::OkStatus();
+    }
+    folders.push_back(folder);
   }
   SpaceOptions& space_options = flags.space;
   const std::string& metric = flags.metric;
   space_options.metric = metric == "eigen" ? SpaceMetric::kEigenvalueScaled : SpaceMetric::kUnit;
   MOTIONDB_ASSIGN_OR_RETURN(space_options.weights.preset, ParseWeightPreset(flags.weights));
   space_options.pose.remove_heading = !flags.keep_heading;
+  space_options.pose.root_velocity = flags.root_velocity > 0;
+  if (flags.root_velocity > 0) space_options.root_velocity_weight = flags.root_velocity;
 
-  const RetrievalOptions& options = flags.retrieval;
+  RetrievalOptions& options = flags.retrieval;
   SearchParams& params = flags.retrieval.params;
   const std::string& neutral = flags.neutral;
   params.neutral = neutral == "origin"     ? NeutralPose::kOrigin
@@ -98,27 +129,30 @@ absl::Status Run(QualityFlags& flags) {
 
   const bench::Clock::time_point start = bench::Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const testing::LabelledIndex library,
-                            testing::LoadLabelledIndex(folder, space_options, {params.ann_dims}));
+                            testing::LoadLabelledIndex(folders, space_options, {params.ann_dims}));
   const double setup_s = bench::SecondsSince(start);
+  SetSplit(library, flags.split, &options);
   MOTIONDB_ASSIGN_OR_RETURN(const RetrievalReport report,
-                            EvaluateLeaveOneOut(*library.index, library.labels, options));
+                            EvaluateRetrieval(*library.index, library.labels, options));
 
   std::printf("%s: %d clips, %lld frames at %.0f Hz, %d dims; load+space+index %.1f s\n",
-              folder.c_str(), library.index->clip_count(),
+              absl::StrJoin(flags.folders, " + ").c_str(), library.index->clip_count(),
               static_cast<long long>(library.index->total_frames()), library.space->sample_rate(),
               library.space->dims(), setup_s);
   std::printf(
-      "metric %s, weights %s, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
+      "metric %s, weights %s, root velocity %g, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
       "neutral %s%s%s\n",
       metric.c_str(), std::string(WeightPresetName(space_options.weights.preset)).c_str(),
-      flags.places > 0 ? "distinct places" : "neighbours",
+      flags.root_velocity, flags.places > 0 ? "distinct places" : "neighbours",
       flags.places > 0 ? flags.places : params.neighbours, params.ann_dims, params.dtw_dims,
       params.slope_limit, neutral.c_str(),
       space_options.pose.remove_heading ? "" : ", heading kept",
       params.refine ? "" : ", no refinement");
-  std::printf("fast:  precision@%d %.3f over %d queries, latency p50 %.2f ms p99 %.2f ms\n",
-              options.precision_at, report.precision, report.queries, report.latency_p50_ms,
-              report.latency_p99_ms);
+  std::printf(
+      "fast:  precision@%d %.3f over %d queries (split %s, %d left out), latency p50 %.2f ms p99 "
+      "%.2f ms\n",
+      options.precision_at, report.precision, report.queries, flags.split.c_str(),
+      report.skipped_queries, report.latency_p50_ms, report.latency_p99_ms);
   std::printf("fast stages, mean ms:");
   for (const auto& [stage, ms] : report.mean_stage_ms) std::printf(" %s %.2f", stage.c_str(), ms);
   std::printf("\n");
@@ -130,7 +164,15 @@ absl::Status Run(QualityFlags& flags) {
         report.exact_latency_p50_ms, options.recall_at, report.recall);
   }
   for (const auto& [label, precision] : report.precision_by_label) {
-    std::printf("  %-22s precision@%d %.3f\n", label.c_str(), options.precision_at, precision);
+    std::printf("  %-22s precision@%d %.3f, found:", label.c_str(), options.precision_at,
+                precision);
+    for (const auto& [found, count] : report.confusion.at(label)) {
+      std::printf(" %s %d", found.c_str(), count);
+    }
+    std::printf("\n");
+  }
+  for (const auto& [group, precision] : report.precision_by_group) {
+    std::printf("  %-22s precision@%d %.3f\n", group.c_str(), options.precision_at, precision);
   }
   return absl::OkStatus();
 }

@@ -59,6 +59,7 @@ absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
   const SpaceFlags& space = flags.space;
   if (space.rate) request.set_sample_rate(*space.rate);
   if (space.yaw_rate_weight) request.set_yaw_rate_weight(*space.yaw_rate_weight);
+  if (space.root_velocity_weight) request.set_root_velocity_weight(*space.root_velocity_weight);
   if (flags.skeleton) request.set_skeleton_id(*flags.skeleton);
   request.set_keep_heading(space.keep_heading);
   if (!IsWeightPreset(space.weights)) {
@@ -78,6 +79,7 @@ FlagNames CreateFlagNames(const CreateFlags& flags) {
   FlagNames names = {{"skeleton_id", "--skeleton"},
                      {"sample_rate", "--rate"},
                      {"yaw_rate_weight", "--yaw-rate-weight"},
+                     {"root_velocity_weight", "--root-velocity-weight"},
                      {"weights_json", "--weights"},
                      {"weight_preset", "--weights"},
                      {"metric", "--metric"}};
@@ -103,6 +105,7 @@ nlohmann::json SpaceJson(const v1::Space& space) {
           {"dims", report.dims()},
           {"sample_rate", report.sample_rate()},
           {"heading_removed", report.heading_removed()},
+          {"root_velocity_weight", report.root_velocity_weight()},
           {"training_frames", report.training_frames()},
           {"projected_clips", report.projected_clips()},
           // The resident index, current after later ingests and deletes; the report is the

@@ -74,6 +74,10 @@ absl::StatusOr<SpaceOptions> ParseOptions(const SpaceFlags& flags) {
   options.sample_rate = flags.rate.value_or(options.sample_rate);
   options.yaw_rate_weight = flags.yaw_rate_weight.value_or(options.yaw_rate_weight);
   options.pose.remove_heading = !flags.keep_heading;
+  if (flags.root_velocity_weight) {
+    options.pose.root_velocity = *flags.root_velocity_weight != 0;
+    if (options.pose.root_velocity) options.root_velocity_weight = *flags.root_velocity_weight;
+  }
   MOTIONDB_RETURN_IF_ERROR(ApplyWeights(flags.weights, &options));
   if (flags.metric == "eigen") options.metric = SpaceMetric::kEigenvalueScaled;
   return options;
@@ -101,6 +105,7 @@ nlohmann::json Report(const std::string& out, const MotionSpace& space,
       {"heading_removed", data.pose.remove_heading},
       {"yaw_rate_weight",
        data.pose.remove_heading ? nlohmann::json(data.yaw_rate_weight) : nlohmann::json(nullptr)},
+      {"root_velocity_weight", data.root_velocity_weight},
       {"metric", data.metric == SpaceMetric::kUnit ? "unit" : "eigen"},
       {"training_ranges", data.training.size()},
       {"joint_weights", std::move(weights)},
@@ -118,7 +123,8 @@ void PrintText(const std::string& out, const MotionSpace& space,
   absl::PrintF("  training: %d ranges at %g Hz, heading %s\n", data.training.size(),
                space.sample_rate(),
                data.pose.remove_heading
-                   ? absl::StrFormat("removed (yaw-rate weight %g)", data.yaw_rate_weight)
+                   ? absl::StrFormat("removed (yaw-rate weight %g, root-velocity weight %g)",
+                                     data.yaw_rate_weight, data.root_velocity_weight)
                    : std::string("kept"));
   absl::PrintF("  dims:     %d\n", space.dims());
   absl::PrintF("  explained variance (dim: share, cumulative):\n");

@@ -32,6 +32,12 @@ void AddSpaceFlags(CLI::App* command, SpaceFlags* flags) {
       ->type_name("W")
       ->default_str(absl::StrCat(defaults.yaw_rate_weight))
       ->check(NumberAbove(0));
+  command
+      ->add_option("--root-velocity-weight", flags->root_velocity_weight,
+                   "weight of the two root-velocity dimensions (leg lengths/s); 0: none")
+      ->type_name("W")
+      ->default_str(absl::StrCat(defaults.root_velocity_weight))
+      ->check(NumberAtLeast(0));
   OneOf(command->add_option("--metric", flags->metric,
                             "distance: plain Euclidean, or scaled by eigenvalue"),
         {"unit", "eigen"})

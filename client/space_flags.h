@@ -14,6 +14,7 @@ struct SpaceFlags {
   std::optional<double> rate;             // --rate (unset: SpaceOptions' default)
   std::string weights = "mass";           // --weights mass|uniform|FILE.json
   std::optional<double> yaw_rate_weight;  // --yaw-rate-weight
+  std::optional<double> root_velocity_weight;  // --root-velocity-weight
   std::string metric = "unit";            // --metric unit|eigen
   bool keep_heading = false;              // --keep-heading
 };

@@ -75,6 +75,7 @@ bool ReadReport(const Json& json, SpaceReport& report) {
   if (json.contains("heading_removed"))
     report.heading_removed = json["heading_removed"].get<bool>();
   number("yaw_rate_weight", report.yaw_rate_weight);
+  number("root_velocity_weight", report.root_velocity_weight);
   if (json.contains("metric")) {
     report.metric = json["metric"] == kMetricNames[1] || json["metric"] == 2
                         ? SpaceMetric::kEigenvalueScaled
@@ -122,6 +123,7 @@ SpaceReport DescribeSpace(const MotionSpace& space) {
   report.sample_rate = space.sample_rate();
   report.heading_removed = data.pose.remove_heading;
   report.yaw_rate_weight = data.pose.remove_heading ? data.yaw_rate_weight : 0.0;
+  report.root_velocity_weight = data.root_velocity_weight;
   report.metric = data.metric;
   for (int j = 0; j < space.skeleton().joint_count(); ++j) {
     report.joint_weights.push_back({space.skeleton().joint(j).name, data.joint_weights[j]});
@@ -139,6 +141,7 @@ std::string ReportToJson(const SpaceReport& report) {
   json["sample_rate"] = Double(report.sample_rate);
   json["heading_removed"] = report.heading_removed;
   json["yaw_rate_weight"] = Double(report.yaw_rate_weight);
+  json["root_velocity_weight"] = Double(report.root_velocity_weight);
   json["metric"] = MetricName(report.metric);
   json["weight_preset"] = PresetName(report.weight_preset);
   json["joint_weights"] = Json::array();

@@ -33,7 +33,8 @@ struct SpaceReport {
   std::string pelvis;  // the joint whose yaw is the body's facing
   double sample_rate = 0;
   bool heading_removed = false;
-  double yaw_rate_weight = 0;  // 0 when the heading is kept
+  double yaw_rate_weight = 0;       // 0 when the heading is kept
+  double root_velocity_weight = 0;  // 0 without root-velocity dimensions
   SpaceMetric metric = SpaceMetric::kUnit;
   WeightPreset weight_preset = WeightPreset::kMass;
   std::vector<JointWeightReport> joint_weights;  // in skeleton order, as used

@@ -9,25 +9,38 @@
 
 namespace motiondb::testing {
 
-std::string ContentLabel(const std::filesystem::path& path) {
+namespace {
+
+// The name's `field`-th '_'-separated field, or the whole stem when it has too few.
+std::string NameField(const std::filesystem::path& path, size_t field) {
   const std::vector<std::string> parts = absl::StrSplit(path.stem().string(), '_');
-  return parts.size() >= 2 ? parts[1] : path.stem().string();
+  return parts.size() > field ? parts[field] : path.stem().string();
 }
 
-absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
+}  // namespace
+
+std::string ContentLabel(const std::filesystem::path& path) { return NameField(path, 1); }
+
+std::string StyleLabel(const std::filesystem::path& path) { return NameField(path, 2); }
+
+absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,
                                                 const LibraryIndexOptions& index_options) {
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    if (entry.path().extension() == ".bvh") files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
   LabelledIndex library;
   std::vector<TrainingClip> clips;
-  for (const std::filesystem::path& path : files) {
-    MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
-    clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
-    library.labels.push_back(ContentLabel(path));
+  for (const std::filesystem::path& folder : folders) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+      if (entry.path().extension() == ".bvh") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const std::filesystem::path& path : files) {
+      MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
+      clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
+      library.labels.push_back(ContentLabel(path));
+      library.styles.push_back(StyleLabel(path));
+      library.sources.push_back(folder.filename().string());
+    }
   }
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, MotionSpace::Build(clips, space_options));
   library.space = std::make_unique<MotionSpace>(std::move(space));

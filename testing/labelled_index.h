@@ -18,13 +18,18 @@ namespace motiondb::testing {
 struct LabelledIndex {
   std::unique_ptr<MotionSpace> space;
   std::unique_ptr<LibraryIndex> index;
-  std::vector<std::string> labels;  // per clip: the file name's content field
+  std::vector<std::string> labels;   // per clip: the file name's content field
+  std::vector<std::string> styles;   // per clip: the file name's style field
+  std::vector<std::string> sources;  // per clip: the name of the folder it came from
 };
 
 // "dataset-2_raise-up-left-hand_normal_003.bvh" -> "raise-up-left-hand".
 std::string ContentLabel(const std::filesystem::path& path);
+// "dataset-2_raise-up-left-hand_normal_003.bvh" -> "normal".
+std::string StyleLabel(const std::filesystem::path& path);
 
-absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
+// One space trained on every clip of every folder, and one index of them all, in folder order.
+absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,
                                                 const LibraryIndexOptions& index_options);
 

@@ -24,26 +24,63 @@ double Precision(const std::vector<SearchResult>& results, const std::vector<std
   return static_cast<double>(hits) / k;
 }
 
+// The clips query `q` may find: every other one, or those of other groups.
+std::vector<int64_t> FindableClips(const LibraryIndex& library, const RetrievalOptions& options,
+                                   int q) {
+  std::vector<int64_t> clip_ids;
+  for (int c = 0; c < library.clip_count(); ++c) {
+    const bool findable = options.groups.empty() ? c != q : options.groups[c] != options.groups[q];
+    if (findable) clip_ids.push_back(library.clip(c).clip_id);
+  }
+  return clip_ids;
+}
+
+// How many of `clip_ids` (library clip ids, equal to their indices here) carry `label`.
+int CountLabel(const std::vector<int64_t>& clip_ids, const std::vector<std::string>& labels,
+               const std::string& label) {
+  return static_cast<int>(std::count_if(clip_ids.begin(), clip_ids.end(),
+                                        [&](int64_t c) { return labels[c] == label; }));
+}
+
+absl::Status CheckOptions(const LibraryIndex& library, const std::vector<std::string>& labels,
+                          const RetrievalOptions& options) {
+  const size_t clips = library.clip_count();
+  for (int c = 0; c < library.clip_count(); ++c) {
+    if (library.clip(c).clip_id != c) {
+      return absl::InvalidArgumentError("library clip ids must be their indices");
+    }
+  }
+  if (labels.size() != clips) return absl::InvalidArgumentError("one label per library clip");
+  if (!options.groups.empty() && options.groups.size() != clips) {
+    return absl::InvalidArgumentError("groups: one per library clip, or none");
+  }
+  if (!options.queries.empty() && options.queries.size() != clips) {
+    return absl::InvalidArgumentError("queries: one per library clip, or none");
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
-absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
-                                                    const std::vector<std::string>& labels,
-                                                    const RetrievalOptions& options) {
-  if (static_cast<int>(labels.size()) != library.clip_count()) {
-    return absl::InvalidArgumentError("one label per library clip is needed");
-  }
+absl::StatusOr<RetrievalReport> EvaluateRetrieval(const LibraryIndex& library,
+                                                  const std::vector<std::string>& labels,
+                                                  const RetrievalOptions& options) {
+  MOTIONDB_RETURN_IF_ERROR(CheckOptions(library, labels, options));
   RetrievalReport report;
-  std::map<std::string, int> label_queries;
+  std::map<std::string, int> label_queries, group_queries;
   std::vector<double> latencies, exact_latencies;
   int recall_hits = 0, recall_total = 0;
   for (int q = 0; q < library.clip_count(); ++q) {
+    if (!options.queries.empty() && !options.queries[q]) continue;
     SearchParams params = options.params;
     params.max_results = std::max(options.precision_at, options.recall_at);
-    params.clip_ids.clear();
+    params.clip_ids = FindableClips(library, options, q);
     params.tags.clear();
-    for (int c = 0; c < library.clip_count(); ++c) {
-      if (c != q) params.clip_ids.push_back(library.clip(c).clip_id);
+    if (CountLabel(params.clip_ids, labels, labels[q]) < options.precision_at) {
+      ++report.skipped_queries;
+      continue;
     }
+    const int query_number = report.queries++;
     const CoordinateView query = library.clip_coordinates(q);
     MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse fast, Search(library, query, params));
     latencies.push_back(fast.stats.total_ms);
@@ -55,8 +92,15 @@ absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
     const double precision = Precision(fast.results, labels, labels[q], options.precision_at);
     report.precision += precision;
     report.precision_by_label[labels[q]] += precision;
+    for (int i = 0; i < options.precision_at && i < static_cast<int>(fast.results.size()); ++i) {
+      ++report.confusion[labels[q]][labels[fast.results[i].clip_index]];
+    }
     ++label_queries[labels[q]];
-    if (options.exact_every > 0 && q % options.exact_every == 0) {
+    if (!options.groups.empty()) {
+      report.precision_by_group[options.groups[q]] += precision;
+      ++group_queries[options.groups[q]];
+    }
+    if (options.exact_every > 0 && query_number % options.exact_every == 0) {
       MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse exact, ExactSearch(library, query, params));
       exact_latencies.push_back(exact.stats.total_ms);
       report.exact_precision += Precision(exact.results, labels, labels[q], options.precision_at);
@@ -70,9 +114,10 @@ absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
       }
     }
   }
-  report.queries = library.clip_count();
+  if (report.queries == 0) return absl::InvalidArgumentError("no query has enough relevant clips");
   report.precision /= report.queries;
   for (auto& [label, sum] : report.precision_by_label) sum /= label_queries[label];
+  for (auto& [group, sum] : report.precision_by_group) sum /= group_queries[group];
   for (auto& [stage, sum] : report.mean_stage_ms) sum /= report.queries;
   if (report.exact_queries > 0) report.exact_precision /= report.exact_queries;
   report.recall = recall_total > 0 ? static_cast<double>(recall_hits) / recall_total : 0.0;

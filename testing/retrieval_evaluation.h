@@ -1,6 +1,7 @@
-// Retrieval quality of a labelled library, leave-one-out: every clip is a query against all the
-// other clips. Measures precision@k of the label for the fast and (on a subset) the exact
-// search, and the fast search's recall against the exact one.
+// Retrieval quality of a labelled library: every clip is a query against all the other clips
+// (leave-one-out) or against the clips of other groups (leave-group-out: a style against every
+// other style, one dataset against another). Measures precision@k of the label for the fast and
+// (on a subset) the exact search, and the fast search's recall against the exact one.
 #ifndef MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_
 #define MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_
 
@@ -23,10 +24,18 @@ struct RetrievalOptions {
   int recall_at = 10;
   // Every n-th query also runs the exact search (0: never).
   int exact_every = 10;
+  // Per clip, its group: a query searches the clips of other groups only. Empty: every other
+  // clip (leave-one-out).
+  std::vector<std::string> groups;
+  // Per clip, whether it is a query. Empty: every clip. A query is left out (and counted in
+  // `skipped_queries`) when fewer than `precision_at` clips it may find share its label, as its
+  // precision could not reach 1.
+  std::vector<bool> queries;
 };
 
 struct RetrievalReport {
   int queries = 0;
+  int skipped_queries = 0;
   double precision = 0;  // fast search, mean over queries
   int exact_queries = 0;
   double exact_precision = 0;  // exact search, mean over its queries
@@ -35,13 +44,16 @@ struct RetrievalReport {
   double latency_p99_ms = 0;
   double exact_latency_p50_ms = 0;
   std::map<std::string, double> precision_by_label;
+  std::map<std::string, double> precision_by_group;  // with RetrievalOptions::groups
+  // Per query label, the labels of the fast search's first `precision_at` results, counted.
+  std::map<std::string, std::map<std::string, int>> confusion;
   std::map<std::string, double> mean_stage_ms;  // seeds, clusters, warps, refine, ranking
 };
 
 // `labels[c]` is clip c's label. Queries are the clips' own library coordinates.
-absl::StatusOr<RetrievalReport> EvaluateLeaveOneOut(const LibraryIndex& library,
-                                                    const std::vector<std::string>& labels,
-                                                    const RetrievalOptions& options);
+absl::StatusOr<RetrievalReport> EvaluateRetrieval(const LibraryIndex& library,
+                                                  const std::vector<std::string>& labels,
+                                                  const RetrievalOptions& options);
 
 }  // namespace motiondb
 

@@ -70,7 +70,7 @@ class MotionSpaceTest : public ::testing::Test {
 
 TEST_F(MotionSpaceTest, KeepsEveryDimensionInDecreasingVarianceOnAnOrthonormalBasis) {
   const int joints = skeleton_->joint_count();
-  EXPECT_EQ(space_.dims(), 3 * joints + 1);  // + the yaw rate
+  EXPECT_EQ(space_.dims(), 3 * joints + 3);  // + the yaw rate and the root velocity
   const SpaceData& data = space_.data();
   EXPECT_TRUE((data.basis.transpose() * data.basis).isIdentity(1e-10));
   for (int i = 1; i < space_.dims(); ++i) EXPECT_GE(data.eigenvalues[i - 1], data.eigenvalues[i]);
@@ -163,18 +163,20 @@ TEST_F(MotionSpaceTest, TurningTheBodyLeavesTheProjectionUnchangedUnlessTheHeadi
   EXPECT_GT((*kept.ProjectClip(turned) - *kept.ProjectClip(clip)).cwiseAbs().maxCoeff(), 0.1);
 }
 
-TEST_F(MotionSpaceTest, TheYawRateIsTheLastPoseNumberAndSetsTurnsApart) {
+TEST_F(MotionSpaceTest, TheYawRateFollowsTheJointsAndSetsTurnsApart) {
   const Clip left = testing::SyntheticClip(skeleton_, {.turn_rate = 1.0, .seed = 3});
   const Clip right = testing::SyntheticClip(skeleton_, {.turn_rate = -1.0, .seed = 3});
   const RowMatrixXd poses_left = *space_.EncodeClip(left);
   const RowMatrixXd poses_right = *space_.EncodeClip(right);
-  const int yaw = space_.dims() - 1;
+  const int yaw = 3 * skeleton_->joint_count();
   // The pelvis also sways, alike in both: the turns differ by exactly 2 rad/s.
   EXPECT_LT((poses_left.col(yaw) - poses_right.col(yaw)).array().abs().maxCoeff() - 2.0, 1e-9);
   EXPECT_GT((poses_left.col(yaw) - poses_right.col(yaw)).minCoeff(), 2.0 - 1e-9);
   EXPECT_GT(poses_left.col(yaw).mean(), 0.5);
   EXPECT_LT(poses_right.col(yaw).mean(), -0.5);
   EXPECT_DOUBLE_EQ(space_.pose_weights()[yaw], SpaceOptions().yaw_rate_weight);
+  EXPECT_EQ(space_.pose_weights().tail(2),
+            Eigen::VectorXd::Constant(2, SpaceOptions().root_velocity_weight));
   // The yaw rate does not shape the body: same joints, opposite turns, same reconstruction.
   const RowMatrixXd a = *space_.Reconstruct(*space_.ProjectClip(left));
   const RowMatrixXd b = *space_.Reconstruct(*space_.ProjectClip(right));
@@ -295,7 +297,12 @@ TEST_F(MotionSpaceTest, RejectsBadTrainingAndOptions) {
   }
   for (const double weight : {0.0, -0.5, nan}) {
     fails(training_, {.yaw_rate_weight = weight}, "yaw-rate weight");
+    fails(training_, {.root_velocity_weight = weight}, "root-velocity weight");
   }
+  // Without the root velocity its weight is not used.
+  EXPECT_TRUE(
+      MotionSpace::Build(training_, {.pose = {.root_velocity = false}, .root_velocity_weight = -1})
+          .ok());
   fails(training_, {.pose = {.yaw_rate_window = 0}}, "yaw-rate window");
   fails(training_, {.weights = {.overrides = {{"Tail", 1.0}}}}, "unknown joint 'Tail'");
   fails(training_, {.weights = {.overrides = {{"Hips", nan}}}}, "'Hips'");
@@ -367,7 +374,7 @@ TEST(MotionSpaceRealDataTest, Cmu0101) {
   ASSERT_TRUE(read.ok()) << read.status();
   const std::vector<TrainingClip> training = {{"01_01", read->clip, std::nullopt}};
   const MotionSpace space = *MotionSpace::Build(training);
-  EXPECT_EQ(space.dims(), 3 * 31 + 1);
+  EXPECT_EQ(space.dims(), 3 * 31 + 3);
   const std::vector<ReconstructionError> report = *space.RepresentationalError(training);
   for (size_t i = 1; i < report.size(); ++i) EXPECT_LT(report[i].mean_rad, report[i - 1].mean_rad);
   EXPECT_LT(report.back().max_rad, 1e-6);
@@ -403,9 +410,9 @@ TEST(MotionSpaceRealDataTest, BandaiTurnsAndRoundTrip) {
   }
   const MotionSpace space = *MotionSpace::Build(training);
   EXPECT_EQ(space.skeleton().joint(FindPelvis(space.skeleton())).name, "Hips");
-  EXPECT_EQ(space.dims(), 3 * 22 + 1);
+  EXPECT_EQ(space.dims(), 3 * 22 + 3);
   EXPECT_LT(space.RepresentationalError(training)->back().max_rad, 1e-6);
-  const int yaw = space.dims() - 1;
+  const int yaw = 3 * 22;
   EXPECT_GT(space.EncodeClip(training[1].clip)->col(yaw).mean(), 0.3);   // left
   EXPECT_LT(space.EncodeClip(training[2].clip)->col(yaw).mean(), -0.3);  // right
   EXPECT_LT(std::abs(space.EncodeClip(training[0].clip)->col(yaw).mean()), 0.1);

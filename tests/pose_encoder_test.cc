@@ -83,7 +83,7 @@ TEST(PoseEncoderTest, BatchedLogMapMatchesTheScalarOne) {
 }
 
 TEST(PoseEncoderTest, DimensionsAndTheYawRateColumn) {
-  EXPECT_EQ(PoseDims(22, {}), 67);
+  EXPECT_EQ(PoseDims(22, {.root_velocity = false}), 67);
   EXPECT_EQ(PoseDims(22, {.remove_heading = false}), 66);
   EXPECT_FALSE(ValidatePoseOptions({.yaw_rate_window = 0}).ok());
   EXPECT_TRUE(ValidatePoseOptions({.yaw_rate_window = 1}).ok());
@@ -93,7 +93,7 @@ TEST(PoseEncoderTest, DimensionsAndTheYawRateColumn) {
   const PoseRotations kept = ComputePoseRotations(clip, {.remove_heading = false});
   EXPECT_EQ(kept.rotations, clip.rotations());
   EXPECT_EQ(kept.yaw_rate.size(), 0);
-  const PoseRotations removed = ComputePoseRotations(clip, {});
+  const PoseRotations removed = ComputePoseRotations(clip, {.root_velocity = false});
   ASSERT_EQ(removed.yaw_rate.size(), 30);
   const RowMatrixXd references = RowMatrixXd::Zero(clip.skeleton().joint_count(), 4).rowwise() +
                                  Eigen::RowVector4d(1, 0, 0, 0);

@@ -730,7 +730,8 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   EXPECT_EQ(space.name(), "body");
   const v1::SpaceBuildReport& report = space.report();
   EXPECT_EQ(report.joint_count(), 21);
-  EXPECT_EQ(report.dims(), 21 * 3 + 1);  // every joint, plus the yaw rate
+  EXPECT_EQ(report.dims(), 21 * 3 + 3);  // every joint, plus the yaw rate and root velocity
+  EXPECT_EQ(report.root_velocity_weight(), 0.5);
   EXPECT_EQ(report.explained_variance_size(), report.dims());
   EXPECT_EQ(report.training_size(), static_cast<int>(ids.size()));
   EXPECT_EQ(report.projected_clips(), static_cast<int64_t>(ids.size()));
@@ -751,6 +752,24 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
       client.spaces().ListSpaces(client.Context().get(), v1::ListSpacesRequest(), &spaces).ok());
   ASSERT_EQ(spaces.spaces_size(), 1);
   EXPECT_EQ(spaces.spaces(0).space_id(), space.space_id());
+
+  // root_velocity_weight 0 leaves its two dimensions out; a negative one is refused.
+  v1::CreateSpaceRequest still;
+  still.set_name("still");
+  still.set_root_velocity_weight(0);
+  v1::Space still_space;
+  ASSERT_TRUE(client.CreateSpace(still, &still_space).ok());
+  EXPECT_EQ(still_space.report().dims(), 21 * 3 + 1);
+  EXPECT_EQ(still_space.report().root_velocity_weight(), 0.0);
+  still.set_name("backwards");
+  still.set_root_velocity_weight(-1);
+  const grpc::Status refused = client.CreateSpace(still, &still_space);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("root-velocity weight"));
+  v1::DeleteSpaceRequest drop_still;
+  drop_still.set_name("still");
+  v1::DeleteSpaceResponse still_dropped;
+  ASSERT_TRUE(client.spaces().DeleteSpace(client.Context().get(), drop_still, &still_dropped).ok());
 
   // A clip ingested now is projected into the space at once.
   v1::IngestClipResponse late;

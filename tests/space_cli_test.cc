@@ -69,7 +69,7 @@ TEST_F(SpaceCliTest, BuildReportsDimsVarianceAndErrors) {
   const nlohmann::json report = BuildJson({"--train", a_, b_, "--out", space_});
   ASSERT_TRUE(report.is_object());
   const int dims = report["dims"];
-  EXPECT_EQ(dims, 3 * kJoints + 1);
+  EXPECT_EQ(dims, 3 * kJoints + 3);
   ASSERT_EQ(report["explained_variance"].size(), static_cast<size_t>(dims));
   double total = 0.0;
   for (const double share : report["explained_variance"]) total += share;
@@ -99,7 +99,7 @@ TEST_F(SpaceCliTest, BuildReportsDimsVarianceAndErrors) {
   const testing::CommandResult text =
       RunCli({"space", "build", "--train", a_, "--train=" + b_, "--out", space_});
   ASSERT_EQ(text.exit_code, 0) << text.err;
-  EXPECT_THAT(text.out, HasSubstr("dims:     61"));
+  EXPECT_THAT(text.out, HasSubstr("dims:     63"));
   EXPECT_THAT(text.out, HasSubstr("reconstruction error"));
 }
 
@@ -119,6 +119,16 @@ TEST_F(SpaceCliTest, BuildOptions) {
   EXPECT_EQ(heavy["joint_weights"]["UpperLeg_L"], 4.0);
   EXPECT_EQ(heavy["joint_weights"]["Hips"], 1.0);  // the mass preset elsewhere
   EXPECT_EQ(heavy["yaw_rate_weight"], 0.25);
+  EXPECT_EQ(heavy["root_velocity_weight"], 0.5);  // the default
+
+  const nlohmann::json fast =
+      BuildJson({"--train", a_, "--out", space_, "--root-velocity-weight", "2.5"});
+  EXPECT_EQ(fast["root_velocity_weight"], 2.5);
+  EXPECT_EQ(fast["dims"], 3 * kJoints + 3);
+  const nlohmann::json still =
+      BuildJson({"--train", a_, "--out", space_, "--root-velocity-weight", "0"});
+  EXPECT_EQ(still["root_velocity_weight"], 0.0);
+  EXPECT_EQ(still["dims"], 3 * kJoints + 1);
 }
 
 TEST_F(SpaceCliTest, ProjectPrintsOneLinePerFrameAtTheSpaceRate) {
@@ -174,7 +184,7 @@ TEST_F(SpaceCliTest, BadInputIsOneLineNamingTheFile) {
        "tail.json: weight given for unknown joint 'Tail'"},
       {{"project", a_, "--space", bad_space}, "bad.mcs"},
       {{"project", other_, "--space", space_}, "other.bvh"},
-      {{"project", a_, "--space", space_, "--dims", "62"}, "--dims must be in 1..61"},
+      {{"project", a_, "--space", space_, "--dims", "64"}, "--dims must be in 1..63"},
   };
   for (const auto& c : cases) {
     const testing::CommandResult r = RunCli(c.args);

@@ -6,7 +6,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/motion/skeleton_coding.h"
 #include "tests/synthetic_motion.h"
+#include "util/byte_coding.h"
 #include "util/crc32.h"
 
 namespace motiondb {
@@ -21,9 +23,10 @@ class SpaceSerializationTest : public ::testing::Test {
   SpaceSerializationTest()
       : clip_(testing::SyntheticClip(testing::HumanoidSkeleton(/*still_root=*/true),
                                      {.frames = 60, .turn_rate = 0.4})),
-        space_(*MotionSpace::Build(
-            {{"walk.bvh", clip_, FrameRange{5, 50}}},
-            {.yaw_rate_weight = 0.7, .metric = SpaceMetric::kEigenvalueScaled})),
+        space_(*MotionSpace::Build({{"walk.bvh", clip_, FrameRange{5, 50}}},
+                                   {.yaw_rate_weight = 0.7,
+                                    .root_velocity_weight = 1.3,
+                                    .metric = SpaceMetric::kEigenvalueScaled})),
         bytes_(SerializeSpace(space_)) {}
 
   // `bytes` with its checksum recomputed, so that only the later checks can reject it.
@@ -53,6 +56,8 @@ TEST_F(SpaceSerializationTest, RoundTripIsExact) {
   EXPECT_EQ(a.pose.remove_heading, b.pose.remove_heading);
   EXPECT_EQ(a.pose.yaw_rate_window, b.pose.yaw_rate_window);
   EXPECT_EQ(b.yaw_rate_weight, 0.7);
+  EXPECT_TRUE(b.pose.root_velocity);
+  EXPECT_EQ(b.root_velocity_weight, 1.3);
   EXPECT_EQ(b.metric, SpaceMetric::kEigenvalueScaled);
   EXPECT_EQ(a.joint_weights, b.joint_weights);
   EXPECT_EQ(a.references, b.references);
@@ -69,12 +74,35 @@ TEST_F(SpaceSerializationTest, RoundTripIsExact) {
 
 TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
   EXPECT_EQ(bytes_.substr(0, 8), "MDBSPACE");
-  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x01\x00\x00\x00", 4));
+  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x02\x00\x00\x00", 4));
   uint64_t payload = 0;
   for (int i = 0; i < 8; ++i) payload |= uint64_t{static_cast<uint8_t>(bytes_[12 + i])} << (8 * i);
   EXPECT_EQ(payload, bytes_.size() - kHeaderSize - 4);
   EXPECT_EQ(Crc32("123456789"), 0xCBF43926u);  // the standard check value
   EXPECT_EQ(Crc32(""), 0u);
+}
+
+// A file of format 1 (written before the root velocity) reads as a space without it.
+TEST_F(SpaceSerializationTest, VersionOneReadsAsWithoutRootVelocity) {
+  const MotionSpace plain = *MotionSpace::Build({{"walk.bvh", clip_, FrameRange{5, 50}}},
+                                                {.pose = {.root_velocity = false}});
+  std::string bytes = SerializeSpace(plain);
+  // Version 1 lacks the root-velocity flag and weight that follow the metric.
+  ByteWriter skeleton;
+  WriteSkeleton(plain.skeleton(), skeleton);
+  const size_t added = kHeaderSize + skeleton.bytes().size() + 8 + 1 + 4 + 8 + 1;
+  bytes.erase(added, 1 + 8);
+  bytes[8] = 1;
+  const uint64_t payload = bytes.size() - kHeaderSize - 4;
+  for (int i = 0; i < 8; ++i) bytes[12 + i] = static_cast<char>(payload >> (8 * i));
+  const absl::StatusOr<MotionSpace> parsed = ParseSpace(Resealed(bytes));
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  EXPECT_FALSE(parsed->data().pose.root_velocity);
+  EXPECT_EQ(parsed->dims(), plain.dims());
+  EXPECT_EQ(parsed->data().basis, plain.data().basis);
+  // The same bytes as version 2 are short by the flag and weight.
+  bytes[8] = 2;
+  EXPECT_FALSE(ParseSpace(Resealed(bytes)).ok());
 }
 
 TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
@@ -85,9 +113,9 @@ TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
   EXPECT_THAT(ParseSpace("BVH HIERARCHY").status().message(), HasSubstr("bad magic"));
 
   std::string version = bytes_;
-  version[8] = 2;
+  version[8] = 3;
   EXPECT_EQ(ParseSpace(version).status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 2 is not supported"));
+  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 3 is not supported"));
 
   for (const size_t at : {kHeaderSize, bytes_.size() / 2, bytes_.size() - 5, bytes_.size() - 1}) {
     std::string flipped = bytes_;

@@ -115,16 +115,25 @@ Clip TurnedClip(const Clip& clip, double angle) {
   const int pelvis = skeleton.FindJoint("Hips");
   const Quat turn = AxisAngle(angle, Eigen::Vector3d::UnitY());
   RowMatrixXd rotations = clip.rotations();
+  RowMatrixXd positions = clip.positions();
+  std::vector<int> chain;  // the pelvis first, the root last
+  for (int j = pelvis; j >= 0; j = skeleton.joint(j).parent) chain.push_back(j);
   for (int f = 0; f < clip.frame_count(); ++f) {
-    Quat above = Quat::Identity();  // the global orientation of the pelvis's parent
-    for (int j = skeleton.joint(pelvis).parent; j >= 0; j = skeleton.joint(j).parent) {
-      above = clip.rotation(f, j) * above;
+    // Each translation of the chain turns in its parent's frame, so the world positions turn.
+    Quat above = Quat::Identity();  // the global orientation of the chain joint's parent
+    for (auto j = chain.rbegin(); j != chain.rend(); ++j) {
+      const int slot = skeleton.position_slot(*j);
+      if (slot >= 0) {
+        const Eigen::Vector3d local = positions.block<1, 3>(f, 3 * slot).transpose();
+        positions.block<1, 3>(f, 3 * slot) = (above.conjugate() * turn * above * local).transpose();
+      }
+      if (*j != pelvis) above = above * clip.rotation(f, *j);
     }
     const Quat local = above.conjugate() * turn * above * clip.rotation(f, pelvis);
     rotations.block<1, 4>(f, 4 * pelvis) << local.w(), local.x(), local.y(), local.z();
   }
   absl::StatusOr<Clip> turned =
-      Clip::Create(clip.shared_skeleton(), clip.frame_time(), rotations, clip.positions());
+      Clip::Create(clip.shared_skeleton(), clip.frame_time(), rotations, positions);
   EXPECT_TRUE(turned.ok()) << turned.status();
   return *std::move(turned);
 }

@@ -34,8 +34,9 @@ struct SyntheticMotion {
 // slightly and turns at `turn_rate`; a still root never rotates.
 Clip SyntheticClip(std::shared_ptr<const Skeleton> skeleton, const SyntheticMotion& motion = {});
 
-// `clip` turned by `angle` radians about the vertical axis, applied to the pelvis's global
-// orientation: G' = R_y(angle) * G, the pelvis's local rotation adjusted through its ancestors.
+// `clip` turned by `angle` radians about the vertical axis through the origin: the pelvis's
+// global orientation G' = R_y(angle) * G (its local rotation adjusted through its ancestors),
+// and the translations of the root-to-pelvis chain turned so that their world positions turn.
 Clip TurnedClip(const Clip& clip, double angle);
 
 }  // namespace motiondb::testing

@@ -9,6 +9,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/motion/resample.h"
+#include "core/space/root_velocity.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -38,12 +39,20 @@ absl::Status CheckSampleRate(double rate) {
   return absl::OkStatus();
 }
 
-absl::Status CheckYawRateWeight(double weight) {
+absl::Status CheckDimensionWeight(absl::string_view what, double weight) {
   if (!std::isfinite(weight) || weight <= 0.0) {
     return absl::InvalidArgumentError(
-        absl::StrCat("yaw-rate weight must be finite and positive, got ", weight));
+        absl::StrCat(what, " weight must be finite and positive, got ", weight));
   }
   return absl::OkStatus();
+}
+
+// The weights of the dimensions that are not joints, for the options that have them.
+absl::Status CheckExtraWeights(const PoseOptions& pose, double yaw_rate_weight,
+                               double root_velocity_weight) {
+  MOTIONDB_RETURN_IF_ERROR(CheckDimensionWeight("yaw-rate", yaw_rate_weight));
+  if (!pose.remove_heading || !pose.root_velocity) return absl::OkStatus();
+  return CheckDimensionWeight("root-velocity", root_velocity_weight);
 }
 
 absl::Status CheckShape(absl::string_view what, Eigen::Index rows, Eigen::Index cols,
@@ -59,7 +68,8 @@ absl::Status CheckData(const SpaceData& data) {
   if (data.skeleton == nullptr) return absl::InvalidArgumentError("space has no skeleton");
   MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(data.sample_rate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(data.pose));
-  MOTIONDB_RETURN_IF_ERROR(CheckYawRateWeight(data.yaw_rate_weight));
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckExtraWeights(data.pose, data.yaw_rate_weight, data.root_velocity_weight));
   const int joints = data.skeleton->joint_count();
   const int dims = PoseDims(joints, data.pose);
   MOTIONDB_RETURN_IF_ERROR(CheckShape("joint weights", data.joint_weights.size(), 1, joints, 1));
@@ -116,7 +126,8 @@ void SolveBasis(const RowMatrixXd& centred, SpaceData* data) {
   }
 }
 
-// The weight of each pose-vector number: each joint's three, then the yaw rate's.
+// The weight of each pose-vector number: each joint's three, then the yaw rate's and the root
+// velocity's.
 Eigen::VectorXd PoseWeights(const SpaceData& data) {
   const Eigen::Index joints = data.joint_weights.size();
   Eigen::VectorXd weights(PoseDims(static_cast<int>(joints), data.pose));
@@ -124,6 +135,9 @@ Eigen::VectorXd PoseWeights(const SpaceData& data) {
     weights.segment<3>(3 * j).setConstant(data.joint_weights[j]);
   }
   if (data.pose.remove_heading) weights[3 * joints] = data.yaw_rate_weight;
+  if (data.pose.remove_heading && data.pose.root_velocity) {
+    weights.tail<kRootVelocityDims>().setConstant(data.root_velocity_weight);
+  }
   return weights;
 }
 
@@ -139,12 +153,15 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& 
   if (training.empty()) return absl::InvalidArgumentError("a space needs training clips");
   MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(options.pose));
-  MOTIONDB_RETURN_IF_ERROR(CheckYawRateWeight(options.yaw_rate_weight));
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckExtraWeights(options.pose, options.yaw_rate_weight, options.root_velocity_weight));
   SpaceData data;
   data.skeleton = training.front().clip.shared_skeleton();
   data.sample_rate = options.sample_rate;
   data.pose = options.pose;
+  data.pose.root_velocity = options.pose.remove_heading && options.pose.root_velocity;
   data.yaw_rate_weight = options.yaw_rate_weight;
+  data.root_velocity_weight = data.pose.root_velocity ? options.root_velocity_weight : 0.0;
   data.metric = options.metric;
   MOTIONDB_ASSIGN_OR_RETURN(data.joint_weights,
                             ComputeJointWeights(*data.skeleton, options.weights));

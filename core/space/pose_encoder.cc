@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/space/heading.h"
+#include "core/space/root_velocity.h"
 
 namespace motiondb {
 namespace {
@@ -83,14 +84,18 @@ absl::Status ValidatePoseOptions(const PoseOptions& options) {
 }
 
 int PoseDims(int joint_count, const PoseOptions& options) {
-  return 3 * joint_count + (options.remove_heading ? 1 : 0);
+  if (!options.remove_heading) return 3 * joint_count;
+  return 3 * joint_count + 1 + (options.root_velocity ? kRootVelocityDims : 0);
 }
 
 PoseRotations ComputePoseRotations(const Clip& clip, const PoseOptions& options) {
-  PoseRotations pose{clip.rotations(), Eigen::VectorXd()};
+  PoseRotations pose{clip.rotations(), Eigen::VectorXd(), RowMatrixXd()};
   if (options.remove_heading) {
     const Eigen::VectorXd yaw = RemoveHeading(clip.skeleton(), &pose.rotations);
     pose.yaw_rate = YawRate(yaw, clip.fps(), options.yaw_rate_window);
+    if (options.root_velocity) {
+      pose.root_velocity = RootVelocity(clip, yaw, options.yaw_rate_window);
+    }
   }
   return pose;
 }
@@ -99,7 +104,7 @@ RowMatrixXd EncodePoses(const PoseRotations& pose, const RowMatrixXd& references
   const Eigen::Index frames = pose.rotations.rows();
   const Eigen::Index joints = references.rows();
   const bool has_yaw_rate = pose.yaw_rate.size() > 0;
-  RowMatrixXd poses(frames, 3 * joints + (has_yaw_rate ? 1 : 0));
+  RowMatrixXd poses(frames, 3 * joints + (has_yaw_rate ? 1 : 0) + pose.root_velocity.cols());
   std::vector<Eigen::Matrix4d> to_relative;
   for (Eigen::Index j = 0; j < joints; ++j) {
     to_relative.push_back(ConjugateProduct(
@@ -129,6 +134,7 @@ RowMatrixXd EncodePoses(const PoseRotations& pose, const RowMatrixXd& references
     }
   }
   if (has_yaw_rate) poses.col(3 * joints) = pose.yaw_rate;
+  if (pose.root_velocity.size() > 0) poses.rightCols<kRootVelocityDims>() = pose.root_velocity;
   return poses;
 }
 

@@ -15,7 +15,8 @@
 // Payload, in order (u8/u32/i32/u64 integers, f64 doubles, str = u32 length + bytes):
 //   skeleton: u32 joints; per joint: str name, i32 parent, 3 f64 offset, u8 channel count,
 //             that many u8 channels (Channel enum values), u8 has End Site, [3 f64 End Site]
-//   f64 sample rate, u8 remove heading, i32 yaw-rate window, f64 yaw-rate weight, u8 metric
+//   f64 sample rate, u8 remove heading, i32 yaw-rate window, f64 yaw-rate weight, u8 metric,
+//   [version 2 on: u8 root velocity, f64 root-velocity weight]
 //   joints f64 joint weights, joints x 4 f64 references (w, x, y, z)
 //   u32 dims, dims f64 mean, dims f64 eigenvalues, dims x dims f64 basis (row-major)
 //   u32 training ranges; per range: str source, i32 first frame, i32 last frame
@@ -29,7 +30,7 @@ constexpr size_t kChecksumSize = 4;
 // Files larger than this are refused before reading: a 1000-joint space is about 72 MB.
 constexpr int64_t kMaxFileBytes = int64_t{1} << 30;
 
-absl::StatusOr<SpaceData> ReadPayload(ByteReader& in) {
+absl::StatusOr<SpaceData> ReadPayload(ByteReader& in, uint32_t version) {
   SpaceData data;
   MOTIONDB_ASSIGN_OR_RETURN(data.skeleton, ReadSkeleton(in));
   MOTIONDB_ASSIGN_OR_RETURN(data.sample_rate, in.F64("sample rate"));
@@ -42,6 +43,12 @@ absl::StatusOr<SpaceData> ReadPayload(ByteReader& in) {
     return absl::InvalidArgumentError(absl::StrCat("space has unknown metric ", metric));
   }
   data.metric = static_cast<SpaceMetric>(metric);
+  data.pose.root_velocity = false;
+  if (version >= 2) {
+    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t root_velocity, in.U8("root-velocity flag"));
+    data.pose.root_velocity = root_velocity != 0;
+    MOTIONDB_ASSIGN_OR_RETURN(data.root_velocity_weight, in.F64("root-velocity weight"));
+  }
 
   const Eigen::Index joints = data.skeleton->joint_count();
   data.joint_weights.resize(joints);
@@ -83,6 +90,8 @@ std::string SerializeSpace(const MotionSpace& space) {
   payload.I32(data.pose.yaw_rate_window);
   payload.F64(data.yaw_rate_weight);
   payload.U8(static_cast<uint8_t>(data.metric));
+  payload.U8(data.pose.root_velocity ? 1 : 0);
+  payload.F64(data.root_velocity_weight);
   payload.F64s(data.joint_weights.data(), data.joint_weights.size());
   payload.F64s(data.references.data(), data.references.size());
   payload.U32(static_cast<uint32_t>(data.mean.size()));
@@ -111,9 +120,9 @@ absl::StatusOr<MotionSpace> ParseSpace(absl::string_view bytes) {
   }
   ByteReader header(bytes.substr(kMagic.size()), "space");
   MOTIONDB_ASSIGN_OR_RETURN(const uint32_t version, header.U32("format version"));
-  if (version != kSpaceFormatVersion) {
+  if (version < 1 || version > kSpaceFormatVersion) {
     return absl::InvalidArgumentError(absl::StrCat("space format version ", version,
-                                                   " is not supported (this build reads ",
+                                                   " is not supported (this build reads 1 to ",
                                                    kSpaceFormatVersion, ")"));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const uint64_t payload_size, header.U64("payload size"));
@@ -128,7 +137,7 @@ absl::StatusOr<MotionSpace> ParseSpace(absl::string_view bytes) {
     return absl::DataLossError("space checksum mismatch: the bytes are damaged");
   }
   ByteReader payload(checked.substr(kHeaderSize), "space");
-  MOTIONDB_ASSIGN_OR_RETURN(SpaceData data, ReadPayload(payload));
+  MOTIONDB_ASSIGN_OR_RETURN(SpaceData data, ReadPayload(payload, version));
   if (payload.remaining() != 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("space payload has ", payload.remaining(), " unread bytes at its end"));

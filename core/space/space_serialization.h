@@ -22,7 +22,8 @@
 
 namespace motiondb {
 
-inline constexpr uint32_t kSpaceFormatVersion = 1;
+// 2 added the root velocity (flag and weight after the metric); 1 is read as without it.
+inline constexpr uint32_t kSpaceFormatVersion = 2;
 
 std::string SerializeSpace(const MotionSpace& space);
 // Errors are DATA_LOSS for damaged bytes (magic, checksum, truncation) and INVALID_ARGUMENT for

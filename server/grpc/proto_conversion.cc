@@ -254,6 +254,10 @@ absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request) {
   }
   options.pose.remove_heading = !request.keep_heading();
   if (request.has_yaw_rate_weight()) options.yaw_rate_weight = request.yaw_rate_weight();
+  if (request.has_root_velocity_weight()) {
+    options.pose.root_velocity = request.root_velocity_weight() != 0;
+    if (options.pose.root_velocity) options.root_velocity_weight = request.root_velocity_weight();
+  }
   MOTIONDB_ASSIGN_OR_RETURN(options.metric, FromProto(request.metric()));
   return out;
 }
@@ -406,6 +410,7 @@ void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out) {
   out->set_sample_rate(report.sample_rate);
   out->set_heading_removed(report.heading_removed);
   out->set_yaw_rate_weight(report.yaw_rate_weight);
+  out->set_root_velocity_weight(report.root_velocity_weight);
   out->set_metric(ToProto(report.metric));
   out->set_weight_preset(ToProto(report.weight_preset));
   for (const JointWeightReport& weight : report.joint_weights) {
