@@ -11,6 +11,7 @@
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
+#include "core/search/pose_search.h"
 #include "core/search/warp/time_warp.h"
 #include "tests/search_test_data.h"
 
@@ -353,6 +354,60 @@ TEST_F(SearchTest, FiltersByClipIdAndTag) {
   params.tags.clear();
   params.clip_ids = {999};
   EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kNotFound);
+}
+
+// A one-frame query: the nearest distinct places, one frame each, scored by the pose distance.
+TEST_F(SearchTest, OneFrameIsAPoseQuery) {
+  // The pattern's peak: each planted copy holds it near its middle.
+  const RowMatrixXf pattern = testing::Pattern(40, kDims);
+  const RowMatrixXf pose = pattern.row(20);
+  SearchParams params;
+  params.max_results = 10;
+  absl::StatusOr<SearchResponse> found = Search(*library_, CoordinateView::Of(pose), params);
+  ASSERT_TRUE(found.ok()) << found.status();
+  const std::vector<SearchResult>& results = found->results;
+  ASSERT_EQ(results.size(), 10u);
+  // The global nearest frame over the warp's dimensions, by brute force, comes first.
+  double nearest = INFINITY;
+  for (int64_t f = 0; f < library_->total_frames(); ++f) {
+    nearest = std::min<double>(nearest, Distance(pose.data(), FrameRow(*library_, f), 5));
+  }
+  EXPECT_NEAR(results[0].score, nearest, 1e-6);
+  const int64_t separation = std::llround(kPoseSeparationS * library_->rate());
+  for (size_t i = 0; i < results.size(); ++i) {
+    const SearchResult& r = results[i];
+    EXPECT_EQ(r.first_frame, r.seed_frame);
+    EXPECT_EQ(r.last_frame, r.seed_frame);
+    EXPECT_DOUBLE_EQ(r.start_s, r.seed_frame / 30.0);
+    const CoordinateView clip = library_->clip_coordinates(r.clip_index);
+    EXPECT_FLOAT_EQ(r.score, Distance(pose.data(), clip.row(r.seed_frame), 5));
+    if (i > 0) {
+      EXPECT_LE(results[i - 1].score, r.score);
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (results[j].clip_index == r.clip_index) {
+        EXPECT_GE(std::abs(results[j].seed_frame - r.seed_frame), separation) << i << " " << j;
+      }
+    }
+  }
+  // Every planted copy is among the first three: the peak is far from the noise.
+  for (const Planted& p : planted_) {
+    EXPECT_TRUE(std::any_of(results.begin(), results.begin() + 3,
+                            [&](const SearchResult& r) {
+                              return r.clip_index == p.clip && r.seed_frame >= p.first &&
+                                     r.seed_frame <= p.last;
+                            }))
+        << "clip " << p.clip << " at " << p.first;
+  }
+  // A library frame finds itself at distance 0; the filters hold.
+  const RowMatrixXf own = Eigen::Map<const RowMatrixXf>(FrameRow(*library_, 1200 + 77), 1, kDims);
+  params.clip_ids = {101};
+  found = Search(*library_, CoordinateView::Of(own), params);
+  ASSERT_TRUE(found.ok()) << found.status();
+  ASSERT_FALSE(found->results.empty());
+  EXPECT_EQ(found->results[0].seed_frame, 77);
+  EXPECT_EQ(found->results[0].score, 0.0);
+  for (const SearchResult& r : found->results) EXPECT_EQ(r.clip_id, 101);
 }
 
 TEST_F(SearchTest, RejectsBadParametersAndQueries) {

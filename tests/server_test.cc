@@ -817,6 +817,18 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   }
   EXPECT_EQ(raises_found, 4);
 
+  // One frame, the raise's middle, is a pose query: one-frame places, the frame itself first.
+  const int peak = (raise.first_frame + raise.last_frame) / 2;
+  v1::SearchResponse poses;
+  status = client.Search(ClipQuery("body", raise_clip, peak, peak), &poses);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(poses.results_size(), 4);
+  EXPECT_EQ(poses.results(0).clip_id(), raise_clip);
+  EXPECT_NEAR(poses.results(0).start_frame(), peak, 2);  // the nearest 30 Hz sample
+  EXPECT_LT(poses.results(0).score(), 1e-3);
+  for (const v1::SearchResult& r : poses.results()) EXPECT_EQ(r.start_frame(), r.end_frame());
+  EXPECT_EQ(poses.counts().warps(), 0);
+
   // The same range uploaded as BVH gives the same results.
   v1::SearchRequest uploaded = query;
   uploaded.mutable_bvh()->set_bvh(BvhText(Humanoid().clips[raise.clip]));

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/search/internal/search_query.h"
+#include "core/search/pose_search.h"
 #include "core/search/warp/time_warp.h"
 #include "core/search/warp_refinement.h"
 #include "util/status_macros.h"
@@ -183,6 +184,7 @@ int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral)
 
 absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateView query,
                                       const SearchParams& params) {
+  if (query.rows == 1) return PoseSearch(library, query, params);
   const Clock::time_point start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
   SearchResponse response;

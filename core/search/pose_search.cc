@@ -1,0 +1,82 @@
+#include "core/search/pose_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/index/coarse_rate.h"
+#include "core/search/internal/search_query.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+// Places asked of the kd-tree per result wanted: ranked over ann_dims, they are re-ranked over
+// dtw_dims, and moving to the best frame near each may bring two together.
+constexpr int kPlacesPerResult = 4;
+
+// The frame within `reach` of `frame` in `clip` nearest to `pose` over `dims`, and its distance:
+// the kd-tree holds every n-th frame only (core/index/coarse_rate.h).
+SearchResult NearestFrameAround(const LibraryIndex& library, const float* pose, int dims, int clip,
+                                int64_t frame, int64_t reach) {
+  const CoordinateView coordinates = library.clip_coordinates(clip);
+  SearchResult best;
+  best.clip_index = clip;
+  best.score = INFINITY;
+  const int64_t last = std::min(coordinates.rows - 1, frame + reach);
+  for (int64_t f = std::max<int64_t>(0, frame - reach); f <= last; ++f) {
+    const double distance = Distance(pose, coordinates.row(f), dims);
+    if (distance < best.score) {
+      best.score = distance;
+      best.first_frame = best.last_frame = best.seed_frame = f;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, CoordinateView pose,
+                                          const SearchParams& params) {
+  const auto start = std::chrono::steady_clock::now();
+  if (pose.rows != 1) return absl::InvalidArgumentError("a pose query has one frame");
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, pose, params));
+  SearchResponse response;
+  SearchStats& stats = response.stats;
+  stats.characteristic_frame = 0;
+  const int64_t separation =
+      std::max<int64_t>(std::llround(params.cluster_gap_s * library.rate()) + 1,
+                        std::llround(kPoseSeparationS * library.rate()));
+  const std::vector<Neighbour> places =
+      library.NearestPlaces(pose.row(0), params.ann_dims, kPlacesPerResult * params.max_results,
+                            separation, params.epsilon, allowed);
+  stats.seeds = stats.clusters = static_cast<int64_t>(places.size());
+  stats.seeds_ms = MillisecondsSince(start);
+
+  const auto stage = std::chrono::steady_clock::now();
+  const int64_t reach = CoarseFactor(library.rate()) - 1;
+  std::vector<SearchResult> candidates;
+  candidates.reserve(places.size());
+  for (const Neighbour& place : places) {
+    const auto [clip, frame] = library.Locate(place.frame);
+    candidates.push_back(
+        NearestFrameAround(library, pose.row(0), params.dtw_dims, clip, frame, reach));
+  }
+  stats.refine_ms = MillisecondsSince(stage);
+  // One-frame results overlap only when equal: as `separation` frames from each, two overlap
+  // exactly when closer than it, and the ranking's overlap rule drops the worse.
+  SearchParams ranking = params;
+  ranking.max_overlap = 0.0;
+  for (SearchResult& candidate : candidates) {
+    candidate.last_frame = candidate.seed_frame + separation - 1;
+  }
+  response.results = FinishResults(library, std::move(candidates), ranking);
+  for (SearchResult& result : response.results) {
+    result.first_frame = result.last_frame = result.seed_frame;
+    result.start_s = result.end_s = result.seed_frame / library.rate();
+  }
+  stats.total_ms = MillisecondsSince(start);
+  return response;
+}
+
+}  // namespace motiondb
