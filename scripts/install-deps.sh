@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages motiondb needs that are not installed yet.
-#   scripts/install-deps.sh               everything: build, tests, benchmarks, tools
+#   scripts/install-deps.sh               everything: build, start, tests, benchmarks, tools
+#                                         (scripts/test.sh, CI)
+#   scripts/install-deps.sh --start       what scripts/start.sh needs: the build and its demo
 #   scripts/install-deps.sh --build-only  what a Release server and CLI build needs (Docker)
 # Idempotent: does nothing (and needs no network) when everything is present.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 lists=("$here/packages-build.txt")
-[[ "${1:-}" == "--build-only" ]] || lists+=("$here/packages-dev.txt")
+case "${1:-}" in
+  --build-only) ;;
+  --start) lists+=("$here/packages-start.txt") ;;
+  "") lists+=("$here/packages-start.txt" "$here/packages-dev.txt") ;;
+  *) echo "install-deps: unknown option '$1' (--start, --build-only or none)" >&2; exit 2 ;;
+esac
 # A line is a package name, optionally followed by `command=NAME`: then the package also counts
 # as present when NAME is on PATH (another source installed it, e.g. a nodejs that bundles npm,
 # which Debian's npm package would conflict with).
@@ -33,3 +40,8 @@ fi
 echo "install-deps: installing ${missing[*]}"
 "${sudo[@]}" apt-get update -qq
 DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The tests use the prometheus package for its promtool only: the server it ships and starts
+# (on :9090, every interface, no authentication) is not wanted on a developer's machine.
+if [[ " ${missing[*]} " == *" prometheus "* && -d /run/systemd/system ]]; then
+  "${sudo[@]}" systemctl disable --now prometheus.service
+fi

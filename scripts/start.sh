@@ -20,7 +20,7 @@ if [[ "${1:-}" == "--demo" ]]; then
   demo=1
   shift
 fi
-"$root/scripts/install-deps.sh"
+"$root/scripts/install-deps.sh" --start
 build="${BUILD_DIR:-$root/build}"
 BUILD_DIR="$build" "$root/scripts/build.sh" motiondb-server motiondb
 "$root/scripts/build-web.sh"

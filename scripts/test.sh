@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds motiondb and runs the whole test suite with ctest.
+# Installs the Debian packages the tests need that are missing, builds motiondb and runs the
+# whole test suite with ctest.
 # Usage: scripts/test.sh [--sanitize] [ctest arguments...]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -10,6 +11,7 @@ if [[ "${1:-}" == "--sanitize" ]]; then
   build_dir="$root/build-asan"
   shift
 fi
+"$root/scripts/install-deps.sh"
 BUILD_DIR="$build_dir" "$root/scripts/build.sh" "${build_args[@]}"
 cd "$build_dir"
 ctest --output-on-failure -j "${JOBS:-2}" "$@"
