@@ -1,0 +1,720 @@
+// Markup propagation quality (issue 13, item 6), through the real server: motiondb-server runs
+// as a child on a fresh database; the Bandai clips of ../shared/mocap are ingested over gRPC
+// (tagged by dataset and style), one space is trained on them, and for each experiment the
+// manual labels are replaced by k examples per content (descriptor = the file name's content,
+// the whole clip, value 1), a propagation job runs over the clips the experiment evaluates (its
+// tags filter), and the propagated labels are read back with ListLabels and scored:
+// - clips: for each evaluated (unlabelled) clip, the strongest propagated descriptor among the
+//   labels covering at least half of it: coverage (clips with any such label) and accuracy
+//   (that descriptor is the clip's content), over the covered clips and over all;
+// - long takes (clips of one actor and style concatenated, root positions made continuous in
+//   the ground plane, the facing left as recorded): per frame the strongest descriptor covering
+//   it against the true content (no label: wrong), and segment F1@50.
+// Experiments: bandai2-normal within its one style; bandai1 within each style; bandai1 across
+// styles (examples from k styles, one clip per content each, evaluated on the other styles);
+// takes of bandai2-normal's non-example clips; takes of each bandai1 style (from the 14 styles
+// recorded by one actor each) with examples from other styles. Only clips whose content has an
+// example are evaluated.
+//
+// usage: propagation_quality [--seeds N] [--max-results M]... [--take-clips N]
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "bench/measure.h"
+#include "core/bvh/bvh_reader.h"
+#include "core/bvh/bvh_writer.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/job_service.grpc.pb.h"
+#include "motiondb/v1/label_service.grpc.pb.h"
+#include "motiondb/v1/space_service.grpc.pb.h"
+#include "testing/labelled_index.h"
+#include "testing/server_process.h"
+#include "util/cli_conventions.h"
+#include "util/file_io.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Flags {
+  int seeds = 3;
+  std::vector<int> max_results = {20, 100};
+  int take_clips = 20;  // bandai2-normal clips per long take
+};
+
+constexpr int kPool = 3;  // bandai2-normal examples set aside per content and seed (k <= kPool)
+constexpr char kSpace[] = "body";
+constexpr char kNone[] = "-";  // the prediction of a clip or frame without a label
+
+// A clip of the corpus as ingested.
+struct CorpusClip {
+  fs::path path;
+  std::string dataset, content, style;
+  int64_t id = 0;
+  int frames = 0;
+};
+
+// A long take as ingested: its true content per frame.
+struct Take {
+  int64_t id = 0;
+  std::string tag;
+  std::vector<std::string> truth;
+};
+
+// What one job is asked and what it is scored on.
+struct Experiment {
+  std::string name;
+  int k = 0;
+  std::vector<const CorpusClip*> examples;
+  std::vector<const CorpusClip*> clips;  // scored as clips
+  std::vector<const Take*> takes;        // scored per frame
+  std::vector<std::string> tags;         // the clips searched
+};
+
+absl::Status FromGrpc(const grpc::Status& status, const std::string& what) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                      absl::StrCat(what, ": ", status.error_message()));
+}
+
+// The server's services, over one channel.
+class Api {
+ public:
+  explicit Api(const std::shared_ptr<grpc::Channel>& channel)
+      : clips_(v1::ClipService::NewStub(channel)),
+        spaces_(v1::SpaceService::NewStub(channel)),
+        labels_(v1::LabelService::NewStub(channel)),
+        jobs_(v1::JobService::NewStub(channel)) {}
+
+  // The clip as stored.
+  absl::StatusOr<v1::Clip> Ingest(const std::string& name, const std::string& bvh,
+                                  const std::vector<std::string>& tags) {
+    v1::IngestClipRequest request;
+    request.set_file_name(name + ".bvh");
+    request.set_bvh(bvh);
+    for (const std::string& tag : tags) request.add_tags(tag);
+    v1::IngestClipResponse response;
+    grpc::ClientContext context;
+    MOTIONDB_RETURN_IF_ERROR(FromGrpc(clips_->IngestClip(&context, request, &response), name));
+    return response.clip();
+  }
+
+  absl::Status CreateSpace() {
+    v1::CreateSpaceRequest request;
+    request.set_name(kSpace);
+    v1::Space space;
+    grpc::ClientContext context;
+    return FromGrpc(spaces_->CreateSpace(&context, request, &space), "CreateSpace");
+  }
+
+  // Deletes every manual label (and so every propagated one) and adds `examples`.
+  absl::Status SetExamples(const std::vector<const CorpusClip*>& examples) {
+    v1::DeleteLabelsRequest remove;
+    remove.set_origin(v1::LABEL_ORIGIN_MANUAL);
+    v1::DeleteLabelsResponse removed;
+    grpc::ClientContext remove_context;
+    MOTIONDB_RETURN_IF_ERROR(
+        FromGrpc(labels_->DeleteLabels(&remove_context, remove, &removed), "DeleteLabels"));
+    v1::AddLabelsRequest add;
+    for (const CorpusClip* example : examples) {
+      v1::NewLabel* label = add.add_labels();
+      label->set_clip_id(example->id);  // no range: the whole clip
+      label->set_descriptor_name(example->content);
+      label->set_value(1);
+    }
+    v1::AddLabelsResponse added;
+    grpc::ClientContext add_context;
+    return FromGrpc(labels_->AddLabels(&add_context, add, &added), "AddLabels");
+  }
+
+  // Propagates every manual descriptor over the clips carrying one of `tags`, waits for the
+  // job and returns the propagated labels.
+  absl::StatusOr<std::vector<v1::Label>> Propagate(const std::vector<std::string>& tags,
+                                                   int max_results) {
+    v1::StartPropagationRequest start;
+    start.set_space(kSpace);
+    start.mutable_search()->set_max_results(max_results);
+    for (const std::string& tag : tags) start.add_tags(tag);
+    v1::Job job;
+    grpc::ClientContext context;
+    MOTIONDB_RETURN_IF_ERROR(
+        FromGrpc(jobs_->StartPropagation(&context, start, &job), "StartPropagation"));
+    MOTIONDB_ASSIGN_OR_RETURN(job, WaitForJob(job.job_id()));
+    if (job.state() != v1::JOB_STATE_SUCCEEDED) {
+      return absl::InternalError(
+          absl::StrCat(job.job_id(), " ended ", v1::JobState_Name(job.state()), ": ", job.error()));
+    }
+    return PropagatedLabels();
+  }
+
+ private:
+  absl::StatusOr<v1::Job> WaitForJob(const std::string& job_id) {
+    v1::GetJobRequest get;
+    get.set_job_id(job_id);
+    v1::Job job;
+    do {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      grpc::ClientContext context;
+      MOTIONDB_RETURN_IF_ERROR(FromGrpc(jobs_->GetJob(&context, get, &job), "GetJob"));
+    } while (job.state() == v1::JOB_STATE_QUEUED || job.state() == v1::JOB_STATE_RUNNING);
+    return job;
+  }
+
+  absl::StatusOr<std::vector<v1::Label>> PropagatedLabels() {
+    v1::ListLabelsRequest list;
+    list.set_origin(v1::LABEL_ORIGIN_PROPAGATED);
+    list.set_page_size(1000);
+    std::vector<v1::Label> labels;
+    do {
+      v1::ListLabelsResponse page;
+      grpc::ClientContext context;
+      MOTIONDB_RETURN_IF_ERROR(FromGrpc(labels_->ListLabels(&context, list, &page), "ListLabels"));
+      labels.insert(labels.end(), page.labels().begin(), page.labels().end());
+      list.set_page_token(page.next_page_token());
+    } while (!list.page_token().empty());
+    return labels;
+  }
+
+  std::unique_ptr<v1::ClipService::Stub> clips_;
+  std::unique_ptr<v1::SpaceService::Stub> spaces_;
+  std::unique_ptr<v1::LabelService::Stub> labels_;
+  std::unique_ptr<v1::JobService::Stub> jobs_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The corpus and the long takes.
+
+absl::StatusOr<std::vector<CorpusClip>> IngestFolder(Api& api, const fs::path& folder,
+                                                     const std::string& dataset) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().extension() == ".bvh") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<CorpusClip> clips;
+  for (const fs::path& path : files) {
+    CorpusClip& clip = clips.emplace_back();
+    clip = {path, dataset, testing::ContentLabel(path), testing::StyleLabel(path)};
+    MOTIONDB_ASSIGN_OR_RETURN(const std::string bvh, ReadFileBytes(path.string(), 64 << 20));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const v1::Clip stored,
+        api.Ingest(path.stem().string(), bvh, {dataset, dataset + ":" + clip.style}));
+    clip.id = stored.clip_id();
+    clip.frames = stored.frame_count();
+  }
+  return clips;
+}
+
+// The clips of `parts` one after the other, on the first one's skeleton (all must have the same
+// offsets: one actor). Each part's root is moved in the ground plane (x, z) to start where the
+// previous part ended; its height and every rotation are as recorded.
+absl::StatusOr<Clip> Concatenate(const std::vector<Clip>& parts) {
+  const Clip& first = parts.front();
+  const int slot = first.skeleton().position_slot(0);
+  int rows = 0;
+  for (const Clip& part : parts) {
+    for (int j = 0; j < first.skeleton().joint_count(); ++j) {
+      if (part.skeleton().joint(j).offset != first.skeleton().joint(j).offset) {
+        return absl::InvalidArgumentError("a take's clips must share their skeleton's offsets");
+      }
+    }
+    rows += part.frame_count();
+  }
+  RowMatrixXd rotations(rows, first.rotations().cols()), positions(rows, first.positions().cols());
+  int row = 0;
+  for (const Clip& part : parts) {
+    rotations.middleRows(row, part.frame_count()) = part.rotations();
+    positions.middleRows(row, part.frame_count()) = part.positions();
+    if (slot >= 0 && row > 0) {
+      for (const int axis : {0, 2}) {
+        const double shift = positions(row - 1, 3 * slot + axis) - positions(row, 3 * slot + axis);
+        positions.block(row, 3 * slot + axis, part.frame_count(), 1).array() += shift;
+      }
+    }
+    row += part.frame_count();
+  }
+  return Clip::Create(first.shared_skeleton(), first.frame_time(), std::move(rotations),
+                      std::move(positions));
+}
+
+absl::StatusOr<Take> IngestTake(Api& api, const std::string& name, const std::string& tag,
+                                const std::vector<const CorpusClip*>& members) {
+  std::vector<Clip> parts;
+  Take take;
+  take.tag = tag;
+  for (const CorpusClip* member : members) {
+    MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(member->path.string()));
+    take.truth.insert(take.truth.end(), read.clip.frame_count(), member->content);
+    parts.push_back(std::move(read.clip));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip, Concatenate(parts));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string bvh, WriteBvh(clip));
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::Clip stored, api.Ingest(name, bvh, {tag}));
+  take.id = stored.clip_id();
+  return take;
+}
+
+template <typename T>
+void Shuffle(std::vector<T>& items, uint32_t seed) {
+  std::mt19937 random(seed);
+  std::shuffle(items.begin(), items.end(), random);
+}
+
+std::vector<const CorpusClip*> Select(const std::vector<CorpusClip>& clips,
+                                      const std::function<bool(const CorpusClip&)>& keep) {
+  std::vector<const CorpusClip*> selected;
+  for (const CorpusClip& clip : clips) {
+    if (keep(clip)) selected.push_back(&clip);
+  }
+  return selected;
+}
+
+// Per content, its clips among `clips` in an order drawn from `seed`.
+std::map<std::string, std::vector<const CorpusClip*>> ByContent(
+    const std::vector<const CorpusClip*>& clips, uint32_t seed) {
+  std::map<std::string, std::vector<const CorpusClip*>> by_content;
+  for (const CorpusClip* clip : clips) by_content[clip->content].push_back(clip);
+  for (auto& [content, members] : by_content) Shuffle(members, seed);
+  return by_content;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The experiments.
+
+// The clips of `candidates` that are not examples and whose content has one.
+std::vector<const CorpusClip*> Unlabelled(const std::vector<const CorpusClip*>& candidates,
+                                          const std::vector<const CorpusClip*>& examples) {
+  std::set<const CorpusClip*> given(examples.begin(), examples.end());
+  std::set<std::string> contents;
+  for (const CorpusClip* example : examples) contents.insert(example->content);
+  std::vector<const CorpusClip*> left;
+  for (const CorpusClip* clip : candidates) {
+    if (!given.contains(clip) && contents.contains(clip->content)) left.push_back(clip);
+  }
+  return left;
+}
+
+// bandai2-normal within its style, and its takes: the examples are the first k of the seed's
+// pool; the takes (ingested here) hold the clips outside the pool.
+absl::StatusOr<std::vector<Experiment>> Bandai2Experiments(Api& api,
+                                                           const std::vector<CorpusClip>& corpus,
+                                                           int seed, const Flags& flags,
+                                                           std::deque<Take>* takes) {
+  const std::vector<const CorpusClip*> all =
+      Select(corpus, [](const CorpusClip& c) { return c.dataset == "bandai2"; });
+  std::map<int, std::vector<const CorpusClip*>> examples;  // by k
+  std::vector<const CorpusClip*> rest;
+  for (const auto& [content, members] : ByContent(all, seed)) {
+    for (const int k : {1, kPool}) {
+      examples[k].insert(examples[k].end(), members.begin(), members.begin() + k);
+    }
+    rest.insert(rest.end(), members.begin() + kPool, members.end());
+  }
+  Shuffle(rest, seed);
+  const std::string tag = absl::StrCat("take:bandai2:", seed);
+  const size_t first_take = takes->size();
+  for (size_t i = 0; i < rest.size(); i += flags.take_clips) {
+    const std::vector<const CorpusClip*> members(
+        rest.begin() + i, rest.begin() + std::min(rest.size(), i + flags.take_clips));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        takes->emplace_back(),
+        IngestTake(api, absl::StrCat("take-bandai2-s", seed, "-", i / flags.take_clips), tag,
+                   members));
+  }
+  std::vector<Experiment> experiments;
+  for (const int k : {1, kPool}) {
+    experiments.push_back({"bandai2-normal, within style",
+                           k,
+                           examples[k],
+                           Unlabelled(all, examples[k]),
+                           {},
+                           {"bandai2"}});
+    Experiment on_takes{"bandai2-normal long takes, within style", k, examples[k], {}, {}, {tag}};
+    for (size_t t = first_take; t < takes->size(); ++t) on_takes.takes.push_back(&(*takes)[t]);
+    experiments.push_back(std::move(on_takes));
+  }
+  return experiments;
+}
+
+// bandai1 within each style: k clips per content of the style are the examples.
+std::vector<Experiment> Bandai1WithinStyle(const std::vector<CorpusClip>& corpus, int seed) {
+  std::set<std::string> styles;
+  for (const CorpusClip& clip : corpus) {
+    if (clip.dataset == "bandai1") styles.insert(clip.style);
+  }
+  std::vector<Experiment> experiments;
+  for (const int k : {1, kPool}) {
+    for (const std::string& style : styles) {
+      const std::vector<const CorpusClip*> in_style = Select(
+          corpus, [&](const CorpusClip& c) { return c.dataset == "bandai1" && c.style == style; });
+      Experiment experiment{"bandai1, within each style", k, {}, {}, {}, {"bandai1:" + style}};
+      for (const auto& [content, members] : ByContent(in_style, seed)) {
+        const size_t n = std::min<size_t>(k, members.size());
+        experiment.examples.insert(experiment.examples.end(), members.begin(), members.begin() + n);
+      }
+      experiment.clips = Unlabelled(in_style, experiment.examples);
+      experiments.push_back(std::move(experiment));
+    }
+  }
+  return experiments;
+}
+
+// bandai1 across styles: k source styles drawn from `seed`, one clip per content from each;
+// evaluated on the other styles' clips, and on their takes.
+std::vector<Experiment> Bandai1AcrossStyles(const std::vector<CorpusClip>& corpus,
+                                            const std::vector<Take>& style_takes, int seed) {
+  std::vector<std::string> styles;
+  for (const Take& take : style_takes) styles.push_back(take.tag.substr(take.tag.rfind(':') + 1));
+  Shuffle(styles, seed);
+  std::vector<Experiment> experiments;
+  for (const int k : {1, kPool}) {
+    const std::set<std::string> sources(styles.begin(), styles.begin() + k);
+    Experiment clips{"bandai1, across styles", k, {}, {}, {}, {}};
+    Experiment takes{"bandai1 long takes, across styles", k, {}, {}, {}, {}};
+    for (const std::string& source : sources) {
+      const auto in_source = Select(
+          corpus, [&](const CorpusClip& c) { return c.dataset == "bandai1" && c.style == source; });
+      for (const auto& [content, members] : ByContent(in_source, seed)) {
+        clips.examples.push_back(members.front());
+      }
+    }
+    std::set<std::string> targets;
+    for (const std::string& style : styles) {
+      if (sources.contains(style)) continue;
+      targets.insert(style);
+      clips.tags.push_back("bandai1:" + style);
+      takes.tags.push_back("take:bandai1:" + style);
+    }
+    const auto in_targets = Select(corpus, [&](const CorpusClip& c) {
+      return c.dataset == "bandai1" && targets.contains(c.style);
+    });
+    clips.clips = Unlabelled(in_targets, clips.examples);
+    for (const Take& take : style_takes) {
+      if (std::count(takes.tags.begin(), takes.tags.end(), take.tag) > 0)
+        takes.takes.push_back(&take);
+    }
+    takes.examples = clips.examples;
+    experiments.push_back(std::move(clips));
+    experiments.push_back(std::move(takes));
+  }
+  return experiments;
+}
+
+// One take per bandai1 style recorded by one actor (every style but `normal`, whose clips come
+// from four skeletons): its clips in a fixed shuffled order.
+absl::StatusOr<std::vector<Take>> IngestStyleTakes(Api& api,
+                                                   const std::vector<CorpusClip>& corpus) {
+  std::map<std::string, std::vector<const CorpusClip*>> by_style;
+  for (const CorpusClip& clip : corpus) {
+    if (clip.dataset == "bandai1" && clip.style != "normal") by_style[clip.style].push_back(&clip);
+  }
+  std::vector<Take> takes;
+  for (auto& [style, members] : by_style) {
+    Shuffle(members, 1);
+    MOTIONDB_ASSIGN_OR_RETURN(takes.emplace_back(), IngestTake(api, "take-bandai1-" + style,
+                                                               "take:bandai1:" + style, members));
+  }
+  return takes;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scoring.
+
+// Counts of (true content, prediction), and the frame and segment counts of takes.
+struct Score {
+  std::map<std::string, std::map<std::string, int64_t>> confusion;
+  int64_t frames = 0, frames_right = 0;
+  int64_t segments_true = 0, segments_predicted = 0, segments_matched = 0;
+  int jobs = 0;
+};
+
+using LabelsByClip = std::map<int64_t, std::vector<const v1::Label*>>;
+
+// The strongest descriptor among `labels` that cover at least `min_frames` of their clip.
+std::string Strongest(const std::vector<const v1::Label*>& labels, int64_t min_frames) {
+  const v1::Label* best = nullptr;
+  for (const v1::Label* label : labels) {
+    if (label->last_frame() - label->first_frame() + 1 < min_frames) continue;
+    if (best == nullptr || label->value() > best->value()) best = label;
+  }
+  return best == nullptr ? kNone : best->descriptor_name();
+}
+
+void ScoreClips(const Experiment& experiment, const LabelsByClip& labels, Score* score) {
+  for (const CorpusClip* clip : experiment.clips) {
+    const auto found = labels.find(clip->id);
+    const std::string predicted =
+        found == labels.end() ? kNone : Strongest(found->second, (clip->frames + 1) / 2);
+    ++score->confusion[clip->content][predicted];
+  }
+}
+
+// Per frame, the strongest descriptor covering it (kNone where none does).
+std::vector<std::string> FramePrediction(size_t frames,
+                                         const std::vector<const v1::Label*>& labels) {
+  std::vector<std::string> predicted(frames, kNone);
+  std::vector<double> strength(frames, -1);
+  for (const v1::Label* label : labels) {
+    for (int f = label->first_frame(); f <= label->last_frame() && f < static_cast<int>(frames);
+         ++f) {
+      if (label->value() > strength[f]) {
+        strength[f] = label->value();
+        predicted[f] = label->descriptor_name();
+      }
+    }
+  }
+  return predicted;
+}
+
+struct Segment {
+  std::string label;
+  int first = 0, last = 0;
+};
+
+// The maximal runs of one label, kNone's left out.
+std::vector<Segment> Segments(const std::vector<std::string>& frames) {
+  std::vector<Segment> segments;
+  for (int f = 0; f < static_cast<int>(frames.size()); ++f) {
+    if (f > 0 && frames[f] == frames[f - 1]) {
+      if (frames[f] != kNone) segments.back().last = f;
+    } else if (frames[f] != kNone) {
+      segments.push_back({frames[f], f, f});
+    }
+  }
+  return segments;
+}
+
+double IoU(const Segment& a, const Segment& b) {
+  const int shared = std::min(a.last, b.last) - std::max(a.first, b.first) + 1;
+  if (shared <= 0) return 0;
+  return static_cast<double>(shared) / (std::max(a.last, b.last) - std::min(a.first, b.first) + 1);
+}
+
+// Predicted segments matched to true ones at IoU >= 0.5 (each true segment once; a predicted
+// segment takes its best-overlapping true segment of its label), as in MS-TCN's F1@k.
+int64_t MatchedSegments(const std::vector<Segment>& predicted, const std::vector<Segment>& truth) {
+  std::vector<bool> used(truth.size(), false);
+  int64_t matched = 0;
+  for (const Segment& segment : predicted) {
+    int best = -1;
+    double best_iou = 0;
+    for (size_t t = 0; t < truth.size(); ++t) {
+      const double iou = truth[t].label == segment.label ? IoU(segment, truth[t]) : 0;
+      if (iou > best_iou) best = static_cast<int>(t), best_iou = iou;
+    }
+    if (best >= 0 && best_iou >= 0.5 && !used[best]) used[best] = true, ++matched;
+  }
+  return matched;
+}
+
+void ScoreTakes(const Experiment& experiment, const LabelsByClip& labels, Score* score) {
+  static const std::vector<const v1::Label*> kNoLabels;
+  for (const Take* take : experiment.takes) {
+    const auto found = labels.find(take->id);
+    const std::vector<std::string> predicted =
+        FramePrediction(take->truth.size(), found == labels.end() ? kNoLabels : found->second);
+    for (size_t f = 0; f < predicted.size(); ++f) {
+      ++score->confusion[take->truth[f]][predicted[f]];
+      score->frames_right += predicted[f] == take->truth[f];
+    }
+    score->frames += predicted.size();
+    const std::vector<Segment> predicted_segments = Segments(predicted);
+    const std::vector<Segment> true_segments = Segments(take->truth);
+    score->segments_predicted += predicted_segments.size();
+    score->segments_true += true_segments.size();
+    score->segments_matched += MatchedSegments(predicted_segments, true_segments);
+  }
+}
+
+absl::Status RunExperiment(Api& api, const Experiment& experiment, int max_results, Score* score) {
+  if (experiment.clips.empty() && experiment.takes.empty()) return absl::OkStatus();
+  MOTIONDB_RETURN_IF_ERROR(api.SetExamples(experiment.examples));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<v1::Label> labels,
+                            api.Propagate(experiment.tags, max_results));
+  LabelsByClip by_clip;
+  for (const v1::Label& label : labels) by_clip[label.clip_id()].push_back(&label);
+  ++score->jobs;
+  ScoreTakes(experiment, by_clip, score);
+  ScoreClips(experiment, by_clip, score);
+  return absl::OkStatus();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The report.
+
+struct Tally {
+  int64_t total = 0, covered = 0, right = 0;
+};
+
+Tally TallyOf(const std::map<std::string, int64_t>& predictions, const std::string& truth) {
+  Tally tally;
+  for (const auto& [predicted, count] : predictions) {
+    tally.total += count;
+    if (predicted != kNone) tally.covered += count;
+    if (predicted == truth) tally.right += count;
+  }
+  return tally;
+}
+
+double Ratio(int64_t a, int64_t b) { return b == 0 ? 0 : static_cast<double>(a) / b; }
+
+// "walk 40/45 (covered 44): run 3, - 1": right of all, then the wrong predictions, most first.
+void PrintConfusion(const Score& score) {
+  for (const auto& [truth, predictions] : score.confusion) {
+    const Tally tally = TallyOf(predictions, truth);
+    std::vector<std::pair<int64_t, std::string>> wrong;
+    for (const auto& [predicted, count] : predictions) {
+      if (predicted != truth) wrong.emplace_back(-count, absl::StrCat(predicted, " ", count));
+    }
+    std::sort(wrong.begin(), wrong.end());
+    std::vector<std::string> parts;
+    for (const auto& [order, text] : wrong) parts.push_back(text);
+    std::printf("    %s %lld/%lld (covered %lld)%s%s\n", truth.c_str(),
+                static_cast<long long>(tally.right), static_cast<long long>(tally.total),
+                static_cast<long long>(tally.covered), parts.empty() ? "" : ": ",
+                absl::StrJoin(parts, ", ").c_str());
+  }
+}
+
+void PrintRow(const std::string& name, int k, int max_results, const Score& score) {
+  Tally all;
+  for (const auto& [truth, predictions] : score.confusion) {
+    const Tally tally = TallyOf(predictions, truth);
+    all.total += tally.total, all.covered += tally.covered, all.right += tally.right;
+  }
+  std::string takes = " | | ";
+  if (score.frames > 0) {
+    const double precision = Ratio(score.segments_matched, score.segments_predicted);
+    const double recall = Ratio(score.segments_matched, score.segments_true);
+    takes =
+        absl::StrFormat(" | %.3f | %.3f (P %.2f R %.2f) ", Ratio(score.frames_right, score.frames),
+                        precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0,
+                        precision, recall);
+  }
+  std::printf("| %s | %d | %d | %d | %lld | %.3f | %.3f | %.3f%s|\n", name.c_str(), k, max_results,
+              score.jobs, static_cast<long long>(all.total), Ratio(all.covered, all.total),
+              Ratio(all.right, all.covered), Ratio(all.right, all.total), takes.c_str());
+}
+
+absl::StatusOr<std::vector<Experiment>> AllExperiments(Api& api,
+                                                       const std::vector<CorpusClip>& corpus,
+                                                       const Flags& flags,
+                                                       std::deque<Take>* bandai2_takes,
+                                                       const std::vector<Take>& style_takes) {
+  std::vector<Experiment> experiments;
+  for (int seed = 1; seed <= flags.seeds; ++seed) {
+    MOTIONDB_ASSIGN_OR_RETURN(std::vector<Experiment> some,
+                              Bandai2Experiments(api, corpus, seed, flags, bandai2_takes));
+    for (const std::vector<Experiment>& more :
+         {some, Bandai1WithinStyle(corpus, seed), Bandai1AcrossStyles(corpus, style_takes, seed)}) {
+      experiments.insert(experiments.end(), more.begin(), more.end());
+    }
+  }
+  return experiments;
+}
+
+absl::Status Measure(Api& api, const fs::path& mocap, const Flags& flags) {
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<CorpusClip> corpus,
+                            IngestFolder(api, mocap / "bandai1", "bandai1"));
+  MOTIONDB_ASSIGN_OR_RETURN(std::vector<CorpusClip> bandai2,
+                            IngestFolder(api, mocap / "bandai2-normal", "bandai2"));
+  corpus.insert(corpus.end(), bandai2.begin(), bandai2.end());
+  // Trained on the clips; the takes, ingested after, are projected into it.
+  MOTIONDB_RETURN_IF_ERROR(api.CreateSpace());
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Take> style_takes, IngestStyleTakes(api, corpus));
+  std::deque<Take> bandai2_takes;  // the experiments point into it
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Experiment> experiments,
+                            AllExperiments(api, corpus, flags, &bandai2_takes, style_takes));
+  std::map<std::tuple<std::string, int, int>, Score> scores;
+  for (const int max_results : flags.max_results) {
+    for (const Experiment& experiment : experiments) {
+      MOTIONDB_RETURN_IF_ERROR(RunExperiment(
+          api, experiment, max_results, &scores[{experiment.name, experiment.k, max_results}]));
+    }
+  }
+  std::printf(
+      "| experiment | k | max_results | jobs | evaluated | coverage | accuracy (covered) | "
+      "accuracy (all) | frame accuracy | F1@50 "
+      "|\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+  for (const auto& [key, score] : scores) {
+    PrintRow(std::get<0>(key), std::get<1>(key), std::get<2>(key), score);
+  }
+  for (const auto& [key, score] : scores) {
+    std::printf("\n%s, k = %d, max_results %d: per content, right/all (covered): wrong\n",
+                std::get<0>(key).c_str(), std::get<1>(key), std::get<2>(key));
+    PrintConfusion(score);
+  }
+  return absl::OkStatus();
+}
+
+absl::Status Run(const Flags& flags) {
+  const fs::path mocap = bench::MocapRoot();
+  if (!fs::exists(mocap / "bandai1") || !fs::exists(mocap / "bandai2-normal")) {
+    std::printf("skipped: %s has no bandai1 and bandai2-normal\n", mocap.c_str());
+    return absl::OkStatus();
+  }
+  const fs::path work =
+      fs::temp_directory_path() / ("motiondb_propagation_quality_" + std::to_string(::getpid()));
+  fs::create_directories(work);
+  testing::ServerProcess server;
+  std::string error;
+  if (!server.Start({"--db", (work / "library.sqlite").string(), "--quiet"}, &error)) {
+    return absl::InternalError(error);
+  }
+  const auto channel = testing::InsecureChannel(server.address());
+  if (!testing::WaitUntilServing(channel, "")) {
+    return absl::InternalError("the server did not start serving");
+  }
+  Api api(channel);
+  const absl::Status measured = Measure(api, mocap, flags);
+  server.Stop(SIGTERM);
+  fs::remove_all(work);
+  return measured;
+}
+
+}  // namespace
+}  // namespace motiondb
+
+int main(int argc, char** argv) {
+  CLI::App app("Markup propagation quality on the Bandai clips, through the real server.",
+               "propagation_quality");
+  motiondb::Flags flags;
+  app.add_option("--seeds", flags.seeds, "draws of the examples (and of bandai2's takes)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app.add_option("--max-results", flags.max_results,
+                 "each query's max_results (repeat for several)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000));
+  app.add_option("--take-clips", flags.take_clips, "bandai2-normal clips per long take")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000));
+  if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
+    return *exit_code;
+  }
+  const absl::Status status = motiondb::Run(flags);
+  if (!status.ok()) {
+    std::fprintf(stderr, "propagation_quality: %s\n", std::string(status.message()).c_str());
+    return 1;
+  }
+  return 0;
+}
