@@ -28,7 +28,7 @@ struct SearchFlags {
   std::string seeds = "frames";
   std::optional<double> epsilon;
   std::string neutral = "mean";
-  bool exact = false, path = false, no_refine = false;
+  bool exact = false, path = false, no_refine = false, explain = false;
   bool exclude_query = true;  // a --clip query's own range is not a result
   std::vector<int64_t> in_clips;
   std::vector<std::string> tags;
@@ -103,9 +103,32 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   for (const int64_t id : flags.in_clips) request.add_clip_ids(id);
   request.set_exact(flags.exact);
   request.set_return_path(flags.path);
+  request.set_explain(flags.explain);
   if (flags.no_refine) request.set_refine(false);
   if (flags.clip) request.set_exclude_query(flags.exclude_query);
   return request;
+}
+
+nlohmann::json ExplanationJson(const v1::SearchExplanation& explanation) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (const v1::JointShare& joint : explanation.joints()) {
+    joints.push_back({{"name", joint.name()}, {"share", joint.share()}, {"score", joint.score()}});
+  }
+  return {{"joints", std::move(joints)},
+          {"full_score", explanation.full_score()},
+          {"mean_speed", explanation.mean_speed()},
+          {"max_speed", explanation.max_speed()}};
+}
+
+// The explanation's first three joints and the speeds, on one line under a result.
+void PrintExplanation(const v1::SearchExplanation& explanation) {
+  std::string joints;
+  for (int i = 0; i < 3 && i < explanation.joints_size(); ++i) {
+    absl::StrAppend(&joints, i > 0 ? ", " : "", explanation.joints(i).name(), " ",
+                    absl::StrFormat("%.0f%%", 100 * explanation.joints(i).share()));
+  }
+  absl::PrintF("       why: %s; speed x%.2f (at most x%.2f)\n", joints, explanation.mean_speed(),
+               explanation.max_speed());
 }
 
 nlohmann::json ResponseJson(const v1::SearchResponse& response) {
@@ -116,6 +139,7 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
         {"end_s", r.end_s()},     {"start_frame", r.start_frame()}, {"end_frame", r.end_frame()},
         {"score", r.score()},     {"seed_frame", r.seed_frame()}};
     if (r.path_size() > 0) item["path"] = std::vector<int>(r.path().begin(), r.path().end());
+    if (r.has_explanation()) item["explanation"] = ExplanationJson(r.explanation());
     results.push_back(std::move(item));
   }
   const v1::SearchTimings& t = response.timings();
@@ -155,6 +179,7 @@ absl::Status Search(const SearchFlags& flags, bool json, const ServerConnection&
   for (const v1::SearchResult& r : response.results()) {
     absl::PrintF("%4d %8d  %-40s %9.3f %9.3f %6d-%-6d %10.5f\n", ++rank, r.clip_id(), r.clip_name(),
                  r.start_s(), r.end_s(), r.start_frame(), r.end_frame(), r.score());
+    if (r.has_explanation()) PrintExplanation(r.explanation());
   }
   const v1::SearchTimings& t = response.timings();
   absl::PrintF(
@@ -225,6 +250,9 @@ void AddSearch(Commands& commands) {
                  "--clip: leave out (or keep) results overlapping the query's own range")
       ->default_str("exclude");
   search->add_flag("--path", flags->path, "each result's warp path (with --json)");
+  search->add_flag("--explain", flags->explain,
+                   "each result's share of its distance per joint (the top three printed) and "
+                   "its speed against the query");
   search->add_option("--in-clip", flags->in_clips, "only in this clip; repeat for more")
       ->type_name("ID")
       ->allow_extra_args(false)

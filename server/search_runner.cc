@@ -118,32 +118,54 @@ struct OwnRange {
   }
 };
 
-// Runs the search, without the hits overlapping `own` when given. The query's own range and
-// its near shifts rank first, so the search is asked for more results than wanted, and asked
-// again for yet more while what is left falls short and the search had more to give.
+// What Hits needs beyond the query: how to search and what to add to each hit.
+struct HitOptions {
+  bool exact = false;
+  bool explain = false;
+  bool keep_paths = false;  // the caller asked for the paths
+  std::optional<OwnRange> own;
+};
+
+// `result` as a hit, explained when asked.
+absl::StatusOr<SearchHit> FullHit(const SpaceSnapshot& snapshot, const Query& query,
+                                  const SearchResult& result, const HitOptions& options) {
+  SearchHit hit = HitOf(result, snapshot);
+  if (options.explain) {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        hit.explanation,
+        ExplainHit(*snapshot.space, query.rows(),
+                   snapshot.index->clip_coordinates(result.clip_index), result.path));
+  }
+  if (!options.keep_paths) hit.path.clear();
+  return hit;
+}
+
+// Runs the search, without the hits overlapping `options.own` when given. The query's own range
+// and its near shifts rank first, so the search is asked for more results than wanted, and
+// asked again for yet more while what is left falls short and the search had more to give.
 absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const Query& query,
-                                            SearchParams params, bool exact,
-                                            const std::optional<OwnRange>& own,
+                                            SearchParams params, const HitOptions& options,
                                             SearchStats* stats) {
   const int wanted = params.max_results;
-  int extra = own ? 4 : 0;
+  int extra = options.own ? 4 : 0;
+  params.return_path = params.return_path || options.explain;
   while (true) {
     params.max_results = std::min(wanted + extra, kMaxSearchResults);
     MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
-                              exact ? ExactSearch(*snapshot.index, query.rows(), params)
-                                    : Search(*snapshot.index, query.rows(), params));
+                              options.exact ? ExactSearch(*snapshot.index, query.rows(), params)
+                                            : Search(*snapshot.index, query.rows(), params));
     *stats = found.stats;
     std::vector<SearchHit> hits;
     hits.reserve(found.results.size());
     for (const SearchResult& result : found.results) {
-      SearchHit hit = HitOf(result, snapshot);
-      if (!own || !own->Overlaps(hit)) hits.push_back(std::move(hit));
+      if (static_cast<int>(hits.size()) == wanted) break;
+      MOTIONDB_ASSIGN_OR_RETURN(SearchHit hit, FullHit(snapshot, query, result, options));
+      if (!options.own || !options.own->Overlaps(hit)) hits.push_back(std::move(hit));
     }
     const bool exhausted = static_cast<int>(found.results.size()) < params.max_results;
     // At most a few rounds: the query's overlaps are few after overlap suppression.
     if (static_cast<int>(hits.size()) >= wanted || exhausted || extra >= 256 ||
         params.max_results == kMaxSearchResults) {
-      if (static_cast<int>(hits.size()) > wanted) hits.resize(wanted);
       return hits;
     }
     extra *= 4;
@@ -160,10 +182,12 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                             FindSpace(registry_, request.space));
   const int dims = snapshot->space->dims();
   Query query;
-  std::optional<OwnRange> own;
+  HitOptions options{request.exact, request.explain, request.params.return_path, std::nullopt};
   if (const auto* stored = std::get_if<ClipSelection>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(query, StoredQuery(*stored, *snapshot, database_));
-    if (request.exclude_query.value_or(true)) own = OwnRange{stored->clip_id, query.range};
+    if (request.exclude_query.value_or(true)) {
+      options.own = OwnRange{stored->clip_id, query.range};
+    }
   } else if (const auto* upload = std::get_if<UploadedQuery>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(query, QueryOfUpload(*upload, *snapshot, limits_));
   } else {
@@ -177,7 +201,7 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
   if (snapshot->index) {
     outcome.library_frames = snapshot->index->total_frames();
     MOTIONDB_ASSIGN_OR_RETURN(outcome.hits,
-                              Hits(*snapshot, query, params, request.exact, own, &outcome.stats));
+                              Hits(*snapshot, query, params, options, &outcome.stats));
     if (outcome.stats.characteristic_frame >= 0) {
       outcome.characteristic_frame =
           query.frames.ToOriginal(query.first_row + outcome.stats.characteristic_frame);

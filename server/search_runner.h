@@ -17,6 +17,7 @@
 #include "core/search/search_result.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
+#include "server/search_explanation.h"
 #include "server/upload.h"
 #include "storage/database.h"
 
@@ -45,6 +46,9 @@ struct SearchRequest {
   // A stored-clip query: drop hits in its clip overlapping its range (unset: true), filling
   // params.max_results with others. Ignored for an uploaded query.
   std::optional<bool> exclude_query;
+  // Each hit with its SearchExplanation (the path is computed for it, and returned only when
+  // params.return_path asks).
+  bool explain = false;
 };
 
 // A ranked time range, in the clip's own frames (inclusive).
@@ -58,6 +62,7 @@ struct SearchHit {
   double score = 0;       // mean pose distance along the warp; lower is better
   int seed_frame = -1;    // the frame matched to the characteristic query frame; -1 in exact mode
   std::vector<int> path;  // per query sample at the space rate, when requested
+  std::optional<SearchExplanation> explanation;  // when requested
 };
 
 struct SearchOutcome {

@@ -2,6 +2,11 @@
 // port. Every JSON route's answer is parsed into the gRPC response message and compared with
 // the same server's gRPC answer; then errors, the token, TLS, the web UI's files, health and
 // the Prometheus metrics (checked by promtool when it is installed).
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -230,6 +235,32 @@ Message Parse(const std::string& text) {
   Message message;
   EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &message)) << text;
   return message;
+}
+
+// Sends `request` (headers and as much body as given) on a connection of its own and returns
+// the status line of the answer, read without sending more: a server that waited for the rest
+// of the body would answer only once its read timed out, with another status.
+std::string RawStatusLine(int port, const std::string& request) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval timeout{60, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  std::string answer;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0 &&
+      ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) ==
+          static_cast<ssize_t>(request.size())) {
+    char buffer[4096];
+    while (answer.find("\r\n") == std::string::npos) {
+      const ssize_t n = ::recv(fd, buffer, sizeof(buffer), 0);
+      if (n <= 0) break;
+      answer.append(buffer, static_cast<size_t>(n));
+    }
+  }
+  ::close(fd);
+  return answer.substr(0, answer.find("\r\n"));
 }
 
 TEST_F(HttpTest, ReadRoutesAnswerAsGrpc) {
@@ -486,10 +517,70 @@ TEST_F(HttpTest, ErrorsAreMappedAsGrpcGatewayMapsThemWithCodeAndMessage) {
       absl::StrCat(R"({"file_name":"take_0.bvh","on_conflict":"ON_CONFLICT_ERROR","bvh":")",
                    absl::Base64Escape(HumanoidBvh(1)), R"("})");
   expect_error(http.Post("/v1/clips", again, "application/json"), 409, 6, "take_0");
+  // A query parameter naming a field the path gives, by any of its names, is refused and
+  // changes nothing.
+  const std::string clip = absl::StrCat("/v1/clips/", ids_[3]);
+  for (const std::string& query :
+       {"clip_id=" + absl::StrCat(ids_[0]), std::string("id=77"), std::string("clipId=77")}) {
+    expect_error(http.Delete((clip + "?" + query).c_str()), 400, 3, "the path gives clip_id");
+  }
+  expect_error(http.Get((clip + "/bvh?clip.clipId=77").c_str()), 400, 3,
+               "the path gives clip.clip_id");
+  expect_error(http.Get("/v1/spaces/body/curve?space=other"), 400, 3, "the path gives space");
+  EXPECT_EQ(http.Get(clip.c_str())->status, 200);
+  EXPECT_EQ(http.Get(absl::StrCat("/v1/clips/", ids_[0]).c_str())->status, 200);
   // No such route, or not with that method.
   expect_error(http.Get("/v1/nothing"), 404, 5, "GET /v1/nothing");
-  expect_error(http.Put("/v1/clips", "{}", "application/json"), 404, 5, "PUT /v1/clips");
+  expect_error(http.Put("/v1/clips", "", "application/json"), 404, 5, "PUT /v1/clips");
   expect_error(http.Get("/v1/jobs/job-1:cancel"), 404, 5, "");
+}
+
+// httplib 0.11 reads a chunked body whole, inflates a compressed one whole and reads a POST
+// without a length until the connection ends, all before any handler; such bodies, and bodies
+// where none is taken, are refused from their headers alone. The server then serves on.
+TEST_F(HttpTest, BodiesAreRefusedFromTheirHeadersBeforeTheyAreRead) {
+  ServerProcess* server =
+      Start({"--auth-token-file", (dir_ / "token").string(), "--max-message-mb", "1"});
+  ASSERT_NE(server, nullptr);
+  const int port = server->http_port();
+  const std::string token = absl::StrCat("Authorization: Bearer ", kToken, "\r\n");
+  const auto post = [](const std::string& path, const std::string& headers) {
+    return absl::StrCat("POST ", path, " HTTP/1.1\r\nHost: test\r\n", headers, "\r\n");
+  };
+  // The first MiB of a chunked body that never ends.
+  EXPECT_EQ(RawStatusLine(port, post("/v1/search", token + "Transfer-Encoding: chunked\r\n") +
+                                    "100000\r\n" + std::string(1 << 20, '{') + "\r\n"),
+            "HTTP/1.1 411 Length Required");
+  // A length far beyond --max-message-mb, its body not sent.
+  EXPECT_EQ(RawStatusLine(port, post("/v1/search", token + "Content-Length: 100000000\r\n")),
+            "HTTP/1.1 413 Payload Too Large");
+  // A POST without a length, to a route that takes a body or to one that does not.
+  EXPECT_EQ(RawStatusLine(port, post("/v1/jobs/job-1:cancel", token)),
+            "HTTP/1.1 411 Length Required");
+  EXPECT_EQ(RawStatusLine(port, post("/x", "")), "HTTP/1.1 411 Length Required");
+  // A body on a route without one (its token is right) or on a file's path.
+  EXPECT_EQ(RawStatusLine(port, absl::StrCat("GET /v1/clips HTTP/1.1\r\nHost: test\r\n", token,
+                                             "Content-Length: 2\r\n\r\n{}")),
+            "HTTP/1.1 413 Payload Too Large");
+  EXPECT_EQ(RawStatusLine(port, post("/index.html", "Content-Length: 2\r\n") + "{}"),
+            "HTTP/1.1 413 Payload Too Large");
+
+  // A gzip body (16 MiB inflated) without a token, through httplib's own client.
+  httplib::Client anonymous = HttpClient(*server);
+  anonymous.set_compress(true);
+  const httplib::Result gzip = anonymous.Post("/x", std::string(16 << 20, ' '), "application/json");
+  ASSERT_TRUE(gzip) << httplib::to_string(gzip.error());
+  const ErrorAnswer error = ErrorOf(gzip);
+  EXPECT_EQ(error.status, 415);
+  EXPECT_THAT(error.message, HasSubstr("uncompressed"));
+
+  // It serves on, a body where one belongs too.
+  httplib::Client right = HttpClient(*server, kToken);
+  EXPECT_EQ(right.Get("/healthz")->status, 200);
+  const httplib::Result search = right.Post("/v1/search", "{}", "application/json");
+  ASSERT_TRUE(search);
+  EXPECT_THAT(ErrorOf(search).message, HasSubstr("space"));
+  EXPECT_EQ(right.Post("/v1/jobs/job-1:cancel", "", "application/json")->status, 404);
 }
 
 TEST_F(HttpTest, TheTokenGuardsTheApiAndMetricsNotHealthOrFiles) {

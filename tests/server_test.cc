@@ -829,6 +829,34 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   for (const v1::SearchResult& r : poses.results()) EXPECT_EQ(r.start_frame(), r.end_frame());
   EXPECT_EQ(poses.counts().warps(), 0);
 
+  // explain: each result says which joints its distance lies in and how fast it plays; the
+  // path it needs is returned only when asked for.
+  v1::SearchRequest explained_query = query;
+  explained_query.set_return_path(false);
+  explained_query.set_explain(true);
+  v1::SearchResponse explained;
+  status = client.Search(explained_query, &explained);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(explained.results_size(), found.results_size());
+  for (const v1::SearchResult& r : explained.results()) {
+    EXPECT_EQ(r.path_size(), 0);
+    ASSERT_TRUE(r.has_explanation());
+    const v1::SearchExplanation& why = r.explanation();
+    EXPECT_EQ(why.joints_size(), 21 + 2);  // every joint, the yaw rate, the root velocity
+    double shares = 0, parts = 0;
+    for (const v1::JointShare& joint : why.joints()) {
+      shares += joint.share();
+      parts += joint.score();
+    }
+    // The query's own range differs in nothing: nothing to share out.
+    EXPECT_NEAR(shares, why.full_score() > 0 ? 1.0 : 0.0, 1e-9);
+    EXPECT_NEAR(parts, why.full_score(), 1e-9);
+    EXPECT_GE(why.full_score(), r.score() * (1 - 1e-4));  // the score counts 5 dimensions
+    EXPECT_GT(why.mean_speed(), 0);
+    EXPECT_GE(why.max_speed(), why.mean_speed() * (1 - 1e-9));
+  }
+  EXPECT_NEAR(explained.results(0).explanation().mean_speed(), 1.0, 0.05);  // itself
+
   // The same range uploaded as BVH gives the same results.
   v1::SearchRequest uploaded = query;
   uploaded.mutable_bvh()->set_bvh(BvhText(Humanoid().clips[raise.clip]));

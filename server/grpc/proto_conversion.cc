@@ -205,6 +205,7 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
   }
   out.exact = request.exact();
   out.exclude_query = Optional(request.has_exclude_query(), request.exclude_query());
+  out.explain = request.explain();
   return out;
 }
 
@@ -219,6 +220,7 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
        "search.clip_ids: a propagation searches every clip of the space (filter by tags)"},
       {search.tags_size() > 0, "search.tags: give the tags as tags"},
       {search.return_path(), "search.return_path: a propagation keeps no paths"},
+      {search.explain(), "search.explain: a propagation keeps no explanations"},
       {search.has_exclude_query(), "search.exclude_query: a query's own range is always excluded"},
       {search.has_characteristic_frame(), "search.characteristic_frame: each query finds its own"}};
   for (const auto& [set, message] : refused) {
@@ -369,6 +371,18 @@ void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response) {
   response->set_last_frame(exported.frames.last);
 }
 
+void ToProto(const SearchExplanation& explanation, v1::SearchExplanation* out) {
+  for (const JointShare& joint : explanation.joints) {
+    v1::JointShare* share = out->add_joints();
+    share->set_name(joint.name);
+    share->set_share(joint.share);
+    share->set_score(joint.score);
+  }
+  out->set_full_score(explanation.full_score);
+  out->set_mean_speed(explanation.mean_speed);
+  out->set_max_speed(explanation.max_speed);
+}
+
 void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
   for (const SearchHit& hit : outcome.hits) {
     v1::SearchResult* out = response->add_results();
@@ -381,6 +395,7 @@ void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
     out->set_score(hit.score);
     out->set_seed_frame(hit.seed_frame);
     for (const int frame : hit.path) out->add_path(frame);
+    if (hit.explanation) ToProto(*hit.explanation, out->mutable_explanation());
   }
   response->set_characteristic_frame(outcome.characteristic_frame);
   const SearchStats& stats = outcome.stats;

@@ -55,6 +55,7 @@ void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton);
 void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
 void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response);
+void ToProto(const SearchExplanation& explanation, v1::SearchExplanation* out);
 void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response);
 void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out);
 // The space's record, stored report and resident index.

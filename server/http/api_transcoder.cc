@@ -1,6 +1,7 @@
 #include "server/http/api_transcoder.h"
 
 #include <future>
+#include <set>
 
 #include <grpcpp/client_context.h>
 
@@ -94,11 +95,21 @@ absl::Status ApiTranscoder::FillRequest(const ApiRoute& route, const HttpCall& c
     return name;
   };
   const std::vector<std::string> names = route.PathNames();
-  for (size_t i = 0; i < names.size() && i < call.path_values.size(); ++i) {
-    MOTIONDB_RETURN_IF_ERROR(SetField(field_of(names[i]), call.path_values[i], request));
+  // A query parameter may not name a field the path gives (DELETE /v1/clips/3?clip_id=77).
+  std::set<std::string> from_path;
+  for (const std::string& name : names) {
+    from_path.insert(FieldName(field_of(name), *request->GetDescriptor()));
   }
   for (const auto& [name, value] : call.query) {
+    const std::string field = FieldName(field_of(name), *request->GetDescriptor());
+    if (from_path.count(field) > 0) {
+      return absl::InvalidArgumentError(absl::StrCat("parameter '", name, "': the path gives ",
+                                                     field, "; it cannot be a query parameter"));
+    }
     MOTIONDB_RETURN_IF_ERROR(SetField(field_of(name), value, request));
+  }
+  for (size_t i = 0; i < names.size() && i < call.path_values.size(); ++i) {
+    MOTIONDB_RETURN_IF_ERROR(SetField(field_of(names[i]), call.path_values[i], request));
   }
   return absl::OkStatus();
 }

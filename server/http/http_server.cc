@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <future>
+#include <optional>
+#include <regex>
 #include <thread>
 
 #include <httplib.h>
@@ -94,6 +97,56 @@ bool Authorized(const ServerOptions& options, const httplib::Request& request) {
   return authorized;
 }
 
+// The routes that take a request body, as regular expressions of their paths.
+std::vector<std::regex> BodyRoutes() {
+  std::vector<std::regex> paths;
+  for (const ApiRoute& route : ApiRoutes()) {
+    if (route.json_body) paths.emplace_back(route.PathRegex());
+  }
+  return paths;
+}
+
+struct Refusal {
+  int status = 0;
+  std::string message;
+};
+
+// A request whose body is refused before it is read: httplib 0.11 checks its payload limit only
+// against Content-Length, reads a chunked body and inflates a compressed one whole before any
+// handler runs, and reads a POST without a length until the connection ends. So a body comes
+// uncompressed with its Content-Length, within `max_body`, and only to a POST route that takes
+// one.
+std::optional<Refusal> RefuseBody(const httplib::Request& request, size_t max_body,
+                                  const std::vector<std::regex>& body_routes) {
+  if (request.has_header("Transfer-Encoding")) {
+    return Refusal{411, "send the request body with a Content-Length, not a Transfer-Encoding"};
+  }
+  if (request.has_header("Content-Encoding")) {
+    return Refusal{415, "send the request body uncompressed, without a Content-Encoding"};
+  }
+  const bool takes_body =
+      request.method == "POST" &&
+      std::any_of(body_routes.begin(), body_routes.end(), [&request](const std::regex& path) {
+        return std::regex_match(request.path, path);
+      });
+  size_t length = 0;
+  if (!request.has_header("Content-Length")) {
+    if (request.method != "POST") return std::nullopt;
+    return Refusal{411, "a POST needs a Content-Length (curl: -d '' for an empty body)"};
+  }
+  if (!absl::SimpleAtoi(request.get_header_value("Content-Length"), &length)) {
+    return Refusal{400, "the Content-Length is not a number"};
+  }
+  if (length > 0 && !takes_body) {
+    return Refusal{413, absl::StrCat(request.method, " ", request.path, " takes no request body")};
+  }
+  if (length > max_body) {
+    return Refusal{413, absl::StrCat("the request body is larger than the ", max_body,
+                                     " bytes the server takes (--max-message-mb, base64-encoded)")};
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::string DefaultWebRoot() { return MOTIONDB_WEB_DIST; }
@@ -105,14 +158,11 @@ struct HttpServer::State {
   std::unique_ptr<ApiTranscoder> api;
   std::unique_ptr<httplib::Server> http;
   std::thread listener;
-  int port = 0;
 };
 
 HttpServer::HttpServer(std::unique_ptr<State> state) : state_(std::move(state)) {}
 
 HttpServer::~HttpServer() { Stop(); }
-
-int HttpServer::port() const { return state_->port; }
 
 void HttpServer::Stop() {
   if (state_->http) state_->http->stop();
@@ -121,12 +171,21 @@ void HttpServer::Stop() {
 
 namespace {
 
-// The token check, the metrics' bookkeeping and JSON bodies for the library's own errors.
-void AddHooks(MotionDbServer& server, httplib::Server& http) {
-  http.set_pre_routing_handler([&server](const httplib::Request& request,
-                                         httplib::Response& response) {
+// The body and token checks, the metrics' bookkeeping and JSON bodies for the library's own
+// errors. The pre-routing handler runs once the headers are read, before httplib reads a body.
+void AddHooks(MotionDbServer& server, size_t max_body, httplib::Server& http) {
+  http.set_pre_routing_handler([&server, max_body, body_routes = BodyRoutes()](
+                                   const httplib::Request& request, httplib::Response& response) {
     // Until a route's handler names itself.
     exchange = {std::chrono::steady_clock::now(), IsApiPath(request.path) ? "unmatched" : "static"};
+    if (const std::optional<Refusal> refusal = RefuseBody(request, max_body, body_routes)) {
+      exchange.route = "refused";
+      response.status = refusal->status;
+      // The body is left unread, so the connection cannot carry another request.
+      response.set_header("Connection", "close");
+      response.set_content(ErrorJson(CodeOfHttpStatus(refusal->status), refusal->message), kJson);
+      return httplib::Server::HandlerResponse::Handled;
+    }
     if (!NeedsToken(server.options(), request.path) || Authorized(server.options(), request)) {
       return httplib::Server::HandlerResponse::Unhandled;
     }
@@ -145,13 +204,13 @@ void AddHooks(MotionDbServer& server, httplib::Server& http) {
         const std::string message =
             response.status == 404
                 ? absl::StrCat("no route or file for ", request.method, " ", request.path)
-            : response.status == 413 ? "the request body is larger than the server takes "
-                                       "(--max-message-mb, once base64-decoded)"
-                                     : absl::StrCat("HTTP status ", response.status);
+                : absl::StrCat("HTTP status ", response.status);
         response.set_content(ErrorJson(CodeOfHttpStatus(response.status), message), kJson);
         return httplib::Server::HandlerResponse::Handled;
       }));
-  http.set_logger([&server](const httplib::Request&, const httplib::Response& response) {
+  // Counted before the answer is written (httplib's logger runs after), so that a scrape sent
+  // once an answer arrived counts it.
+  http.set_post_routing_handler([&server](const httplib::Request&, httplib::Response& response) {
     const double seconds =
         exchange.start == std::chrono::steady_clock::time_point{}
             ? 0.0
@@ -258,32 +317,37 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
   http.set_tcp_nodelay(true);
   http.set_keep_alive_max_count(kKeepAliveRequests);
   // A JSON body carries a BVH file in base64: 4/3 of the largest message, and room for the rest.
-  http.set_payload_max_length((size_t{static_cast<size_t>(server.options().max_message_mb)} << 20) /
-                                  3 * 4 +
-                              (size_t{1} << 20));
-  AddHooks(server, http);
+  const size_t max_body =
+      (static_cast<size_t>(server.options().max_message_mb) << 20) / 3 * 4 + (size_t{1} << 20);
+  http.set_payload_max_length(max_body);
+  AddHooks(server, max_body, http);
   AddApiRoutes(*state->api, http);
   AddOperationsRoutes(*state->api, server, http);
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
   AddWebRoot(web_root, http);
 
   const auto& [host, port] = host_port;
-  state->port =
+  const int bound =
       port == 0 ? http.bind_to_any_port(host) : (http.bind_to_port(host, port) ? port : -1);
-  if (state->port <= 0) {
+  if (bound <= 0) {
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen,
                                                " for HTTP (address in use or not local)"));
   }
-  state->listener = std::thread([&http] { http.listen_after_bind(); });
-  // stop() does nothing until the loop runs; wait for it, so that Stop() always ends it.
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  std::promise<void> listened;
+  std::future<void> ended = listened.get_future();
+  state->listener = std::thread([&http, listened = std::move(listened)]() mutable {
+    http.listen_after_bind();
+    listened.set_value();
+  });
+  // stop() does nothing until the loop runs; wait for it, so that Stop() always ends it. A
+  // loop that ended by itself (its socket failed) is joined: no thread outlives the error.
   while (!http.is_running()) {
-    if (std::chrono::steady_clock::now() > give_up) {
+    if (ended.wait_for(std::chrono::milliseconds(1)) == std::future_status::ready) {
+      state->listener.join();
       return absl::UnavailableError(absl::StrCat("HTTP on ", options.listen, " did not start"));
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  LogLine(absl::StrCat("HTTP on ", options.listen, " (http port ", state->port, ")",
+  LogLine(absl::StrCat("HTTP on ", options.listen, " (http port ", bound, ")",
                        server.options().tls_cert_pem.empty() ? ", plain text" : ", HTTPS",
                        "; web UI from ", web_root,
                        std::filesystem::is_directory(web_root) ? "" : " (not built)"));

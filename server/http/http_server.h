@@ -19,8 +19,7 @@
 namespace motiondb::server {
 
 struct HttpOptions {
-  // host:port to serve HTTP on (--http); "off": no HTTP face. Port 0 picks a free one,
-  // reported by HttpServer::port() and logged.
+  // host:port to serve HTTP on (--http); "off": no HTTP face. Port 0 picks a free one, logged.
   std::string listen = "127.0.0.1:8080";
   // The built web UI served at / (--web-root); empty: DefaultWebRoot().
   std::string web_root;
@@ -38,7 +37,6 @@ class HttpServer {
                                                            MotionDbServer& server);
   ~HttpServer();  // Stop()
 
-  int port() const;
   // Stops listening, lets requests in progress finish, and returns (idempotent).
   void Stop();
 

@@ -15,8 +15,7 @@ namespace {
 using google::protobuf::FieldDescriptor;
 using google::protobuf::Message;
 
-const FieldDescriptor* FindField(const Message& message, absl::string_view name) {
-  const google::protobuf::Descriptor& type = *message.GetDescriptor();
+const FieldDescriptor* FindField(const google::protobuf::Descriptor& type, absl::string_view name) {
   if (const FieldDescriptor* field = type.FindFieldByName(std::string(name))) return field;
   if (const FieldDescriptor* field = type.FindFieldByCamelcaseName(std::string(name))) {
     return field;
@@ -121,7 +120,7 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
   const std::vector<absl::string_view> names = absl::StrSplit(path, '.');
   Message* owner = message;
   for (size_t i = 0; i < names.size(); ++i) {
-    const FieldDescriptor* field = FindField(*owner, names[i]);
+    const FieldDescriptor* field = FindField(*owner->GetDescriptor(), names[i]);
     if (field == nullptr) {
       return absl::InvalidArgumentError(absl::StrCat("parameter '", path,
                                                      "': ", owner->GetDescriptor()->full_name(),
@@ -148,6 +147,18 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
     }
   }
   return absl::OkStatus();
+}
+
+std::string FieldName(absl::string_view path, const google::protobuf::Descriptor& type) {
+  std::string name;
+  const google::protobuf::Descriptor* owner = &type;
+  for (const absl::string_view part : absl::StrSplit(path, '.')) {
+    const FieldDescriptor* field = owner == nullptr ? nullptr : FindField(*owner, part);
+    if (field == nullptr) return "";
+    absl::StrAppend(&name, name.empty() ? "" : ".", field->name());
+    owner = field->message_type();
+  }
+  return name;
 }
 
 std::string ToJson(const Message& message) {

@@ -27,6 +27,10 @@ absl::Status MergeJson(absl::string_view json, google::protobuf::Message* messag
 absl::Status SetField(absl::string_view path, absl::string_view text,
                       google::protobuf::Message* message);
 
+// The field `path` names (as SetField takes it) by its fields' .proto names ("clip.clipId" ->
+// "clip.clip_id"); "" when it names none.
+std::string FieldName(absl::string_view path, const google::protobuf::Descriptor& type);
+
 // `message` as proto3 JSON, every field present (zero values too, so that clients need no
 // defaults of their own).
 std::string ToJson(const google::protobuf::Message& message);

@@ -3,7 +3,7 @@
 // library. Run by run_browser_tests.sh (ctest Web.BrowserTests), which says how it is invoked.
 // Screenshots go to $MOTIONDB_WEB_TEST_OUT.
 import assert from "node:assert/strict";
-import { mkdirSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { after, before, test } from "node:test";
@@ -254,6 +254,54 @@ test("a selected range is labelled and the label propagated", async () => {
   assert.match(await page.textContent("[data-testid=job-state]"), /job-\d+ succeeded 1\/1/);
   await page.screenshot({ path: join(OUT, "labels.png") });
   await page.close();
+});
+
+test("a server with a token asks for it once, however many calls it refused", async () => {
+  const tokenFile = join(work, "token");
+  writeFileSync(tokenFile, "web-token\n");
+  const guarded = await ServerProcess.start(SERVER, ["--auth-token-file", tokenFile]);
+  // A browser of its own: the refused calls log console errors, which the last test forbids.
+  const own = await Browser.launch();
+  try {
+    const upload = await fetch(`${guarded.baseUrl}/v1/clips`, {
+      method: "POST",
+      headers: { "Content-Type": "application/json", Authorization: "Bearer web-token" },
+      body: JSON.stringify({
+        file_name: "Boxing_Toes.bvh",
+        bvh: readFileSync(join(ASSIMP_BVH, "Boxing_Toes.bvh")).toString("base64"),
+      }),
+    });
+    assert.equal(upload.status, 200, await upload.text());
+    const page = await own.page();
+    // Every prompt the page opens, counted as it opens.
+    await page.addInitScript(() => {
+      window.tokenPrompts = 0;
+      const showModal = HTMLDialogElement.prototype.showModal;
+      HTMLDialogElement.prototype.showModal = function () {
+        window.tokenPrompts++;
+        return showModal.call(this);
+      };
+    });
+    let refused = 0;
+    const allRefused = new Promise((resolve) =>
+      page.on("response", (response) => {
+        if (response.status() === 401 && ++refused === 3) resolve();
+      }),
+    );
+    await page.goto(guarded.baseUrl + "/");
+    // The page's first three calls (spaces, skeletons, clips) are refused before it answers.
+    await allRefused;
+    await page.fill("[data-testid=token]", "web-token", WAIT);
+    await page.click(".token-dialog button[value=ok]");
+    await page.waitForSelector("body[data-ready=true]", WAIT);
+    await expectListed(page, ["Boxing_Toes"]);
+    assert.equal(await page.evaluate(() => window.tokenPrompts), 1);
+    assert.equal(await page.locator("dialog").count(), 0);
+    await page.close();
+  } finally {
+    await own.close();
+    await guarded.stop();
+  }
 });
 
 test("no page logged an error", () => {

@@ -1,6 +1,6 @@
 // The one place the page talks HTTP: JSON in and out, the bearer token, and errors as ApiError
 // carrying the server's {code, message}. On a 401 the page asks for the token once (kept in
-// sessionStorage for the tab) and repeats the call.
+// sessionStorage for the tab), however many calls were refused together, and repeats them.
 
 const TOKEN_KEY = "motiondb.token";
 
@@ -22,10 +22,27 @@ export function setTokenPrompt(prompt: () => Promise<string | null>): void {
   askToken = prompt;
 }
 
-function headers(hasBody: boolean): Headers {
+/** The prompt open now, which every call refused meanwhile waits for. */
+let pendingPrompt: Promise<boolean> | null = null;
+
+/** After a 401 to a call sent with `sent`: whether there is another token to try. */
+function newToken(sent: string | null): Promise<boolean> {
+  // Another call's prompt got one since this call was sent.
+  if (sessionStorage.getItem(TOKEN_KEY) !== sent) return Promise.resolve(true);
+  pendingPrompt ??= askToken()
+    .then((token) => {
+      if (token) sessionStorage.setItem(TOKEN_KEY, token.trim());
+      return Boolean(token);
+    })
+    .finally(() => {
+      pendingPrompt = null;
+    });
+  return pendingPrompt;
+}
+
+function headers(hasBody: boolean, token: string | null): Headers {
   const result = new Headers({ Accept: "application/json" });
   if (hasBody) result.set("Content-Type", "application/json");
-  const token = sessionStorage.getItem(TOKEN_KEY);
   if (token) result.set("Authorization", `Bearer ${token}`);
   return result;
 }
@@ -52,15 +69,14 @@ export async function call<T>(
   }
   const body = options.body === undefined ? undefined : JSON.stringify(options.body);
   for (let attempt = 0; ; attempt++) {
-    const response = await fetch(url, { method, headers: headers(body !== undefined), body });
+    const token = sessionStorage.getItem(TOKEN_KEY);
+    const response = await fetch(url, {
+      method,
+      headers: headers(body !== undefined, token),
+      body,
+    });
     if (response.ok) return (await response.json()) as T;
-    if (response.status === 401 && attempt === 0) {
-      const token = await askToken();
-      if (token) {
-        sessionStorage.setItem(TOKEN_KEY, token.trim());
-        continue;
-      }
-    }
+    if (response.status === 401 && attempt === 0 && (await newToken(token))) continue;
     throw await errorOf(response);
   }
 }
