@@ -201,7 +201,7 @@ void AddPropagate(Commands& commands) {
                    "a descriptor to propagate (repeat; default: every manual one)")
       ->type_name("D")
       ->allow_extra_args(false);
-  propagate->add_option("--max-results", flags->max_results, "results per label (default 20)")
+  propagate->add_option("--max-results", flags->max_results, "results per label (default 100)")
       ->type_name("N")
       ->check(WholeAtLeast(1));
   propagate->add_option("--tag", flags->tags, "only search clips tagged T (repeat: any of them)")

@@ -647,6 +647,8 @@ TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
   const nlohmann::json jobs = nlohmann::json::parse(r.out)["jobs"];
   ASSERT_EQ(jobs.size(), 2u);
   EXPECT_EQ(jobs[1]["job_id"], id);
+  // Unset, a job's max_results is propagation's 100, not a search's 20.
+  EXPECT_EQ(jobs[0]["parameters"]["max_results"], 100);
   r = Remote({"jobs"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("JOB"));

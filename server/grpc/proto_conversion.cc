@@ -231,6 +231,7 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
   out.descriptors.assign(request.descriptor_names().begin(), request.descriptor_names().end());
   MOTIONDB_ASSIGN_OR_RETURN(out.search, Prefixed("search", FromProto(search)));
   out.search.params.tags.assign(request.tags().begin(), request.tags().end());
+  if (!search.has_max_results()) out.search.params.max_results = kPropagationMaxResults;
   return out;
 }
 
