@@ -23,7 +23,14 @@ fi
 "$root/scripts/install-deps.sh" --start
 build="${BUILD_DIR:-$root/build}"
 BUILD_DIR="$build" "$root/scripts/build.sh" motiondb-server motiondb
-"$root/scripts/build-web.sh"
+# The page is the one part that needs the npm registry: without it the server still starts,
+# with gRPC and the JSON API, and says how to build the page.
+page=1
+if ! "$root/scripts/build-web.sh"; then
+  page=0
+  echo "start.sh: the web page was not built (see above); starting without it." \
+    "scripts/build-web.sh builds it once the npm registry is reachable." >&2
+fi
 server="$build/server/motiondb-server"
 cli="$build/client/motiondb"
 # The CLI talks to wherever the server was told to listen, and the page is where it serves HTTP
@@ -69,6 +76,9 @@ if ((demo)); then
   echo "Try: $cli search --space demo --clip 1 --server $address"
 fi
 echo
-[[ "$http" == "off" ]] || echo "open $scheme://${http/#0.0.0.0:/127.0.0.1:} (web asset browser and JSON API)"
+if [[ "$http" != "off" ]]; then
+  url="$scheme://${http/#0.0.0.0:/127.0.0.1:}"
+  if ((page)); then echo "open $url (web asset browser and JSON API)"; else echo "JSON API: $url"; fi
+fi
 echo "motiondb-server is running (pid $pid). Use $cli help; Ctrl-C stops the server."
 wait "$pid"
