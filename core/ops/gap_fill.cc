@@ -1,5 +1,7 @@
 #include "core/ops/gap_fill.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
 #include "core/ops/wavelet_smoothing.h"
@@ -20,7 +22,28 @@ absl::StatusOr<Eigen::RowVectorXd> EndVelocity(const Eigen::Ref<const RowMatrixX
               : Eigen::RowVectorXd(smooth.row(1) - smooth.row(0));
 }
 
+// The angular velocity of one joint from frame f to f + 1, per frame.
+Eigen::Vector3d Step(const Eigen::Ref<const RowMatrixXd>& rotations, Eigen::Index f,
+                     Eigen::Index j) {
+  const auto a = rotations.block<1, 4>(f, 4 * j);
+  const auto b = rotations.block<1, 4>(f + 1, 4 * j);
+  return LogMap(Quat(a[0], a[1], a[2], a[3]).conjugate() * Quat(b[0], b[1], b[2], b[3]));
+}
+
 }  // namespace
+
+AngleError VelocityJump(const Eigen::Ref<const RowMatrixXd>& rotations, int seam, double rate) {
+  AngleError jump;
+  const Eigen::Index joints = rotations.cols() / 4;
+  if (seam < 1 || seam + 1 >= rotations.rows() || joints == 0) return jump;
+  for (Eigen::Index j = 0; j < joints; ++j) {
+    const double change = (Step(rotations, seam, j) - Step(rotations, seam - 1, j)).norm() * rate;
+    jump.mean_rad += change;
+    jump.max_rad = std::max(jump.max_rad, change);
+  }
+  jump.mean_rad /= static_cast<double>(joints);
+  return jump;
+}
 
 RowMatrixXd HermiteCurve(const Eigen::Ref<const Eigen::RowVectorXd>& p0,
                          const Eigen::Ref<const Eigen::RowVectorXd>& p1,

@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/motion/matrix.h"
+#include "core/ops/reconstruction.h"
 
 namespace motiondb {
 
@@ -46,6 +47,12 @@ RowMatrixXd HermiteCurve(const Eigen::Ref<const Eigen::RowVectorXd>& p0,
 absl::StatusOr<RowMatrixXd> FillGap(const Eigen::Ref<const RowMatrixXd>& before,
                                     const Eigen::Ref<const RowMatrixXd>& after,
                                     const GapFillOptions& options = {});
+
+// The jump in joint angular velocity at frame `seam` of pose rotations (frames x 4 * joints)
+// sampled at `rate`: per joint, |w(seam -> seam + 1) - w(seam - 1 -> seam)| in rad/s, w being
+// the rotation vector of q_a^-1 q_b times the rate; mean and max over the joints. Zero when the
+// seam lacks a frame on either side. How abruptly a transition starts or ends (4.3).
+AngleError VelocityJump(const Eigen::Ref<const RowMatrixXd>& rotations, int seam, double rate);
 
 }  // namespace motiondb
 
