@@ -217,10 +217,15 @@ absl::Status Blend(const BlendFlags& flags, bool json, const ServerConnection& c
     weights.push_back(std::vector<double>(frame.weights().begin(), frame.weights().end()));
   }
   return ReportResult(response.result(), flags.output, json, {{"weights", weights}}, [&] {
-    for (int k = 0; k < response.frames_size(); ++k) {
+    constexpr int kShown = 10;  // --json has them all
+    for (int k = 0; k < response.frames_size() && k < kShown; ++k) {
       std::string row;
       for (const double w : response.frames(k).weights()) absl::StrAppendFormat(&row, " %.3f", w);
       absl::PrintF("  frame %d weights:%s\n", k, row);
+    }
+    if (response.frames_size() > kShown) {
+      absl::PrintF("  ... %d frames more (--json lists every frame's)\n",
+                   response.frames_size() - kShown);
     }
   });
 }
