@@ -190,8 +190,9 @@ void AddFit(Commands& commands, CLI::App* detect) {
       ->capture_default_str();
   fit->add_option("--dims", flags->dims, "the truncation (default 3)")->type_name("N");
   fit->add_option("--seed", flags->seed, "seeds the fit (default 1)")->type_name("N");
-  fit->add_option("--quantile", flags->quantile,
-                  "the default threshold: this quantile of the examples' scores (default 0.05)")
+  fit->add_option(
+         "--quantile", flags->quantile,
+         "the default threshold: this quantile of the examples' held-out scores (default 0)")
       ->type_name("Q");
   fit->add_option("--iterations", flags->max_iterations, "EM iterations at most (default 200)")
       ->type_name("N");

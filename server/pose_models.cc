@@ -36,22 +36,22 @@ absl::StatusOr<StoredPoseModel> CreatePoseModel(const EditContext& context,
                             FindSpace(context.registry, request.space));
   if (request.examples.empty()) return absl::InvalidArgumentError("examples: no poses given");
   std::vector<RowMatrixXd> parts;
-  Eigen::Index rows = 0;
+  std::vector<int> groups;  // each example range is a group for the threshold
   for (size_t i = 0; i < request.examples.size(); ++i) {
     MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
                               LoadSource(context.database, *snapshot, request.examples[i],
                                          absl::StrCat("examples[", i, "]")));
-    rows += source.motion.coordinates.rows();
+    groups.insert(groups.end(), source.motion.coordinates.rows(), static_cast<int>(i));
     parts.push_back(source.motion.coordinates);
   }
-  RowMatrixXd examples(rows, snapshot->space->dims());
-  rows = 0;
+  RowMatrixXd examples(groups.size(), snapshot->space->dims());
+  Eigen::Index row = 0;
   for (const RowMatrixXd& part : parts) {
-    examples.middleRows(rows, part.rows()) = part;
-    rows += part.rows();
+    examples.middleRows(row, part.rows()) = part;
+    row += part.rows();
   }
   StoredPoseModel stored;
-  MOTIONDB_ASSIGN_OR_RETURN(stored.model, FitPoseModel(examples, request.options));
+  MOTIONDB_ASSIGN_OR_RETURN(stored.model, FitPoseModel(examples, request.options, groups));
   stored.record.name = request.name;
   stored.record.space_id = snapshot->record.space_id;
   stored.record.space_name = snapshot->record.name;

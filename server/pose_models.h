@@ -20,7 +20,9 @@ namespace motiondb::server {
 struct PoseModelRequest {
   std::string name;  // unique among pose models; printable, 1 to 128 bytes
   std::string space;
-  std::vector<ClipSelection> examples{};  // every frame of each (at the space rate) is a pose
+  // Every frame of each (at the space rate) is a pose; each range is a group of FitPoseModel's
+  // threshold.
+  std::vector<ClipSelection> examples{};
   PoseModelOptions options{};
   std::string parameters_json{};  // stored with the model: how it was fitted
 };

@@ -14,21 +14,28 @@ std::string ContentLabel(const std::filesystem::path& path) {
   return parts.size() >= 2 ? parts[1] : path.stem().string();
 }
 
-absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
-                                                const SpaceOptions& space_options,
-                                                const LibraryIndexOptions& index_options) {
+absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
+                                                             std::vector<std::string>* labels) {
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (entry.path().extension() == ".bvh") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
-  LabelledIndex library;
   std::vector<TrainingClip> clips;
   for (const std::filesystem::path& path : files) {
     MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
     clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
-    library.labels.push_back(ContentLabel(path));
+    labels->push_back(ContentLabel(path));
   }
+  return clips;
+}
+
+absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
+                                                const SpaceOptions& space_options,
+                                                const LibraryIndexOptions& index_options) {
+  LabelledIndex library;
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<TrainingClip> clips,
+                            ReadLabelledFolder(folder, &library.labels));
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, MotionSpace::Build(clips, space_options));
   library.space = std::make_unique<MotionSpace>(std::move(space));
   std::vector<LibraryClip> projected;

@@ -24,6 +24,11 @@ struct LabelledIndex {
 // "dataset-2_raise-up-left-hand_normal_003.bvh" -> "raise-up-left-hand".
 std::string ContentLabel(const std::filesystem::path& path);
 
+// Every *.bvh of `folder`, in name order, as whole training clips named by their file names;
+// `labels` gets each one's ContentLabel.
+absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
+                                                             std::vector<std::string>* labels);
+
 absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::filesystem::path& folder,
                                                 const SpaceOptions& space_options,
                                                 const LibraryIndexOptions& index_options);

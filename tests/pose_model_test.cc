@@ -111,6 +111,32 @@ TEST(PoseModelTest, RoundTripsThroughItsStoredForm) {
   EXPECT_FALSE(ParsePoseModel(broken).ok());
 }
 
+TEST(PoseModelTest, GroupsSetTheThresholdByModelsThatDidNotSeeThem) {
+  // Two groups of one pose a little apart: each scored by a model of the other is less likely
+  // than under the model of both, so the threshold admits a new instance that far off.
+  std::mt19937_64 generator(3);
+  std::normal_distribution<double> normal(0.0, 0.05);
+  RowMatrixXd examples(100, 3);
+  std::vector<int> groups;
+  for (int n = 0; n < 100; ++n) {
+    const double shift = n < 50 ? 0.0 : 0.3;
+    examples.row(n) << shift + normal(generator), normal(generator), normal(generator);
+    groups.push_back(n < 50 ? 0 : 1);
+  }
+  const PoseModel pooled = *FitPoseModel(examples, {.components = 1});
+  const PoseModel held_out = *FitPoseModel(examples, {.components = 1}, groups);
+  EXPECT_EQ(pooled.means, held_out.means);
+  EXPECT_LT(held_out.threshold, pooled.threshold);
+  // The threshold is the least likely example under the model of the other group.
+  const PoseModel first = *FitPoseModel(examples.topRows(50), {.components = 1});
+  const PoseModel second = *FitPoseModel(examples.bottomRows(50), {.components = 1});
+  const double expected = std::min(PoseLogLikelihood(second, examples.topRows(50)).minCoeff(),
+                                   PoseLogLikelihood(first, examples.bottomRows(50)).minCoeff());
+  EXPECT_DOUBLE_EQ(held_out.threshold, expected);
+  EXPECT_THAT(std::string(FitPoseModel(examples, {}, {0, 1}).status().message()),
+              HasSubstr("groups"));
+}
+
 TEST(PoseModelTest, BadFitsAreRefusedNamingTheField) {
   const RowMatrixXd samples = SampleMixture(KnownMixture(), 10, 1);
   const auto message = [&](const PoseModelOptions& options) {
@@ -154,9 +180,9 @@ TEST(PoseDetectionTest, FindsTheIntervalsWhereTheCurveHoldsThePose) {
   EXPECT_LE(detection->intervals[0].peak_frame, 39);
   EXPECT_EQ(detection->intervals[0].peak, detection->log_likelihood[20]);
   EXPECT_EQ(detection->log_likelihood.size(), 100);
-  // Examples' likelihoods lie around the default threshold: about 95% at or above it.
+  // With one group, the default threshold is the least likely example's own log-likelihood.
   const Eigen::VectorXd own = PoseLogLikelihood(model, examples);
-  EXPECT_NEAR((own.array() >= model.threshold).cast<double>().mean(), 0.95, 0.02);
+  EXPECT_DOUBLE_EQ(own.minCoeff(), model.threshold);
 
   const absl::StatusOr<Detection> long_only = DetectPose(model, curve, {.min_frames = 6});
   ASSERT_EQ(long_only->intervals.size(), 1u);

@@ -145,20 +145,16 @@ absl::StatusOr<CovarianceType> ParseCovarianceType(absl::string_view name) {
       "covariance: '", name, "' is not a covariance type; expected full, diagonal or spherical"));
 }
 
-absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& examples,
-                                       const PoseModelOptions& options) {
-  if (examples.rows() == 0) return absl::InvalidArgumentError("examples: no poses given");
-  MOTIONDB_RETURN_IF_ERROR(
-      ops_internal::CheckPoints("examples", examples, static_cast<int>(examples.cols()), 1, true));
-  MOTIONDB_RETURN_IF_ERROR(CheckOptions(options, examples.rows(), examples.cols()));
-  const RowMatrixXd x = examples.leftCols(options.dims);
+namespace {
+
+// EM from k-means++ means; its threshold is left for the caller.
+PoseModel FitMixture(const RowMatrixXd& x, const PoseModelOptions& options) {
   const int k = options.components;
   const RowMatrixXd centred = x.rowwise() - x.colwise().mean();
   const Eigen::MatrixXd spread = centred.transpose() * centred / static_cast<double>(x.rows());
   // The floor scales with the data, with a tiny absolute part for examples that never vary.
   const double floor =
       options.regularization * spread.trace() / options.dims + std::numeric_limits<float>::min();
-
   PoseModel model;
   model.dims = options.dims;
   model.covariance = options.covariance;
@@ -176,9 +172,51 @@ absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& exam
     previous = model.log_likelihood;
   }
   model.iterations = std::min(model.iterations, options.max_iterations);
-  Eigen::VectorXd scores = PoseLogLikelihood(model, x);
+  model.log_likelihood = PoseLogLikelihood(model, x).mean();
+  return model;
+}
+
+// The examples' log-likelihoods for the threshold: each group's under a model of the others.
+absl::StatusOr<Eigen::VectorXd> HeldOutScores(const RowMatrixXd& x, const PoseModelOptions& options,
+                                              const std::vector<int>& groups,
+                                              const PoseModel& model) {
+  std::vector<int> names = groups;
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  if (names.size() < 2) return PoseLogLikelihood(model, x);
+  Eigen::VectorXd scores(x.rows());
+  for (const int group : names) {
+    std::vector<Eigen::Index> in, out;
+    for (Eigen::Index n = 0; n < x.rows(); ++n) (groups[n] == group ? in : out).push_back(n);
+    if (static_cast<int>(out.size()) < options.components) {
+      return absl::InvalidArgumentError(absl::StrCat("examples: without group ", group, ", ",
+                                                     out.size(), " poses cannot fit ",
+                                                     options.components, " components"));
+    }
+    const PoseModel others = FitMixture(x(out, Eigen::all), options);
+    const Eigen::VectorXd held = PoseLogLikelihood(others, x(in, Eigen::all));
+    for (size_t i = 0; i < in.size(); ++i) scores[in[i]] = held[i];
+  }
+  return scores;
+}
+
+}  // namespace
+
+absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& examples,
+                                       const PoseModelOptions& options,
+                                       const std::vector<int>& groups) {
+  if (examples.rows() == 0) return absl::InvalidArgumentError("examples: no poses given");
+  MOTIONDB_RETURN_IF_ERROR(
+      ops_internal::CheckPoints("examples", examples, static_cast<int>(examples.cols()), 1, true));
+  MOTIONDB_RETURN_IF_ERROR(CheckOptions(options, examples.rows(), examples.cols()));
+  if (!groups.empty() && static_cast<Eigen::Index>(groups.size()) != examples.rows()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("groups: ", groups.size(), " given for ", examples.rows(), " examples"));
+  }
+  const RowMatrixXd x = examples.leftCols(options.dims);
+  PoseModel model = FitMixture(x, options);
+  MOTIONDB_ASSIGN_OR_RETURN(Eigen::VectorXd scores, HeldOutScores(x, options, groups, model));
   std::sort(scores.begin(), scores.end());
-  model.log_likelihood = scores.mean();
   model.threshold = scores[static_cast<Eigen::Index>(
       std::floor(options.threshold_quantile * static_cast<double>(scores.size() - 1)))];
   return model;

@@ -47,9 +47,10 @@ struct PoseModelOptions {
   // Added to every variance, as a share of the examples' mean variance per dimension, so that a
   // component cannot collapse onto a single pose; finite, in (0, 1].
   double regularization = 1e-3;
-  // The model's detection threshold is this quantile of the examples' own log-likelihoods, in
-  // [0, 1]: 0.05 fires on poses at least as likely as the 5% least likely examples.
-  double threshold_quantile = 0.05;
+  // The model's detection threshold: this quantile, in [0, 1], of the examples' log-likelihoods,
+  // each scored by a model fitted without its group (see FitPoseModel), so that the threshold
+  // admits new instances of the pose, not only the examples themselves; 0: the least likely.
+  double threshold_quantile = 0.0;
 };
 
 struct PoseModel {
@@ -64,10 +65,15 @@ struct PoseModel {
 };
 
 // Fits a model to `examples` (m x at least options.dims coordinates, the first options.dims
-// used). INVALID_ARGUMENT naming the option, or examples when there are none, too few for k, or
-// NaN values.
+// used). `groups` (empty, or one per example) says which examples belong together, such as the
+// poses of one example clip: with two groups or more, each group's examples are scored for the
+// threshold by a model fitted to the other groups (leave one group out), which estimates how
+// likely an unseen instance of the pose is; with one, by the model itself. INVALID_ARGUMENT
+// naming the option, or examples when there are none, too few for k (in every group's
+// complement too), or NaN values, or groups of the wrong size.
 absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& examples,
-                                       const PoseModelOptions& options = {});
+                                       const PoseModelOptions& options = {},
+                                       const std::vector<int>& groups = {});
 
 // A model's consistency (shapes, weights, positive definite covariances), e.g. after parsing.
 absl::Status ValidatePoseModel(const PoseModel& model);
