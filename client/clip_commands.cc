@@ -35,7 +35,32 @@ nlohmann::json ClipJson(const v1::Clip& clip) {
   if (clip.joint_names_size() > 0) {
     json["joints"] = std::vector<std::string>(clip.joint_names().begin(), clip.joint_names().end());
   }
+  if (clip.has_provenance()) {
+    const v1::Provenance& made = clip.provenance();
+    nlohmann::json sources = nlohmann::json::array();
+    for (const v1::ClipRange& source : made.sources()) {
+      sources.push_back({{"clip_id", source.clip_id()},
+                         {"first_frame", source.first_frame()},
+                         {"last_frame", source.last_frame()}});
+    }
+    json["provenance"] = {{"operator", made.operator_()},
+                          {"space", made.space()},
+                          {"sources", sources},
+                          {"parameters", nlohmann::json::parse(made.parameters_json(), nullptr,
+                                                               /*allow_exceptions=*/false)}};
+  }
   return json;
+}
+
+// "scale in space body from clip 1 frames 40-300, clip 2 frames 0-10; {...}".
+std::string ProvenanceText(const v1::Provenance& made) {
+  std::vector<std::string> sources;
+  for (const v1::ClipRange& source : made.sources()) {
+    sources.push_back(absl::StrFormat("clip %d frames %d-%d", source.clip_id(),
+                                      source.first_frame(), source.last_frame()));
+  }
+  return absl::StrCat(made.operator_(), " in space ", made.space(), " from ",
+                      absl::StrJoin(sources, ", "), "; ", made.parameters_json());
 }
 
 // What `clip show` and `clip update` print. UpdateClip's answer has no joint names, so then
@@ -52,6 +77,7 @@ void PrintClip(const v1::Clip& clip, bool json) {
       clip.joint_names().empty() ? ""
                                  : absl::StrCat(" (", absl::StrJoin(clip.joint_names(), ", "), ")"),
       clip.tags().empty() ? "none" : absl::StrJoin(clip.tags(), ", "));
+  if (clip.has_provenance()) absl::PrintF("  made by:  %s\n", ProvenanceText(clip.provenance()));
 }
 
 struct ListFlags {

@@ -5,10 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/str_split.h"
+#include "client/clip_range_arg.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
 #include "client/space_flags.h"
@@ -27,34 +26,11 @@ struct CreateFlags {
   SpaceFlags space;
 };
 
-// "12" or "12:30-90" (frames at the clip's own rate, inclusive); also --train's check.
-absl::StatusOr<v1::ClipRange> ParseTraining(const std::string& spec) {
-  v1::ClipRange range;
-  const std::vector<std::string> parts = absl::StrSplit(spec, ':');
-  int64_t id = 0;
-  if (parts.size() > 2 || !absl::SimpleAtoi(parts[0], &id)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("expected CLIP_ID or CLIP_ID:FROM-TO, got '", spec, "'"));
-  }
-  range.set_clip_id(id);
-  if (parts.size() == 2) {
-    const std::vector<std::string> bounds = absl::StrSplit(parts[1], '-');
-    int first = 0, last = 0;
-    if (bounds.size() != 2 || !absl::SimpleAtoi(bounds[0], &first) ||
-        !absl::SimpleAtoi(bounds[1], &last)) {
-      return absl::InvalidArgumentError(absl::StrCat("expected CLIP_ID:FROM-TO, got '", spec, "'"));
-    }
-    range.set_first_frame(first);
-    range.set_last_frame(last);
-  }
-  return range;
-}
-
 absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
   v1::CreateSpaceRequest request;
   request.set_name(flags.name);
   for (const std::string& spec : flags.train) {
-    MOTIONDB_ASSIGN_OR_RETURN(*request.add_training(), ParseTraining(spec));
+    MOTIONDB_ASSIGN_OR_RETURN(*request.add_training(), ParseClipRange(spec));
   }
   const SpaceFlags& space = flags.space;
   if (space.rate) request.set_sample_rate(*space.rate);
@@ -211,11 +187,7 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
                    "a clip to learn from (default: all), or frames FROM..TO of it")
       ->type_name("CLIP_ID[:FROM-TO]")
       ->allow_extra_args(false)
-      ->check(CLI::Validator(
-          [](const std::string& spec) {
-            return std::string(ParseTraining(spec).status().message());
-          },
-          ""));
+      ->check(ClipRangeCheck());
   create_command->add_option("--skeleton", create->skeleton, "the skeleton (default: --train's)")
       ->type_name("ID")
       ->check(WholeAtLeast(1));

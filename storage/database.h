@@ -34,6 +34,7 @@
 #include "core/space/motion_space.h"
 #include "storage/job_record.h"
 #include "storage/label_record.h"
+#include "storage/pose_model_record.h"
 
 namespace motiondb::storage {
 
@@ -66,6 +67,9 @@ struct ClipRecord {
   int64_t frame_count = 0;
   int joint_count = 0;
   std::string content_hash;
+  // Where a clip made by an operator came from, as JSON text the application writes and reads
+  // (server/provenance.h); empty for an ingested clip. Stored as given.
+  std::string provenance;
 };
 
 // What every write may be told. A write is checked once its transaction is ready to commit, so
@@ -272,6 +276,16 @@ class Database {
   // space with one of the descriptors; NOT_FOUND for an unknown job.
   absl::StatusOr<int64_t> FinishPropagation(const PropagationOutput& output,
                                             const WriteOptions& write = {});
+
+  // Pose models (storage/pose_model_record.h). InsertPoseModel stores one and returns its id:
+  // ALREADY_EXISTS for a taken name, NOT_FOUND for an unknown space, INVALID_ARGUMENT naming
+  // `name` for a name of 0 or over 128 bytes or with a control character.
+  absl::StatusOr<int64_t> InsertPoseModel(const PoseModelRecord& model,
+                                          const WriteOptions& write = {});
+  absl::StatusOr<PoseModelRecord> GetPoseModel(const std::string& name);  // NOT_FOUND
+  // Every model, by name; only those of one space when `space_id` is not 0.
+  absl::StatusOr<std::vector<PoseModelRecord>> ListPoseModels(int64_t space_id = 0);
+  absl::Status DeletePoseModel(const std::string& name, const WriteOptions& write = {});
 
   // Every skeleton, in id order, with its clip count and first clip, in one query.
   absl::StatusOr<std::vector<SkeletonSummary>> ListSkeletons();

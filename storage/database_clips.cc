@@ -235,7 +235,8 @@ absl::StatusOr<int64_t> Database::InsertClip(
         SqliteStatement insert,
         db.Prepare("INSERT INTO clips (name, source_file, skeleton_id, frame_time, frame_count, "
                    "joint_count, position_joint_count, layout, rotations, positions, "
-                   "created_unix_ms, content_hash) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+                   "created_unix_ms, content_hash, provenance) "
+                   "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
     MOTIONDB_RETURN_IF_ERROR(insert.BindText(1, record.name)
                                  .BindText(2, record.source_file)
                                  .BindInt64(3, skeleton_id)
@@ -248,6 +249,7 @@ absl::StatusOr<int64_t> Database::InsertClip(
                                  .BindBlob(10, positions)
                                  .BindInt64(11, now)
                                  .BindText(12, content_hash)
+                                 .BindText(13, record.provenance)
                                  .Run());
     clip_id = db.last_insert_rowid();
     MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, tags));

@@ -22,6 +22,7 @@ ClipRecord ReadClipRecord(const SqliteStatement& row) {
   record.frame_count = row.ColumnInt64(6);
   record.joint_count = static_cast<int>(row.ColumnInt64(7));
   record.content_hash = row.ColumnText(8);
+  record.provenance = row.ColumnText(9);
   return record;
 }
 

@@ -135,6 +135,23 @@ CREATE TABLE jobs (
 CREATE INDEX jobs_by_state ON jobs (state);
 )sql";
 
+// The Motion Curve operators (issue 16): where a clip made by an operator came from (JSON text
+// the application writes: operator, space, source ranges, parameters; '' for an ingested clip),
+// and the pose models of pose detection by name, each of one space (deleted with it), stored as
+// the text of core/ops/pose_model_serialization.h.
+constexpr const char* kMigration4 = R"sql(
+ALTER TABLE clips ADD COLUMN provenance TEXT NOT NULL DEFAULT '';
+CREATE TABLE pose_models (
+  model_id INTEGER PRIMARY KEY AUTOINCREMENT,
+  name TEXT NOT NULL UNIQUE,
+  space_id INTEGER NOT NULL REFERENCES spaces (space_id) ON DELETE CASCADE,
+  data TEXT NOT NULL,
+  parameters TEXT NOT NULL,
+  created_unix_ms INTEGER NOT NULL
+);
+CREATE INDEX pose_models_by_space ON pose_models (space_id);
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -179,6 +196,7 @@ constexpr std::array kMigrations = {
     Migration{kMigration1, nullptr},
     Migration{kMigration2, BackfillContentHashes},
     Migration{kMigration3, nullptr},
+    Migration{kMigration4, nullptr},
 };
 
 }  // namespace

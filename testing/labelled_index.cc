@@ -8,7 +8,6 @@
 #include "util/status_macros.h"
 
 namespace motiondb::testing {
-
 namespace {
 
 // The name's `field`-th '_'-separated field, or the whole stem when it has too few.
@@ -23,23 +22,34 @@ std::string ContentLabel(const std::filesystem::path& path) { return NameField(p
 
 std::string StyleLabel(const std::filesystem::path& path) { return NameField(path, 2); }
 
+absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
+                                                             std::vector<std::string>* labels) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() == ".bvh") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<TrainingClip> clips;
+  for (const std::filesystem::path& path : files) {
+    MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
+    clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
+    labels->push_back(ContentLabel(path));
+  }
+  return clips;
+}
+
 absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,
                                                 const LibraryIndexOptions& index_options) {
   LabelledIndex library;
   std::vector<TrainingClip> clips;
   for (const std::filesystem::path& folder : folders) {
-    std::vector<std::filesystem::path> files;
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-      if (entry.path().extension() == ".bvh") files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
-    for (const std::filesystem::path& path : files) {
-      MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
-      clips.push_back({path.filename().string(), std::move(read.clip), std::nullopt});
-      library.labels.push_back(ContentLabel(path));
-      library.styles.push_back(StyleLabel(path));
+    MOTIONDB_ASSIGN_OR_RETURN(std::vector<TrainingClip> read,
+                              ReadLabelledFolder(folder, &library.labels));
+    for (TrainingClip& clip : read) {
+      library.styles.push_back(StyleLabel(clip.source));
       library.sources.push_back(folder.filename().string());
+      clips.push_back(std::move(clip));
     }
   }
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace space, MotionSpace::Build(clips, space_options));

@@ -28,6 +28,11 @@ std::string ContentLabel(const std::filesystem::path& path);
 // "dataset-2_raise-up-left-hand_normal_003.bvh" -> "normal".
 std::string StyleLabel(const std::filesystem::path& path);
 
+// Every *.bvh of `folder`, in name order, as whole training clips named by their file names;
+// `labels` gets each one's ContentLabel.
+absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
+                                                             std::vector<std::string>* labels);
+
 // One space trained on every clip of every folder, and one index of them all, in folder order.
 absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,

@@ -11,6 +11,7 @@
 #include "server/grpc/call_gate.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
+#include "server/grpc/edit_service.h"
 #include "server/grpc/job_service.h"
 #include "server/grpc/label_service.h"
 #include "server/grpc/request_logger.h"
@@ -46,6 +47,7 @@ struct MotionDbServer::State {
   std::unique_ptr<LabelServiceImpl> labels;
   std::unique_ptr<JobServiceImpl> job_service;
   std::unique_ptr<ServerInfoServiceImpl> info;
+  std::unique_ptr<EditServiceImpl> edits;
   std::unique_ptr<grpc::Server> server;
 };
 
@@ -99,6 +101,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
   s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
+  s.edits =
+      std::make_unique<EditServiceImpl>(EditContext{*s.database, *s.catalog, s.registry}, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,
@@ -119,6 +123,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.labels.get());
   builder.RegisterService(s.job_service.get());
   builder.RegisterService(s.info.get());
+  builder.RegisterService(s.edits.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   // Always: the metrics count every call, whether or not lines are written.
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;

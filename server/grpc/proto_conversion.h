@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
+#include "motiondb/v1/edit_service.pb.h"
 #include "motiondb/v1/job_service.pb.h"
 #include "motiondb/v1/label_service.pb.h"
 #include "motiondb/v1/search_service.pb.h"
@@ -15,10 +16,15 @@
 #include "server/clip_export.h"
 #include "server/clip_ingest.h"
 #include "server/clip_poses.h"
+#include "server/edit_blends.h"
+#include "server/edit_curves.h"
+#include "server/edit_reconstruct.h"
+#include "server/edit_transitions.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/label_catalog.h"
 #include "server/listing.h"
+#include "server/pose_models.h"
 #include "server/propagation.h"
 #include "server/search_runner.h"
 #include "server/space_builder.h"
@@ -71,6 +77,28 @@ void ToProto(const ClipTimeline& timeline, v1::GetClipLabelsResponse* response);
 // The space and descriptors read from the job's parameters.
 void ToProto(const storage::JobRecord& record, v1::Job* job);
 void ToProto(const storage::JobPage& page, v1::ListJobsResponse* response);
+
+// EditService (issue 16). Each request's parameters (without its output) are kept as proto3
+// JSON in EditOutput::parameters_json, for the provenance of a stored result.
+absl::StatusOr<ReconstructRequest> FromProto(const v1::ReconstructRequest& request);
+absl::StatusOr<InterpolateRequest> FromProto(const v1::InterpolateRequest& request);
+absl::StatusOr<BlendRequest> FromProto(const v1::BlendRequest& request);
+absl::StatusOr<FillGapRequest> FromProto(const v1::FillGapRequest& request);
+absl::StatusOr<ScaleRequest> FromProto(const v1::ScaleRequest& request);
+// INVALID_ARGUMENT naming target unless exactly one of target and the axis is given.
+absl::StatusOr<TranslateRequest> FromProto(const v1::TranslateRequest& request);
+absl::StatusOr<SmoothRequest> FromProto(const v1::SmoothRequest& request);
+absl::StatusOr<PoseModelRequest> FromProto(const v1::CreatePoseModelRequest& request);
+absl::StatusOr<DetectRequest> FromProto(const v1::DetectPoseRequest& request);
+void ToProto(const EditResult& result, v1::EditResult* out);
+void ToProto(const EditResult& result, v1::EditResponse* response);
+void ToProto(const ReconstructOutcome& outcome, v1::ReconstructResponse* response);
+void ToProto(const InterpolateOutcome& outcome, v1::InterpolateResponse* response);
+void ToProto(const BlendOutcome& outcome, v1::BlendResponse* response);
+void ToProto(const FillGapOutcome& outcome, v1::FillGapResponse* response);
+void ToProto(const StoredPoseModel& stored, v1::PoseModel* model);
+// The log-likelihood as little-endian float32.
+void ToProto(const DetectOutcome& outcome, v1::DetectPoseResponse* response);
 
 }  // namespace motiondb::server
 

@@ -26,8 +26,8 @@ namespace motiondb::storage {
 // The columns ReadClipRecord reads, of the clips table as `c`.
 inline constexpr absl::string_view kClipRecordColumns =
     "c.clip_id, c.name, c.source_file, c.skeleton_id, c.created_unix_ms, c.frame_time, "
-    "c.frame_count, c.joint_count, c.content_hash";
-inline constexpr int kClipRecordColumnCount = 9;
+    "c.frame_count, c.joint_count, c.content_hash, c.provenance";
+inline constexpr int kClipRecordColumnCount = 10;
 // The columns ReadClip reads besides, listed after kClipRecordColumns.
 inline constexpr absl::string_view kClipFrameColumns =
     "c.position_joint_count, c.layout, c.rotations, c.positions";

@@ -1,0 +1,103 @@
+#include "core/ops/interpolation.h"
+
+#include "absl/strings/str_cat.h"
+#include "core/ops/internal/op_checks.h"
+#include "core/space/pose_encoder.h"
+#include "util/status_macros.h"
+
+namespace motiondb {
+namespace {
+
+using ops_internal::CheckBetween;
+
+constexpr int kMaxSteps = 10000;
+
+absl::StatusOr<std::vector<double>> Parameters(const InterpolationOptions& options) {
+  if (!options.t.empty()) {
+    if (options.t.size() > kMaxSteps) {
+      return ops_internal::OutOfRange("t", static_cast<double>(options.t.size()),
+                                      absl::StrCat("at most ", kMaxSteps, " values"));
+    }
+    for (size_t i = 0; i < options.t.size(); ++i) {
+      MOTIONDB_RETURN_IF_ERROR(CheckBetween(absl::StrCat("t[", i, "]"), options.t[i], 0.0, 1.0));
+    }
+    return options.t;
+  }
+  MOTIONDB_RETURN_IF_ERROR(CheckBetween("steps", options.steps, 2, kMaxSteps));
+  std::vector<double> t(options.steps);
+  for (int i = 0; i < options.steps; ++i) t[i] = static_cast<double>(i) / (options.steps - 1);
+  return t;
+}
+
+RowMatrixXd SlerpJoints(const Eigen::Ref<const RowMatrixXd>& rotations,
+                        const std::vector<double>& t) {
+  RowMatrixXd slerp(t.size(), rotations.cols());
+  for (Eigen::Index j = 0; j < rotations.cols(); j += 4) {
+    const auto a = rotations.block<1, 4>(0, j);
+    const auto b = rotations.block<1, 4>(1, j);
+    const Quat qa(a[0], a[1], a[2], a[3]);
+    const Quat qb(b[0], b[1], b[2], b[3]);
+    for (size_t i = 0; i < t.size(); ++i) {
+      Quat q = Slerp(qa, qb, t[i]);
+      if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+      slerp.block<1, 4>(i, j) << q.w(), q.x(), q.y(), q.z();
+    }
+  }
+  return slerp;
+}
+
+}  // namespace
+
+absl::StatusOr<Interpolation> InterpolatePoses(const MotionSpace& space,
+                                               const Eigen::Ref<const RowMatrixXd>& poses,
+                                               const Eigen::Ref<const RowMatrixXd>& rotations,
+                                               const InterpolationOptions& options) {
+  MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckPoints("poses", poses, space.dims(), 2, true));
+  if (poses.rows() != 2 || rotations.rows() != 2 ||
+      rotations.cols() != 4 * space.skeleton().joint_count()) {
+    return absl::InvalidArgumentError("poses: interpolation takes exactly two poses");
+  }
+  const int dims = options.dims == -1 ? space.dims() : options.dims;
+  if (dims < 1 || dims > space.dims()) {
+    return ops_internal::OutOfRange("dims", options.dims,
+                                    absl::StrCat("1..", space.dims(), " (or -1 for all)"));
+  }
+  Interpolation result;
+  MOTIONDB_ASSIGN_OR_RETURN(result.t, Parameters(options));
+  const int n = static_cast<int>(result.t.size());
+  result.mc_lerp_coordinates.resize(n, dims);
+  for (int i = 0; i < n; ++i) {
+    result.mc_lerp_coordinates.row(i) =
+        (1.0 - result.t[i]) * poses.row(0).head(dims) + result.t[i] * poses.row(1).head(dims);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(result.mc_lerp, space.Reconstruct(result.mc_lerp_coordinates));
+  result.slerp = SlerpJoints(rotations, result.t);
+
+  // SLERP's poses projected, their yaw rate (which shapes no joint) interpolated linearly.
+  PoseRotations slerp_pose{result.slerp, Eigen::VectorXd()};
+  if (space.data().pose.remove_heading) {
+    MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd vectors, space.Unproject(poses));
+    const Eigen::Index last = vectors.cols() - 1;
+    slerp_pose.yaw_rate.resize(n);
+    for (int i = 0; i < n; ++i) {
+      slerp_pose.yaw_rate[i] =
+          (1.0 - result.t[i]) * vectors(0, last) + result.t[i] * vectors(1, last);
+    }
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(result.slerp_coordinates,
+                            space.Project(EncodePoses(slerp_pose, space.data().references)));
+  AngleErrors(result.mc_lerp, result.slerp, nullptr, &result.overall);
+  for (int i = 0; i < n; ++i) {
+    AngleError step;
+    AngleErrors(result.mc_lerp.row(i), result.slerp.row(i), nullptr, &step);
+    result.difference.push_back(step);
+    Eigen::RowVectorXd point = Eigen::RowVectorXd::Zero(space.dims());
+    point.head(dims) = result.mc_lerp_coordinates.row(i);
+    MOTIONDB_ASSIGN_OR_RETURN(const double distance,
+                              space.Distance(result.slerp_coordinates.row(i), point));
+    result.curve_distance.push_back(distance);
+  }
+  return result;
+}
+
+}  // namespace motiondb

@@ -1,0 +1,81 @@
+#include "server/edit_context.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "core/bvh/bvh_writer.h"
+#include "core/motion/resample.h"
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+#include "util/status_prefix.h"
+
+namespace motiondb::server {
+
+absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
+                                      const ClipSelection& selection, absl::string_view field) {
+  MOTIONDB_RETURN_IF_ERROR(
+      Prefixed(field, CheckClipInSpace(database, snapshot, selection.clip_id)));
+  MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(selection.clip_id));
+  EditSource source;
+  source.range.clip_id = selection.clip_id;
+  MOTIONDB_ASSIGN_OR_RETURN(source.range.frames,
+                            ResolveFrameRange(selection, stored.clip.frame_count(), field));
+  source.clip_name = stored.record.name;
+  source.fps = stored.clip.fps();
+  source.skeleton = stored.clip.shared_skeleton();
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip range, stored.clip.Slice(source.range.frames));
+  MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, range));
+  return source;
+}
+
+absl::StatusOr<EditPose> PoseOf(const MotionSpace& space, const EditSource& source) {
+  const SpaceMotion& motion = source.motion;
+  EditPose pose;
+  if (motion.coordinates.rows() == 1) {
+    pose.coordinates = motion.coordinates;
+    pose.rotations = motion.rotations;
+    pose.placement = motion.placement;
+    return pose;
+  }
+  pose.coordinates = motion.coordinates.colwise().mean();
+  MOTIONDB_ASSIGN_OR_RETURN(pose.rotations, space.Reconstruct(pose.coordinates));
+  const int frames = static_cast<int>(motion.coordinates.rows());
+  std::vector<PlacementFrame> sources;
+  for (int f = 0; f < frames; ++f) sources.push_back({&motion.placement, f});
+  pose.placement = EmptyPlacement(motion.placement, 1);
+  MixPlacementFrame(sources, std::vector<double>(frames, 1.0 / frames), &pose.placement, 0);
+  return pose;
+}
+
+absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSpace& space,
+                                      const EditSource& like, const EditedMotion& motion,
+                                      Provenance provenance, const EditOutput& output,
+                                      const std::function<bool()>& should_stop) {
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const Clip at_space_rate,
+      ToClip(space, like.skeleton, PlaceRotations(space, motion.rotations, motion.placement),
+             motion.placement));
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip, Resample(at_space_rate, like.fps));
+  EditResult result;
+  MOTIONDB_ASSIGN_OR_RETURN(result.bvh, WriteBvh(clip));
+  result.frames = clip.frame_count();
+  result.fps = clip.fps();
+  const std::string stem = output.store_name.empty() ? like.clip_name : output.store_name;
+  result.file_name = absl::StrCat(absl::StrReplaceAll(stem, {{"/", "_"}, {"\\", "_"}}), "_",
+                                  provenance.op, ".bvh");
+  if (output.store_name.empty()) return result;
+  storage::ClipRecord record;
+  record.name = output.store_name;
+  record.source_file = result.file_name;
+  record.tags = output.store_tags;
+  provenance.parameters_json = output.parameters_json;
+  record.provenance = ProvenanceJson(provenance);
+  MOTIONDB_ASSIGN_OR_RETURN(
+      IngestedClip stored,
+      Prefixed("store", context.catalog.IngestClip(record, clip, OnConflict::kError, should_stop)));
+  result.stored = std::move(stored.record);
+  return result;
+}
+
+}  // namespace motiondb::server

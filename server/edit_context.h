@@ -1,0 +1,90 @@
+// What the operators of EditService (issue 16, core/ops) share in the application: a stored
+// clip range brought into a space, a pose taken from one (a frame, or the projected mean of a
+// range, thesis 5.2), and a result turned into BVH with its source's hierarchy and channel
+// orders at its source's frame rate, and, when asked, stored as a clip with its provenance.
+#ifndef MOTIONDB_SERVER_EDIT_CONTEXT_H_
+#define MOTIONDB_SERVER_EDIT_CONTEXT_H_
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "core/ops/space_motion.h"
+#include "server/catalog.h"
+#include "server/frame_conversion.h"
+#include "server/index_registry.h"
+#include "server/provenance.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+// What an operator request says about its result besides its own parameters.
+struct EditOutput {
+  std::string store_name{};  // empty: the result is only returned
+  std::vector<std::string> store_tags{};
+  std::string parameters_json{};  // the request's parameters, for the stored clip's provenance
+};
+
+struct EditResult {
+  std::string bvh;
+  std::string file_name;  // a suggestion: "<store name or source name>_<operator>.bvh"
+  int frames = 0;
+  double fps = 0;
+  std::optional<storage::ClipRecord> stored;  // with store_name: the clip as stored
+};
+
+// A stored clip's range in a space.
+struct EditSource {
+  SourceRange range;  // at the clip's own rate
+  std::string clip_name;
+  double fps = 0;                            // the clip's own
+  std::shared_ptr<const Skeleton> skeleton;  // the clip's own offsets and channels
+  SpaceMotion motion;                        // at the space rate
+};
+
+// A pose of the space: its point, the pose rotations it encodes and its placement.
+struct EditPose {
+  RowMatrixXd coordinates;  // 1 x the space's dims
+  RowMatrixXd rotations;    // 1 x 4 * joints
+  Placement placement;      // 1 frame
+};
+
+// A result before it leaves the space: pose rotations (frames x 4 * joints) and placement at
+// the space rate, exported with `like`'s skeleton at its rate.
+struct EditedMotion {
+  RowMatrixXd rotations;
+  Placement placement;
+};
+
+// The services' shared handles; thread-safe as they are.
+struct EditContext {
+  storage::Database& database;
+  Catalog& catalog;
+  const IndexRegistry& registry;
+};
+
+// The selection's clip, range and motion in the space. NOT_FOUND for an unknown clip,
+// FAILED_PRECONDITION for a clip of another skeleton (CheckClipInSpace), INVALID_ARGUMENT naming
+// `field` for a range outside the clip.
+absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
+                                      const ClipSelection& selection, absl::string_view field);
+
+// The source's only frame, or the projected mean of its frames with the mean of their
+// placements and the pose the mean unprojects to.
+absl::StatusOr<EditPose> PoseOf(const MotionSpace& space, const EditSource& source);
+
+// The BVH of `motion` placed and exported with `like`'s skeleton at its rate, stored as a clip
+// when output.store_name is set (Catalog::IngestClip refusing a taken name; its errors prefixed
+// "store: "). `provenance` names the operator and its sources.
+absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSpace& space,
+                                      const EditSource& like, const EditedMotion& motion,
+                                      Provenance provenance, const EditOutput& output,
+                                      const std::function<bool()>& should_stop);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_EDIT_CONTEXT_H_

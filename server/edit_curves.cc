@@ -1,0 +1,101 @@
+#include "server/edit_curves.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+// The edit of a curve at `rate` under `scope` (its gate in seconds from the range's start),
+// adding to `sources` the ranges it reads besides the curve's.
+using CurveFunction = std::function<absl::StatusOr<RowMatrixXd>(
+    const SpaceSnapshot& snapshot, const RowMatrixXd& curve, const EditScope& scope, double rate,
+    std::vector<SourceRange>& sources)>;
+
+// The scope with its gate moved from the clip's time to the range's.
+EditScope RangeScope(const EditScope& scope, const EditSource& source) {
+  EditScope shifted = scope;
+  if (shifted.gate) {
+    const double start = source.range.frames.first / source.fps;
+    shifted.gate->start_s -= start;
+    shifted.gate->end_s -= start;
+  }
+  return shifted;
+}
+
+absl::StatusOr<EditResult> RunCurveEdit(const EditContext& context, const CurveEdit& edit,
+                                        const std::string& op, const CurveFunction& function,
+                                        const std::function<bool()>& should_stop) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(context.registry, edit.space));
+  const MotionSpace& space = *snapshot->space;
+  MOTIONDB_RETURN_IF_ERROR(ValidateEditScope(edit.scope, space.dims()));
+  MOTIONDB_RETURN_IF_ERROR(ValidateJointConstraints(space, edit.constraints));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
+                            LoadSource(context.database, *snapshot, edit.clip, "clip"));
+  Provenance provenance{op, edit.space, {source.range}};
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const RowMatrixXd curve,
+      function(*snapshot, source.motion.coordinates, RangeScope(edit.scope, source),
+               space.sample_rate(), provenance.sources));
+  EditedMotion edited{RowMatrixXd(), source.motion.placement};
+  MOTIONDB_ASSIGN_OR_RETURN(edited.rotations, space.Reconstruct(curve));
+  MOTIONDB_RETURN_IF_ERROR(
+      ApplyJointConstraints(space, edit.constraints, source.motion.rotations, &edited.rotations));
+  return FinishEdit(context, space, source, edited, std::move(provenance), edit.output,
+                    should_stop);
+}
+
+}  // namespace
+
+absl::StatusOr<EditResult> Scale(const EditContext& context, const ScaleRequest& request,
+                                 const std::function<bool()>& should_stop) {
+  return RunCurveEdit(
+      context, request.edit, "scale",
+      [&](const SpaceSnapshot&, const RowMatrixXd& curve, const EditScope& scope, double rate,
+          std::vector<SourceRange>&) {
+        ScaleOptions options = request.options;
+        options.scope = scope;
+        return ScaleCurve(curve, rate, options);
+      },
+      should_stop);
+}
+
+absl::StatusOr<EditResult> Translate(const EditContext& context, const TranslateRequest& request,
+                                     const std::function<bool()>& should_stop) {
+  return RunCurveEdit(
+      context, request.edit, "translate",
+      [&](const SpaceSnapshot& snapshot, const RowMatrixXd& curve, const EditScope& scope,
+          double rate, std::vector<SourceRange>& sources) -> absl::StatusOr<RowMatrixXd> {
+        RowMatrixXd poses(request.poses.size(), curve.cols());
+        for (size_t i = 0; i < request.poses.size(); ++i) {
+          MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
+                                    LoadSource(context.database, snapshot, request.poses[i],
+                                               absl::StrCat("poses[", i, "]")));
+          MOTIONDB_ASSIGN_OR_RETURN(const EditPose pose, PoseOf(*snapshot.space, source));
+          poses.row(i) = pose.coordinates.row(0);
+          sources.push_back(source.range);
+        }
+        TranslateOptions options = request.options;
+        options.scope = scope;
+        return TranslateCurve(curve, rate, poses, options);
+      },
+      should_stop);
+}
+
+absl::StatusOr<EditResult> Smooth(const EditContext& context, const SmoothRequest& request,
+                                  const std::function<bool()>& should_stop) {
+  return RunCurveEdit(
+      context, request.edit, "smooth",
+      [&](const SpaceSnapshot&, const RowMatrixXd& curve, const EditScope& scope, double rate,
+          std::vector<SourceRange>&) -> absl::StatusOr<RowMatrixXd> {
+        MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd smoothed, SmoothCurve(curve, request.options));
+        return ApplyScope(scope, curve, smoothed, rate);
+      },
+      should_stop);
+}
+
+}  // namespace motiondb::server

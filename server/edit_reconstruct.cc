@@ -1,0 +1,34 @@
+#include "server/edit_reconstruct.h"
+
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+
+absl::StatusOr<ReconstructOutcome> Reconstruct(const EditContext& context,
+                                               const ReconstructRequest& request,
+                                               const std::function<bool()>& should_stop) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(context.registry, request.space));
+  const MotionSpace& space = *snapshot->space;
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
+                            LoadSource(context.database, *snapshot, request.clip, "clip"));
+  MOTIONDB_ASSIGN_OR_RETURN(Reconstruction rebuilt,
+                            motiondb::Reconstruct(space, source.motion.coordinates,
+                                                  source.motion.rotations, request.options));
+  ReconstructOutcome outcome;
+  outcome.dims = rebuilt.dims;
+  outcome.overall = rebuilt.overall;
+  outcome.curve = std::move(rebuilt.curve);
+  for (size_t j = 0; j < rebuilt.joints.size(); ++j) {
+    outcome.joints.push_back({space.skeleton().joint(static_cast<int>(j)).name, rebuilt.joints[j]});
+  }
+  const EditedMotion edited{std::move(rebuilt.rotations), source.motion.placement};
+  MOTIONDB_ASSIGN_OR_RETURN(
+      outcome.result,
+      FinishEdit(context, space, source, edited, {"reconstruct", request.space, {source.range}},
+                 request.output, should_stop));
+  return outcome;
+}
+
+}  // namespace motiondb::server

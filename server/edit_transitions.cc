@@ -1,0 +1,133 @@
+#include "server/edit_transitions.h"
+
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "server/space_lookup.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+constexpr double kMaxTransitionSeconds = 3600.0;
+
+// Seconds in (0, kMaxTransitionSeconds] to frames at `rate`, at least one.
+absl::StatusOr<int> Frames(absl::string_view field, double seconds, double rate) {
+  if (!(seconds > 0.0 && seconds <= kMaxTransitionSeconds)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " = ", seconds, " is out of range; expected more than 0, at most ",
+                     kMaxTransitionSeconds, " seconds"));
+  }
+  return std::max(1, static_cast<int>(std::lround(seconds * rate)));
+}
+
+// The first range, `gap` and the second range in a row, with the placement of the gap mixed
+// linearly between the ranges' ends.
+absl::StatusOr<EditedMotion> Joined(const MotionSpace& space, const EditSource& first,
+                                    const EditSource& second, const RowMatrixXd& gap) {
+  const SpaceMotion& a = first.motion;
+  const SpaceMotion& b = second.motion;
+  const int na = static_cast<int>(a.coordinates.rows());
+  const int nb = static_cast<int>(b.coordinates.rows());
+  const int ng = static_cast<int>(gap.rows());
+  RowMatrixXd curve(na + ng + nb, a.coordinates.cols());
+  curve << a.coordinates, gap, b.coordinates;
+  EditedMotion joined{RowMatrixXd(), EmptyPlacement(a.placement, na + ng + nb)};
+  for (int f = 0; f < na; ++f) MixPlacementFrame({{&a.placement, f}}, {1.0}, &joined.placement, f);
+  for (int k = 0; k < ng; ++k) {
+    const double t = static_cast<double>(k + 1) / (ng + 1);
+    MixPlacementFrame({{&a.placement, na - 1}, {&b.placement, 0}}, {1.0 - t, t}, &joined.placement,
+                      na + k);
+  }
+  for (int f = 0; f < nb; ++f) {
+    MixPlacementFrame({{&b.placement, f}}, {1.0}, &joined.placement, na + ng + f);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(joined.rotations, space.Reconstruct(curve));
+  return joined;
+}
+
+absl::StatusOr<FillGapOutcome> Gap(const EditContext& context, const MotionSpace& space,
+                                   const FillGapRequest& request, const EditSource& first,
+                                   const EditSource& second,
+                                   const std::function<bool()>& should_stop) {
+  GapFillOptions options = request.gap;
+  MOTIONDB_ASSIGN_OR_RETURN(options.frames, Frames("gap_s", request.gap_s, space.sample_rate()));
+  GapFillOptions linear = options;
+  linear.method = GapMethod::kLinear;
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd gap,
+                            FillGap(first.motion.coordinates, second.motion.coordinates, options));
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd line,
+                            FillGap(first.motion.coordinates, second.motion.coordinates, linear));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditedMotion joined, Joined(space, first, second, gap));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditedMotion linear_joined, Joined(space, first, second, line));
+  FillGapOutcome outcome;
+  outcome.transition_frames = options.frames;
+  const int na = static_cast<int>(first.motion.coordinates.rows());
+  for (const int seam : {na - 1, na + options.frames}) {
+    outcome.seams.push_back({VelocityJump(joined.rotations, seam, space.sample_rate()),
+                             VelocityJump(linear_joined.rotations, seam, space.sample_rate())});
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(outcome.result,
+                            FinishEdit(context, space, first, joined,
+                                       {"fill-gap", request.space, {first.range, second.range}},
+                                       request.output, should_stop));
+  return outcome;
+}
+
+absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionSpace& space,
+                                       const FillGapRequest& request, const EditSource& first,
+                                       const EditSource& second,
+                                       const std::function<bool()>& should_stop) {
+  AlignedBlendOptions options = request.blend;
+  MOTIONDB_ASSIGN_OR_RETURN(options.overlap_frames,
+                            Frames("overlap_s", request.overlap_s, space.sample_rate()));
+  const SpaceMotion& a = first.motion;
+  const SpaceMotion& b = second.motion;
+  MOTIONDB_ASSIGN_OR_RETURN(const AlignedBlend plan,
+                            PlanAlignedBlend(a.coordinates, b.coordinates, options));
+  EditedMotion blended{RowMatrixXd(),
+                       EmptyPlacement(a.placement, static_cast<int>(plan.frames.size()))};
+  for (size_t k = 0; k < plan.frames.size(); ++k) {
+    const BlendFrame& frame = plan.frames[k];
+    std::vector<PlacementFrame> sources;
+    std::vector<double> weights;
+    if (frame.a >= 0) {
+      sources.push_back({&a.placement, frame.a});
+      weights.push_back(1.0 - frame.weight_b);
+    }
+    if (frame.b >= 0) {
+      sources.push_back({&b.placement, frame.b});
+      weights.push_back(frame.weight_b);
+    }
+    MixPlacementFrame(sources, weights, &blended.placement, static_cast<int>(k));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      blended.rotations, space.Reconstruct(MixCurves(plan.frames, a.coordinates, b.coordinates)));
+  FillGapOutcome outcome;
+  outcome.transition_frames = options.overlap_frames;
+  outcome.warp_score = plan.warp_score;
+  MOTIONDB_ASSIGN_OR_RETURN(
+      outcome.result, FinishEdit(context, space, first, blended,
+                                 {"blend-overlap", request.space, {first.range, second.range}},
+                                 request.output, should_stop));
+  return outcome;
+}
+
+}  // namespace
+
+absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGapRequest& request,
+                                       const std::function<bool()>& should_stop) {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
+                            FindSpace(context.registry, request.space));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource first,
+                            LoadSource(context.database, *snapshot, request.first, "first"));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource second,
+                            LoadSource(context.database, *snapshot, request.second, "second"));
+  if (!std::isfinite(request.overlap_s) || request.overlap_s != 0.0) {
+    return Overlap(context, *snapshot->space, request, first, second, should_stop);
+  }
+  return Gap(context, *snapshot->space, request, first, second, should_stop);
+}
+
+}  // namespace motiondb::server
