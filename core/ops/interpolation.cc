@@ -73,16 +73,19 @@ absl::StatusOr<Interpolation> InterpolatePoses(const MotionSpace& space,
   MOTIONDB_ASSIGN_OR_RETURN(result.mc_lerp, space.Reconstruct(result.mc_lerp_coordinates));
   result.slerp = SlerpJoints(rotations, result.t);
 
-  // SLERP's poses projected, their yaw rate (which shapes no joint) interpolated linearly.
-  PoseRotations slerp_pose{result.slerp, Eigen::VectorXd()};
+  // SLERP's poses projected, their yaw rate and root velocity (which shape no joint)
+  // interpolated linearly.
+  PoseRotations slerp_pose{result.slerp, Eigen::VectorXd(), RowMatrixXd()};
   if (space.data().pose.remove_heading) {
     MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd vectors, space.Unproject(poses));
-    const Eigen::Index last = vectors.cols() - 1;
-    slerp_pose.yaw_rate.resize(n);
+    const Eigen::Index extra = 3 * space.skeleton().joint_count();  // the first non-joint number
+    RowMatrixXd lerped(n, vectors.cols() - extra);
     for (int i = 0; i < n; ++i) {
-      slerp_pose.yaw_rate[i] =
-          (1.0 - result.t[i]) * vectors(0, last) + result.t[i] * vectors(1, last);
+      lerped.row(i) = (1.0 - result.t[i]) * vectors.row(0).tail(lerped.cols()) +
+                      result.t[i] * vectors.row(1).tail(lerped.cols());
     }
+    slerp_pose.yaw_rate = lerped.col(0);
+    if (space.data().pose.root_velocity) slerp_pose.root_velocity = lerped.rightCols(2);
   }
   MOTIONDB_ASSIGN_OR_RETURN(result.slerp_coordinates,
                             space.Project(EncodePoses(slerp_pose, space.data().references)));

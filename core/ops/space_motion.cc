@@ -9,6 +9,7 @@
 #include "core/motion/resample.h"
 #include "core/space/heading.h"
 #include "core/space/pose_encoder.h"
+#include "core/space/root_velocity.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -40,7 +41,7 @@ absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& cli
   const PoseOptions& options = space.data().pose;
   SpaceMotion motion;
   motion.placement.positions = sampled.positions();
-  PoseRotations pose{sampled.rotations(), Eigen::VectorXd()};
+  PoseRotations pose{sampled.rotations(), Eigen::VectorXd(), RowMatrixXd()};
   if (options.remove_heading) {
     const std::vector<int> chain = AbovePelvis(sampled.skeleton());
     motion.placement.above_pelvis.resize(sampled.frame_count(), 4 * chain.size());
@@ -50,6 +51,9 @@ absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& cli
     }
     motion.placement.yaw = RemoveHeading(sampled.skeleton(), &pose.rotations);
     pose.yaw_rate = YawRate(motion.placement.yaw, sampled.fps(), options.yaw_rate_window);
+    if (options.root_velocity) {
+      pose.root_velocity = RootVelocity(sampled, motion.placement.yaw, options.yaw_rate_window);
+    }
   }
   MOTIONDB_ASSIGN_OR_RETURN(motion.coordinates,
                             space.Project(EncodePoses(pose, space.data().references)));
