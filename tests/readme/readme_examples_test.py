@@ -123,9 +123,12 @@ def main():
             page = f"http://{demo.http_address}"
             if f"open {page}" not in demo.text():
                 failed.append(f"scripts/start.sh --demo did not say: open {page}")
-            if run_block("motiondb clips --tag demo | grep -q 01_01\n"
+            # grep reads to the end (no -q): a reader that exits early can make the writer fail
+            # on a closed pipe, which pipefail reports.
+            if run_block("motiondb clips --tag demo | grep 01_01 >/dev/null\n"
                          "motiondb search --space demo --clip 1 --max 3\n"
-                         f"curl -sf {page}/ | grep -q '<title>motiondb'\n", demo_env, work) != 0:
+                         f"curl -sf {page}/ | grep '<title>motiondb' >/dev/null\n", demo_env,
+                         work) != 0:
                 failed.append("scripts/start.sh --demo")
         finally:
             demo.stop()
