@@ -26,6 +26,12 @@ absl::StatusOr<std::unique_ptr<SqliteConnection>> SqliteConnection::Open(const s
   // sqlite3_open_v2 hands out a connection even on failure, to carry the error message.
   std::unique_ptr<SqliteConnection> connection(new SqliteConnection(db));
   if (rc != SQLITE_OK) return SqliteStatus(db, rc, absl::StrCat("opening '", path, "'"));
+  // SQLite opens a file it may not write read-only without an error; every write would fail.
+  if (mode != Mode::kReadOnly && sqlite3_db_readonly(db, "main") == 1) {
+    return absl::FailedPreconditionError(
+        "the file can only be opened read-only (a read-only file system or the file's "
+        "permissions), and the server writes its database");
+  }
   sqlite3_extended_result_codes(db, 1);
   sqlite3_busy_timeout(db, busy_timeout_ms);
   return connection;

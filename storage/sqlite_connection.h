@@ -25,6 +25,7 @@ class SqliteConnection {
 
   // Opens `path` (a plain file name: URIs are not interpreted). `busy_timeout_ms`: how long a
   // statement waits for another connection's lock before failing with SQLITE_BUSY.
+  // FAILED_PRECONDITION when a writable mode is asked of a file that opens read-only.
   static absl::StatusOr<std::unique_ptr<SqliteConnection>> Open(const std::string& path, Mode mode,
                                                                 int busy_timeout_ms);
   SqliteConnection(const SqliteConnection&) = delete;

@@ -7,8 +7,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <map>
+#include <random>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include <gmock/gmock.h>
@@ -34,216 +38,16 @@
 #include "testing/server_process.h"
 #include "testing/synthetic_corpus.h"
 #include "tests/clip_builder.h"
+#include "tests/server_fixture.h"
 #include "tests/test_data.h"
 #include "util/byte_coding.h"
 
 namespace motiondb {
 namespace {
 
-namespace v1 = ::motiondb::v1;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using testing::ServerProcess;
-
-// ---------------------------------------------------------------------------------------------
-// Test data.
-
-// A small library of the synthetic humanoid (21 joints) with arm raises and shrugs at 50 fps,
-// in clips of about 20 s; generated once.
-const SyntheticCorpus& Humanoid() {
-  static const SyntheticCorpus* const library = [] {
-    SyntheticCorpusOptions options;
-    options.seed = 7;
-    options.script = {{SyntheticAction::kRightArmRaise, 4},
-                      {SyntheticAction::kLeftArmRaise, 4},
-                      {SyntheticAction::kBothArmsRaise, 3},
-                      {SyntheticAction::kShrug, 3}};
-    options.max_clip_duration_s = 20;
-    options.threads = 2;
-    absl::StatusOr<SyntheticCorpus> generated = GenerateSyntheticCorpus(options);
-    EXPECT_TRUE(generated.ok()) << generated.status();
-    return new SyntheticCorpus(*std::move(generated));
-  }();
-  return *library;
-}
-
-std::string BvhText(const Clip& clip) {
-  absl::StatusOr<std::string> text = WriteBvh(clip);
-  EXPECT_TRUE(text.ok()) << text.status();
-  return text.ok() ? *text : "";
-}
-
-// A 3-joint chain (another skeleton than the humanoid's) turning slowly, 61 frames at 30 fps.
-Clip ChainClip(double speed = 0.02) {
-  return testing::MakeClip(
-      testing::ChainSkeleton(), 61, 1.0 / 30,
-      [speed](int f, int j) {
-        return Quat(Eigen::AngleAxisd(speed * f * (j + 1), Eigen::Vector3d::UnitY()));
-      },
-      [](int f, int) { return Eigen::Vector3d(0.1 * f, 90, 0); });
-}
-
-// ---------------------------------------------------------------------------------------------
-// A client of one server.
-
-class Client {
- public:
-  explicit Client(std::shared_ptr<grpc::Channel> channel, std::string token = "")
-      : channel_(std::move(channel)),
-        token_(std::move(token)),
-        clips_(v1::ClipService::NewStub(channel_)),
-        spaces_(v1::SpaceService::NewStub(channel_)),
-        search_(v1::SearchService::NewStub(channel_)),
-        server_(v1::ServerService::NewStub(channel_)),
-        labels_(v1::LabelService::NewStub(channel_)),
-        jobs_(v1::JobService::NewStub(channel_)) {}
-
-  // A call context carrying the token and a deadline (generous by default: a test that hangs
-  // should fail, not stall the suite).
-  std::unique_ptr<grpc::ClientContext> Context(
-      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) const {
-    auto context = std::make_unique<grpc::ClientContext>();
-    context->set_deadline(std::chrono::system_clock::now() + deadline);
-    if (!token_.empty()) context->AddMetadata("authorization", "Bearer " + token_);
-    return context;
-  }
-
-  grpc::Status Ingest(const std::string& file_name, const std::string& bvh,
-                      v1::IngestClipResponse* response, std::vector<std::string> tags = {}) {
-    v1::IngestClipRequest request;
-    request.set_file_name(file_name);
-    request.set_bvh(bvh);
-    for (const std::string& tag : tags) request.add_tags(tag);
-    return clips_->IngestClip(Context().get(), request, response);
-  }
-  // The new clip's id, or -1 after a failed expectation.
-  int64_t IngestOrFail(const std::string& file_name, const std::string& bvh,
-                       std::vector<std::string> tags = {}) {
-    v1::IngestClipResponse response;
-    const grpc::Status status = Ingest(file_name, bvh, &response, std::move(tags));
-    EXPECT_TRUE(status.ok()) << file_name << ": " << status.error_message();
-    return status.ok() ? response.clip().clip_id() : -1;
-  }
-
-  grpc::Status CreateSpace(const v1::CreateSpaceRequest& request, v1::Space* space) {
-    return spaces_->CreateSpace(Context().get(), request, space);
-  }
-  grpc::Status Search(const v1::SearchRequest& request, v1::SearchResponse* response,
-                      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) {
-    return search_->Search(Context(deadline).get(), request, response);
-  }
-
-  v1::ClipService::Stub& clips() { return *clips_; }
-  v1::SpaceService::Stub& spaces() { return *spaces_; }
-  v1::SearchService::Stub& search() { return *search_; }
-  v1::ServerService::Stub& server() { return *server_; }
-  v1::LabelService::Stub& labels() { return *labels_; }
-  v1::JobService::Stub& jobs() { return *jobs_; }
-  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
-
- private:
-  std::shared_ptr<grpc::Channel> channel_;
-  std::string token_;
-  std::unique_ptr<v1::ClipService::Stub> clips_;
-  std::unique_ptr<v1::SpaceService::Stub> spaces_;
-  std::unique_ptr<v1::SearchService::Stub> search_;
-  std::unique_ptr<v1::ServerService::Stub> server_;
-  std::unique_ptr<v1::LabelService::Stub> labels_;
-  std::unique_ptr<v1::JobService::Stub> jobs_;
-};
-
-// A stored range as the query. These tests check that a search finds its own query first,
-// so the query's range is kept (exclude_query defaults to true).
-v1::SearchRequest ClipQuery(const std::string& space, int64_t clip_id, int first, int last) {
-  v1::SearchRequest request;
-  request.set_space(space);
-  request.mutable_clip()->set_clip_id(clip_id);
-  request.mutable_clip()->set_first_frame(first);
-  request.mutable_clip()->set_last_frame(last);
-  request.set_exclude_query(false);
-  return request;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Fixture: a temporary folder with the database; servers started on it.
-
-class ServerTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("server_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-    db_ = (dir_ / "motiondb.sqlite").string();
-  }
-  void TearDown() override {
-    if (HasFailure()) {
-      for (const auto& server : servers_) {
-        std::cerr << "---- server log ----\n" << server->Log() << "--------------------\n";
-      }
-    }
-    servers_.clear();
-    std::filesystem::remove_all(dir_);
-  }
-
-  // Starts a server with `args`, on the test's database unless they give --db; null after a
-  // failed assertion.
-  ServerProcess* StartServer(std::vector<std::string> args = {}, const std::string& token = "",
-                             bool tls = false) {
-    if (std::find(args.begin(), args.end(), "--db") == args.end()) {
-      args.insert(args.begin(), {"--db", db_});
-    }
-    auto server = std::make_unique<ServerProcess>();
-    std::string error;
-    if (!server->Start(args, &error)) {
-      ADD_FAILURE() << error;
-      return nullptr;
-    }
-    if (!tls && !testing::WaitUntilServing(testing::InsecureChannel(server->address()), token)) {
-      ADD_FAILURE() << "the server never reported SERVING:\n" << server->Log();
-      return nullptr;
-    }
-    servers_.push_back(std::move(server));
-    return servers_.back().get();
-  }
-
-  std::string WriteFile(const std::string& name, const std::string& text) {
-    const std::string path = (dir_ / name).string();
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
-  }
-
-  // Ingests the synthetic humanoid library ("humanoid_0".. with tags "synthetic" and "clip<i>");
-  // returns the clip ids.
-  std::vector<int64_t> IngestHumanoid(Client& client) {
-    std::vector<int64_t> ids;
-    const SyntheticCorpus& library = Humanoid();
-    for (size_t i = 0; i < library.clips.size(); ++i) {
-      ids.push_back(client.IngestOrFail("humanoid_" + std::to_string(i) + ".bvh",
-                                        BvhText(library.clips[i]),
-                                        {"synthetic", "clip" + std::to_string(i)}));
-    }
-    return ids;
-  }
-
-  // Creates the space "body" on every humanoid clip.
-  v1::Space CreateHumanoidSpace(Client& client, const std::string& name = "body") {
-    v1::CreateSpaceRequest request;
-    request.set_name(name);
-    v1::Space space;
-    const grpc::Status status = client.CreateSpace(request, &space);
-    EXPECT_TRUE(status.ok()) << status.error_message();
-    return space;
-  }
-
-  std::filesystem::path dir_;
-  std::string db_;
-  std::vector<std::unique_ptr<ServerProcess>> servers_;
-};
-
-// The first right-arm raise of the humanoid library: its clip index and frames (50 fps).
-const SyntheticSegment& FirstRaise() { return Humanoid().segments.front(); }
 
 // ---------------------------------------------------------------------------------------------
 // Clips.
@@ -2207,126 +2011,6 @@ TEST_F(ServerTest, BackupWhileIngestingServesTheSameSearches) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Crash safety.
-
-// Three times over: the server is killed with SIGKILL while a client ingests clip after clip
-// (single messages and chunked streams, each projected into a space), then restarted on the
-// same database. It must open (its integrity check passes), hold every acknowledged clip whole,
-// hold at most the one clip in flight besides, and have every stored clip in its index.
-TEST_F(ServerTest, KillDuringIngestLosesNoAcknowledgedClipAndLeavesNoHalfClip) {
-  ServerProcess* server = StartServer();
-  ASSERT_NE(server, nullptr);
-  std::map<std::string, int> expected_frames;  // every clip that must be stored, by name
-  {
-    Client client(testing::InsecureChannel(server->address()));
-    const std::vector<int64_t> ids = IngestHumanoid(client);
-    ASSERT_EQ(ids.size(), Humanoid().clips.size());
-    CreateHumanoidSpace(client);
-    for (size_t i = 0; i < ids.size(); ++i) {
-      expected_frames["humanoid_" + std::to_string(i)] = Humanoid().clips[i].frame_count();
-    }
-  }
-  std::vector<std::string> texts;
-  for (const Clip& clip : Humanoid().clips) texts.push_back(BvhText(clip));
-
-  for (int round = 0; round < 3; ++round) {
-    SCOPED_TRACE("round " + std::to_string(round));
-    std::atomic<int> acknowledged{0};
-    std::atomic<bool> stopped{false};  // the ingester met an error and returned
-    std::map<std::string, int> acked;  // written by the ingester, read after the join
-    std::string in_flight;
-    int in_flight_frames = 0;
-    std::thread ingester([&] {
-      Client own(testing::InsecureChannel(server->address()));
-      for (int i = 0;; ++i) {
-        const size_t source = i % texts.size();
-        const std::string name = "bulk_" + std::to_string(round) + "_" + std::to_string(i);
-        in_flight = name;
-        in_flight_frames = Humanoid().clips[source].frame_count();
-        v1::IngestClipResponse response;
-        grpc::Status status;
-        if (i % 2 == 0) {
-          status = own.Ingest(name + ".bvh", texts[source], &response);
-        } else {
-          auto context = own.Context();
-          auto writer = own.clips().IngestClipStream(context.get(), &response);
-          v1::IngestClipStreamRequest header;
-          header.set_file_name(name + ".bvh");
-          bool written = writer->Write(header);
-          for (size_t at = 0; written && at < texts[source].size(); at += 16384) {
-            v1::IngestClipStreamRequest chunk;
-            chunk.set_chunk(texts[source].substr(at, 16384));
-            written = writer->Write(chunk);
-          }
-          if (written) writer->WritesDone();
-          status = writer->Finish();
-        }
-        if (!status.ok()) {  // the server is gone (or, before the kill, a failure)
-          stopped = true;
-          return;
-        }
-        acked[name] = response.clip().frame_count();
-        ++acknowledged;
-      }
-    });
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (acknowledged < 4 + 2 * round && !stopped && std::chrono::steady_clock::now() < give_up) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    EXPECT_FALSE(stopped) << "an ingest failed before the kill";
-    std::this_thread::sleep_for(std::chrono::milliseconds(3 * round));
-    EXPECT_EQ(server->Stop(SIGKILL), 128 + SIGKILL);
-    ingester.join();
-    for (const auto& [name, frames] : acked) expected_frames[name] = frames;
-
-    server = StartServer();
-    ASSERT_NE(server, nullptr);
-    EXPECT_THAT(server->Log(), HasSubstr("loaded 1 space indices"));
-    Client client(testing::InsecureChannel(server->address()));
-    v1::ListClipsRequest list;
-    list.set_page_size(1000);
-    v1::ListClipsResponse stored;
-    ASSERT_TRUE(client.clips().ListClips(client.Context().get(), list, &stored).ok());
-    std::map<std::string, int> stored_frames;
-    int64_t any_id = 0;
-    for (const v1::Clip& clip : stored.clips()) {
-      stored_frames[clip.name()] = clip.frame_count();
-      any_id = clip.clip_id();
-    }
-    for (const auto& [name, frames] : expected_frames) {
-      const auto stored_clip = stored_frames.find(name);
-      ASSERT_NE(stored_clip, stored_frames.end()) << name << " was acknowledged but is missing";
-      EXPECT_EQ(stored_clip->second, frames) << name;
-    }
-    // Besides those, only the clip in flight may have been stored, and then whole.
-    for (const auto& [name, frames] : stored_frames) {
-      if (expected_frames.count(name) > 0) continue;
-      EXPECT_EQ(name, in_flight);
-      EXPECT_EQ(frames, in_flight_frames) << name;
-      expected_frames[name] = frames;
-    }
-    // Every stored clip reads back whole and is in the space's index.
-    for (const v1::Clip& clip : stored.clips()) {
-      v1::ExportClipRequest request;
-      request.mutable_clip()->set_clip_id(clip.clip_id());
-      v1::ExportClipResponse exported;
-      ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), request, &exported).ok());
-      absl::StatusOr<BvhReadResult> read = ReadBvh(exported.bvh());
-      ASSERT_TRUE(read.ok()) << clip.name() << ": " << read.status();
-      EXPECT_EQ(read->clip.frame_count(), clip.frame_count()) << clip.name();
-    }
-    v1::GetSpaceRequest get;
-    get.set_name("body");
-    v1::Space space;
-    ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &space).ok());
-    EXPECT_EQ(space.index().clips(), stored.clips_size());
-    v1::SearchResponse found;
-    ASSERT_TRUE(client.Search(ClipQuery("body", any_id, 0, 40), &found).ok());
-    EXPECT_EQ(found.counts().library_frames(), space.index().frames());
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
 // Propagation jobs.
 
 // Adds `labels` (manual); returns them as stored.
@@ -2706,6 +2390,262 @@ TEST_F(ServerTest, KillDuringAJobLeavesItInterruptedWithoutOutputAndItRunsAgain)
   const v1::Job again = PollJob(client, StartOrFail(client, Propagation({"long"})).job_id());
   EXPECT_EQ(again.state(), v1::JOB_STATE_SUCCEEDED) << again.error();
   EXPECT_EQ(again.labels_written(), earlier);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Crash safety: SIGKILL at random points of ingest, space creation and propagation jobs.
+
+// Rounds of the crash loop: MOTIONDB_CRASH_ROUNDS (scripts/crash-loop.sh runs 20), default 3;
+// its random kill points come from MOTIONDB_CRASH_SEED (default 1).
+int EnvInt(const char* name, int default_value) {
+  const char* value = std::getenv(name);
+  return value != nullptr ? std::atoi(value) : default_value;
+}
+
+// What the client of an ingest loop saw when the server was killed under it.
+struct CutIngest {
+  std::map<std::string, int> acknowledged;  // frames of each clip answered OK, by name
+  std::string in_flight;                    // the clip sent when the answer failed
+  int in_flight_frames = 0;
+  bool failed_early = false;  // an ingest failed before the kill
+};
+
+// Ingests humanoid clips ("<prefix>_<i>", single messages and chunked streams alternately) until
+// a call fails, while the server is killed after `delay` past the second acknowledged clip.
+CutIngest IngestUntilKilled(ServerProcess& server, const std::string& prefix,
+                            std::chrono::milliseconds delay) {
+  std::vector<std::string> texts;
+  for (const Clip& clip : Humanoid().clips) texts.push_back(BvhText(clip));
+  CutIngest cut;
+  std::atomic<int> acknowledged{0};
+  std::atomic<bool> stopped{false};
+  std::thread ingester([&] {
+    Client own(testing::InsecureChannel(server.address()));
+    for (int i = 0;; ++i) {
+      const size_t source = i % texts.size();
+      const std::string name = prefix + "_" + std::to_string(i);
+      cut.in_flight = name;
+      cut.in_flight_frames = Humanoid().clips[source].frame_count();
+      v1::IngestClipResponse response;
+      grpc::Status status;
+      if (i % 2 == 0) {
+        status = own.Ingest(name + ".bvh", texts[source], &response);
+      } else {
+        auto context = own.Context();
+        auto writer = own.clips().IngestClipStream(context.get(), &response);
+        v1::IngestClipStreamRequest header;
+        header.set_file_name(name + ".bvh");
+        bool written = writer->Write(header);
+        for (size_t at = 0; written && at < texts[source].size(); at += 16384) {
+          v1::IngestClipStreamRequest chunk;
+          chunk.set_chunk(texts[source].substr(at, 16384));
+          written = writer->Write(chunk);
+        }
+        if (written) writer->WritesDone();
+        status = writer->Finish();
+      }
+      if (!status.ok()) {  // the server is gone (or, before the kill, a failure)
+        stopped = true;
+        return;
+      }
+      cut.acknowledged[name] = response.clip().frame_count();
+      ++acknowledged;
+    }
+  });
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (acknowledged < 2 && !stopped && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(delay);
+  cut.failed_early = stopped;
+  EXPECT_EQ(server.Stop(SIGKILL), 128 + SIGKILL);
+  ingester.join();
+  return cut;
+}
+
+// Kills the server `delay` after a call to `operation` started on its own thread.
+void KillDuring(ServerProcess& server, std::chrono::milliseconds delay,
+                const std::function<void(Client&)>& operation) {
+  std::thread caller([&] {
+    Client own(testing::InsecureChannel(server.address()));
+    operation(own);
+  });
+  std::this_thread::sleep_for(delay);
+  EXPECT_EQ(server.Stop(SIGKILL), 128 + SIGKILL);
+  caller.join();
+}
+
+// Every propagated label of `job_id`.
+std::set<int64_t> LabelsOfJob(const std::vector<v1::Label>& labels, const std::string& job_id) {
+  std::set<int64_t> ids;
+  for (const v1::Label& label : labels) {
+    if (label.job_id() == job_id) ids.insert(label.label_id());
+  }
+  return ids;
+}
+
+// Rounds of: a SIGKILL at a random moment of an ingest loop (single messages and chunked
+// streams, each projected into a space), of a space's creation, or of a propagation job; then a
+// restart on the same database. It must open (its integrity check passes) and hold every
+// acknowledged clip whole, at most the one clip in flight besides (whole), every stored clip in
+// the space's index; a space cut off is absent or whole (indexed and searchable); a job cut off
+// is interrupted with none of its output, the earlier output kept, or succeeded with its output
+// whole.
+TEST_F(ServerTest, KillAtRandomPointsLosesNoAcknowledgedWriteAndLeavesNoHalfWrite) {
+  const int rounds = EnvInt("MOTIONDB_CRASH_ROUNDS", 3);
+  const int seed = EnvInt("MOTIONDB_CRASH_SEED", 1);
+  std::mt19937 random(seed);
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  std::map<std::string, int> expected_frames;  // every clip that must be stored, by name
+  std::chrono::milliseconds creation_time, job_time;
+  std::vector<v1::Label> job_output;  // the propagated labels of the last whole job
+  {
+    Client client(testing::InsecureChannel(server->address()));
+    const std::vector<int64_t> ids = IngestHumanoid(client);
+    ASSERT_EQ(ids.size(), Humanoid().clips.size());
+    for (size_t i = 0; i < ids.size(); ++i) {
+      expected_frames["humanoid_" + std::to_string(i)] = Humanoid().clips[i].frame_count();
+    }
+    auto started = std::chrono::steady_clock::now();
+    CreateHumanoidSpace(client);
+    creation_time = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::steady_clock::now() - started);
+    LabelManyRanges(client, ids, 400);
+    started = std::chrono::steady_clock::now();
+    const v1::Job first = PollJob(client, StartOrFail(client, Propagation({"long"})).job_id());
+    ASSERT_EQ(first.state(), v1::JOB_STATE_SUCCEEDED) << first.error();
+    job_time = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::steady_clock::now() - started);
+    job_output = Propagated(client);
+    ASSERT_FALSE(job_output.empty());
+  }
+  std::set<std::string> known_spaces = {"body"};  // spaces that must be there
+  const std::vector<std::string> kinds = {"ingest", "space creation", "propagation job"};
+  for (int round = 0; round < rounds; ++round) {
+    const int kind = round % 3;
+    // Up to 1.5x the operation's uninterrupted time on the library as it is now (both grow with
+    // it), so that some kills come after its end.
+    const double growth = static_cast<double>(expected_frames.size()) / Humanoid().clips.size();
+    const int window =
+        kind == 0
+            ? 150
+            : static_cast<int>(1.5 * growth *
+                               static_cast<double>((kind == 1 ? creation_time : job_time).count()));
+    const std::chrono::milliseconds delay(std::uniform_int_distribution<int>(0, window)(random));
+    SCOPED_TRACE(absl::StrCat("round ", round, " (seed ", seed, "): kill during ", kinds[kind],
+                              " after ", delay.count(), " ms"));
+    const std::string space_name = "round_" + std::to_string(round);
+    std::string job_id;
+    std::string outcome;  // what the round found, for the crash loop's report
+    if (kind == 0) {
+      CutIngest cut = IngestUntilKilled(*server, "bulk_" + std::to_string(round), delay);
+      EXPECT_FALSE(cut.failed_early) << "an ingest failed before the kill";
+      outcome = absl::StrCat(cut.acknowledged.size(), " clips acknowledged; the clip in flight ");
+      for (const auto& [name, frames] : cut.acknowledged) expected_frames[name] = frames;
+      // Only the clip in flight may have been stored besides, and then whole.
+      expected_frames.emplace(cut.in_flight, -cut.in_flight_frames);
+    } else if (kind == 1) {
+      KillDuring(*server, delay, [&](Client& own) {
+        v1::CreateSpaceRequest request;
+        request.set_name(space_name);
+        v1::Space space;
+        own.CreateSpace(request, &space);
+      });
+    } else {
+      Client client(testing::InsecureChannel(server->address()));
+      job_id = StartOrFail(client, Propagation({"long"})).job_id();
+      KillDuring(*server, delay, [](Client&) {});
+    }
+
+    server = StartServer();
+    ASSERT_NE(server, nullptr);
+    Client client(testing::InsecureChannel(server->address()));
+    absl::StatusOr<std::unique_ptr<storage::SqliteConnection>> file =
+        storage::SqliteConnection::Open(db_, storage::SqliteConnection::Mode::kReadOnly, 1000);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(*(*file)->QueryText("PRAGMA integrity_check"), "ok");
+
+    v1::ListClipsRequest list;
+    list.set_page_size(1000);
+    v1::ListClipsResponse stored;
+    ASSERT_TRUE(client.clips().ListClips(client.Context().get(), list, &stored).ok());
+    std::map<std::string, int> stored_frames;
+    for (const v1::Clip& clip : stored.clips()) stored_frames[clip.name()] = clip.frame_count();
+    for (auto it = expected_frames.begin(); it != expected_frames.end();) {
+      const auto [name, frames] = *it;
+      const auto stored_clip = stored_frames.find(name);
+      if (frames < 0) {  // the clip in flight: absent, or stored whole
+        if (stored_clip == stored_frames.end()) {
+          outcome += "absent";
+          it = expected_frames.erase(it);
+          continue;
+        }
+        outcome += "stored whole";
+        EXPECT_EQ(stored_clip->second, -frames) << name;
+        it->second = -frames;
+      } else {
+        EXPECT_NE(stored_clip, stored_frames.end()) << name << " was acknowledged but is missing";
+        if (stored_clip != stored_frames.end()) {
+          EXPECT_EQ(stored_clip->second, frames) << name;
+        }
+      }
+      ++it;
+    }
+    EXPECT_EQ(stored_frames.size(), expected_frames.size());
+    // Every stored clip reads back whole and is in the space's index.
+    for (const v1::Clip& clip : stored.clips()) {
+      v1::ExportClipRequest request;
+      request.mutable_clip()->set_clip_id(clip.clip_id());
+      v1::ExportClipResponse exported;
+      ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), request, &exported).ok());
+      absl::StatusOr<BvhReadResult> read = ReadBvh(exported.bvh());
+      ASSERT_TRUE(read.ok()) << clip.name() << ": " << read.status();
+      EXPECT_EQ(read->clip.frame_count(), clip.frame_count()) << clip.name();
+    }
+    // Every space (a space cut off while being created is absent or whole) indexes every clip.
+    v1::ListSpacesResponse spaces;
+    ASSERT_TRUE(
+        client.spaces().ListSpaces(client.Context().get(), v1::ListSpacesRequest(), &spaces).ok());
+    std::set<std::string> space_names;
+    for (const v1::Space& space : spaces.spaces()) space_names.insert(space.name());
+    for (const std::string& name : known_spaces) EXPECT_EQ(space_names.count(name), 1u) << name;
+    if (space_names.count(space_name) > 0) known_spaces.insert(space_name);
+    if (kind == 1) outcome = space_names.count(space_name) > 0 ? "space whole" : "space absent";
+    EXPECT_EQ(space_names, known_spaces);
+    for (const v1::Space& space : spaces.spaces()) {
+      EXPECT_EQ(space.index().clips(), stored.clips_size()) << space.name();
+      v1::SearchResponse found;
+      ASSERT_TRUE(
+          client.Search(ClipQuery(space.name(), stored.clips(0).clip_id(), 0, 40), &found).ok());
+      EXPECT_EQ(found.counts().library_frames(), space.index().frames()) << space.name();
+      EXPECT_GT(found.results_size(), 0) << space.name();
+    }
+    if (!job_id.empty()) {
+      v1::GetJobRequest get;
+      get.set_job_id(job_id);
+      v1::Job job;
+      ASSERT_TRUE(client.jobs().GetJob(client.Context().get(), get, &job).ok());
+      const std::vector<v1::Label> labels = Propagated(client);
+      outcome = absl::StrCat("job ", v1::JobState_Name(job.state()), " at ", job.done(), "/",
+                             job.total(), " labels, ", labels.size(), " propagated labels");
+      if (job.state() == v1::JOB_STATE_SUCCEEDED) {
+        EXPECT_EQ(static_cast<int64_t>(LabelsOfJob(labels, job_id).size()), job.labels_written());
+        EXPECT_EQ(labels.size(), LabelsOfJob(labels, job_id).size());
+        job_output = labels;
+      } else {
+        EXPECT_EQ(job.state(), v1::JOB_STATE_INTERRUPTED);
+        EXPECT_TRUE(LabelsOfJob(labels, job_id).empty());
+        ASSERT_EQ(labels.size(), job_output.size());
+        for (size_t i = 0; i < labels.size(); ++i) {
+          EXPECT_EQ(labels[i].SerializeAsString(), job_output[i].SerializeAsString());
+        }
+      }
+    }
+    std::cout << "round " << round << ": SIGKILL " << delay.count() << " ms into " << kinds[kind]
+              << " (up to " << window << " ms): " << outcome << std::endl;
+    if (HasFailure()) break;
+  }
 }
 
 }  // namespace

@@ -71,8 +71,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   auto state = std::make_unique<State>();
   State& s = *state;
   s.options = options;
-  MOTIONDB_ASSIGN_OR_RETURN(s.database,
-                            Prefixed(options.db_path, storage::Database::Open(options.db_path)));
+  MOTIONDB_ASSIGN_OR_RETURN(s.database, storage::Database::Open(options.db_path));
   s.catalog = std::make_unique<Catalog>(*s.database, s.registry);
   const auto load_start = std::chrono::steady_clock::now();
   MOTIONDB_RETURN_IF_ERROR(s.catalog->LoadIndices());

@@ -8,6 +8,7 @@
 #include <google/protobuf/descriptor.h>
 #include <grpcpp/server_context.h>
 
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_replace.h"
@@ -68,8 +69,9 @@ class RequestLogger : public grpc::experimental::Interceptor {
                                 ? "-"
                                 : absl::string_view(given->second.data(), given->second.size()));
       }
-      log_.Record(face, info_->method(), methods->GetSendStatus().error_code(), latency.count(),
-                  peer);
+      const grpc::Status status = methods->GetSendStatus();
+      log_.Record(face, info_->method(), status.error_code(), latency.count(), peer,
+                  status.error_message());
     }
     methods->Proceed();
   }
@@ -85,17 +87,28 @@ class RequestLogger : public grpc::experimental::Interceptor {
 void LogLine(absl::string_view text) { Write(absl::StrCat(Now(), " ", text, "\n")); }
 
 void RequestLog::Record(absl::string_view face, absl::string_view method, grpc::StatusCode code,
-                        double latency_ms, absl::string_view peer) {
+                        double latency_ms, absl::string_view peer, absl::string_view message) {
   const std::string code_name = StatusCodeName(code);
   metrics_.CountCall(face, MethodLabel(method), code_name, latency_ms / 1000);
-  WriteLine(method, code_name, latency_ms, peer);
+  // What the operator must act on (a full disk, a damaged file, a limit reached) is told with
+  // its reason; a client's own mistakes are told to the client only.
+  const bool server_side =
+      code == grpc::StatusCode::RESOURCE_EXHAUSTED || code == grpc::StatusCode::INTERNAL ||
+      code == grpc::StatusCode::UNKNOWN || code == grpc::StatusCode::DATA_LOSS ||
+      code == grpc::StatusCode::UNAVAILABLE;
+  WriteLine(method, code_name, latency_ms, peer, server_side ? message : "");
 }
 
 void RequestLog::WriteLine(absl::string_view what, absl::string_view outcome, double latency_ms,
-                           absl::string_view peer) {
+                           absl::string_view peer, absl::string_view reason) {
   if (!write_lines_) return;
-  Write(absl::StrFormat("%s %s %s %.2fms %s\n", Now(), what, outcome, latency_ms,
-                        peer.empty() ? "-" : peer));
+  constexpr size_t kMaxReason = 300;
+  Write(absl::StrFormat(
+      "%s %s %s %.2fms %s%s\n", Now(), what, outcome, latency_ms, peer.empty() ? "-" : peer,
+      // Escaped, so that a message cannot split or forge a line.
+      reason.empty() ? ""
+                     : absl::StrCat(" \"", absl::CHexEscape(reason.substr(0, kMaxReason)),
+                                    reason.size() > kMaxReason ? "..." : "", "\"")));
 }
 
 grpc::experimental::Interceptor* RequestLoggerFactory::CreateServerInterceptor(

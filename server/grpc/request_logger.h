@@ -1,6 +1,7 @@
 // Every call, told once: a line on stderr (unless --quiet) and the server's metrics
 // (server/server_metrics.h). A line holds the time, method, status code name, latency and peer:
 //   2024-05-01T12:00:00.123Z /motiondb.v1.SearchService/Search OK 3.21ms ipv4:127.0.0.1:53422
+// and, for a failure of the server's own (a full disk, say), the status message in quotes.
 // A call of the HTTP face (server/http/) reaches the services in-process; its peer is shown as
 // http:<the HTTP client's address> and its metrics carry face="http".
 //
@@ -38,13 +39,15 @@ class RequestLog {
 
   // A call of `method` on `face` that ended with `code` after `latency_ms`. Metrics name a
   // method that no service of this process has as "unknown" (a refused call's path is the
-  // client's to choose).
+  // client's to choose). The line ends with `message`, quoted and escaped, for the codes of
+  // the server's own conditions (RESOURCE_EXHAUSTED, INTERNAL, UNKNOWN, DATA_LOSS, UNAVAILABLE).
   void Record(absl::string_view face, absl::string_view method, grpc::StatusCode code,
-              double latency_ms, absl::string_view peer);
+              double latency_ms, absl::string_view peer, absl::string_view message = "");
   // The line alone, for what is no call of a method (the HTTP face's own refusals, counted in
-  // its own metrics): `what` in the method's place and `outcome` in the code's.
+  // its own metrics): `what` in the method's place and `outcome` in the code's, and `reason`
+  // (quoted and escaped) when not empty.
   void WriteLine(absl::string_view what, absl::string_view outcome, double latency_ms,
-                 absl::string_view peer);
+                 absl::string_view peer, absl::string_view reason = "");
 
  private:
   const bool write_lines_;

@@ -32,9 +32,9 @@ FuzzLibrary* Make() {
   // Random bytes make protobuf log every string field that is not UTF-8: noise, and slow.
   google::protobuf::SetLogHandler(nullptr);
   auto library = new FuzzLibrary;
-  const std::string folder = FreshFolder();
+  library->path = FreshFolder() + "/fuzz.sqlite";
   absl::StatusOr<std::unique_ptr<storage::Database>> database =
-      storage::Database::Open(folder + "/fuzz.sqlite");
+      storage::Database::Open(library->path);
   if (!database.ok()) Die(database.status());
   library->database = *std::move(database);
   library->catalog = std::make_unique<server::Catalog>(*library->database, library->registry);

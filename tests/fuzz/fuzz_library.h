@@ -6,6 +6,7 @@
 #define MOTIONDB_TESTS_FUZZ_FUZZ_LIBRARY_H_
 
 #include <memory>
+#include <string>
 
 #include "server/catalog.h"
 #include "server/index_registry.h"
@@ -14,6 +15,7 @@
 namespace motiondb::fuzz {
 
 struct FuzzLibrary {
+  std::string path;  // the SQLite file
   std::unique_ptr<storage::Database> database;
   server::IndexRegistry registry;
   std::unique_ptr<server::Catalog> catalog;

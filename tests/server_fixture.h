@@ -1,0 +1,199 @@
+// The fixture of the server's integration tests (server_test.cc, server_fault_test.cc): a
+// synthetic library, a client of one server over the generated stubs, and a temporary folder
+// whose database the real motiondb-server binary is started on.
+#ifndef MOTIONDB_TESTS_SERVER_FIXTURE_H_
+#define MOTIONDB_TESTS_SERVER_FIXTURE_H_
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "core/motion/clip.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/job_service.grpc.pb.h"
+#include "motiondb/v1/label_service.grpc.pb.h"
+#include "motiondb/v1/search_service.grpc.pb.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
+#include "motiondb/v1/space_service.grpc.pb.h"
+#include "testing/server_process.h"
+#include "testing/synthetic_corpus.h"
+
+namespace motiondb {
+
+namespace v1 = ::motiondb::v1;
+
+// A small library of the synthetic humanoid (21 joints) with arm raises and shrugs at 50 fps,
+// in clips of about 20 s; generated once.
+const SyntheticCorpus& Humanoid();
+// The first right-arm raise of the humanoid library: its clip index and frames (50 fps).
+const SyntheticSegment& FirstRaise();
+
+std::string BvhText(const Clip& clip);
+// A 3-joint chain (another skeleton than the humanoid's) turning slowly, 61 frames at 30 fps.
+Clip ChainClip(double speed = 0.02);
+
+// A stored range as the query. These tests check that a search finds its own query first,
+// so the query's range is kept (exclude_query defaults to true).
+v1::SearchRequest ClipQuery(const std::string& space, int64_t clip_id, int first, int last);
+
+// ---------------------------------------------------------------------------------------------
+// A client of one server.
+
+class Client {
+ public:
+  explicit Client(std::shared_ptr<grpc::Channel> channel, std::string token = "")
+      : channel_(std::move(channel)),
+        token_(std::move(token)),
+        clips_(v1::ClipService::NewStub(channel_)),
+        spaces_(v1::SpaceService::NewStub(channel_)),
+        search_(v1::SearchService::NewStub(channel_)),
+        server_(v1::ServerService::NewStub(channel_)),
+        labels_(v1::LabelService::NewStub(channel_)),
+        jobs_(v1::JobService::NewStub(channel_)) {}
+
+  // A call context carrying the token and a deadline (generous by default: a test that hangs
+  // should fail, not stall the suite).
+  std::unique_ptr<grpc::ClientContext> Context(
+      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) const {
+    auto context = std::make_unique<grpc::ClientContext>();
+    context->set_deadline(std::chrono::system_clock::now() + deadline);
+    if (!token_.empty()) context->AddMetadata("authorization", "Bearer " + token_);
+    return context;
+  }
+
+  grpc::Status Ingest(const std::string& file_name, const std::string& bvh,
+                      v1::IngestClipResponse* response, std::vector<std::string> tags = {}) {
+    v1::IngestClipRequest request;
+    request.set_file_name(file_name);
+    request.set_bvh(bvh);
+    for (const std::string& tag : tags) request.add_tags(tag);
+    return clips_->IngestClip(Context().get(), request, response);
+  }
+  // The new clip's id, or -1 after a failed expectation.
+  int64_t IngestOrFail(const std::string& file_name, const std::string& bvh,
+                       std::vector<std::string> tags = {}) {
+    v1::IngestClipResponse response;
+    const grpc::Status status = Ingest(file_name, bvh, &response, std::move(tags));
+    EXPECT_TRUE(status.ok()) << file_name << ": " << status.error_message();
+    return status.ok() ? response.clip().clip_id() : -1;
+  }
+
+  grpc::Status CreateSpace(const v1::CreateSpaceRequest& request, v1::Space* space) {
+    return spaces_->CreateSpace(Context().get(), request, space);
+  }
+  grpc::Status Search(const v1::SearchRequest& request, v1::SearchResponse* response,
+                      std::chrono::milliseconds deadline = std::chrono::milliseconds(30000)) {
+    return search_->Search(Context(deadline).get(), request, response);
+  }
+
+  v1::ClipService::Stub& clips() { return *clips_; }
+  v1::SpaceService::Stub& spaces() { return *spaces_; }
+  v1::SearchService::Stub& search() { return *search_; }
+  v1::ServerService::Stub& server() { return *server_; }
+  v1::LabelService::Stub& labels() { return *labels_; }
+  v1::JobService::Stub& jobs() { return *jobs_; }
+  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
+
+ private:
+  std::shared_ptr<grpc::Channel> channel_;
+  std::string token_;
+  std::unique_ptr<v1::ClipService::Stub> clips_;
+  std::unique_ptr<v1::SpaceService::Stub> spaces_;
+  std::unique_ptr<v1::SearchService::Stub> search_;
+  std::unique_ptr<v1::ServerService::Stub> server_;
+  std::unique_ptr<v1::LabelService::Stub> labels_;
+  std::unique_ptr<v1::JobService::Stub> jobs_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Fixture: a temporary folder with the database; servers started on it.
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::path(::testing::TempDir()) /
+           ("server_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    db_ = (dir_ / "motiondb.sqlite").string();
+  }
+  void TearDown() override {
+    StopServers();
+    std::filesystem::remove_all(dir_);
+  }
+
+  // Kills the servers still running, after printing their logs when the test failed.
+  void StopServers() {
+    if (HasFailure()) {
+      for (const auto& server : servers_) {
+        std::cerr << "---- server log ----\n" << server->Log() << "--------------------\n";
+      }
+    }
+    servers_.clear();
+  }
+
+  // Starts a server with `args`, on the test's database unless they give --db; null after a
+  // failed assertion.
+  testing::ServerProcess* StartServer(std::vector<std::string> args = {},
+                                      const std::string& token = "", bool tls = false) {
+    if (std::find(args.begin(), args.end(), "--db") == args.end()) {
+      args.insert(args.begin(), {"--db", db_});
+    }
+    auto server = std::make_unique<testing::ServerProcess>();
+    std::string error;
+    if (!server->Start(args, &error)) {
+      ADD_FAILURE() << error;
+      return nullptr;
+    }
+    if (!tls && !testing::WaitUntilServing(testing::InsecureChannel(server->address()), token)) {
+      ADD_FAILURE() << "the server never reported SERVING:\n" << server->Log();
+      return nullptr;
+    }
+    servers_.push_back(std::move(server));
+    return servers_.back().get();
+  }
+
+  std::string WriteFile(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+
+  // Ingests the synthetic humanoid library ("humanoid_0".. with tags "synthetic" and "clip<i>");
+  // returns the clip ids.
+  std::vector<int64_t> IngestHumanoid(Client& client) {
+    std::vector<int64_t> ids;
+    const SyntheticCorpus& library = Humanoid();
+    for (size_t i = 0; i < library.clips.size(); ++i) {
+      ids.push_back(client.IngestOrFail("humanoid_" + std::to_string(i) + ".bvh",
+                                        BvhText(library.clips[i]),
+                                        {"synthetic", "clip" + std::to_string(i)}));
+    }
+    return ids;
+  }
+
+  // Creates the space "body" on every humanoid clip.
+  v1::Space CreateHumanoidSpace(Client& client, const std::string& name = "body") {
+    v1::CreateSpaceRequest request;
+    request.set_name(name);
+    v1::Space space;
+    const grpc::Status status = client.CreateSpace(request, &space);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return space;
+  }
+
+  std::filesystem::path dir_;
+  std::string db_;
+  std::vector<std::unique_ptr<testing::ServerProcess>> servers_;
+};
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_TESTS_SERVER_FIXTURE_H_
