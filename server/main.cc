@@ -56,6 +56,11 @@ void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http) {
   app.add_option("--web-root", http->web_root, "the built web UI served at /")
       ->type_name("DIR")
       ->default_str(motiondb::server::DefaultWebRoot());
+  app.add_option("--http-timeout-s", http->call_timeout_s,
+                 "an HTTP API call still running after this long ends with 504")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(motiondb::cli::NumberAbove(0));
 }
 
 void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFlags* flags) {

@@ -393,6 +393,28 @@ TEST_F(HttpTest, SearchAnswersAsGrpc) {
   }
 }
 
+// HTTP clients send no deadline: the server gives each API call --http-timeout-s, past which the
+// call's work stops and the answer is 504 with DEADLINE_EXCEEDED. An exhaustive search with every
+// dimension in the warp takes far longer than the 1 ms given here on any machine (and longer
+// still under load), while gRPC calls keep their own deadlines.
+TEST_F(HttpTest, ApiCallsEndAtTheHttpTimeout) {
+  ServerProcess* server = Start({"--http-timeout-s", "0.001"});
+  ASSERT_NE(server, nullptr);
+  const auto channel = testing::InsecureChannel(server->address());
+  ASSERT_NO_FATAL_FAILURE(LoadLibrary(channel));
+  const std::string query = absl::StrCat(
+      R"({"space":"body","clip":{"clip_id":")", ids_[0],
+      R"(","first_frame":0,"last_frame":239},"exact":true,"dtw_dims":60,)", R"("slope_limit":4})");
+  httplib::Client http = HttpClient(*server);
+  const ErrorAnswer ended = ErrorOf(http.Post("/v1/search", query, "application/json"));
+  EXPECT_EQ(ended.status, 504);
+  EXPECT_EQ(ended.code, static_cast<int>(grpc::StatusCode::DEADLINE_EXCEEDED));
+  v1::SearchRequest request;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(query, &request).ok());
+  auto search = v1::SearchService::NewStub(channel);
+  EXPECT_GT(GrpcAnswer(*search, &v1::SearchService::Stub::Search, request).results_size(), 0);
+}
+
 TEST_F(HttpTest, WritesGoThroughTheSameServices) {
   ServerProcess* server = Start({"--test-job-pause-after", "0"});
   ASSERT_NE(server, nullptr);

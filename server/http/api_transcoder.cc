@@ -57,11 +57,13 @@ HttpReply FileReply(const Message& response) {
 
 }  // namespace
 
-ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel) : stub_(std::move(channel)) {}
+ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s)
+    : stub_(std::move(channel)), call_timeout_(call_timeout_s) {}
 
 absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
-    std::shared_ptr<grpc::Channel> channel) {
-  auto transcoder = std::unique_ptr<ApiTranscoder>(new ApiTranscoder(std::move(channel)));
+    std::shared_ptr<grpc::Channel> channel, double call_timeout_s) {
+  auto transcoder =
+      std::unique_ptr<ApiTranscoder>(new ApiTranscoder(std::move(channel), call_timeout_s));
   for (const ApiRoute& route : ApiRoutes()) {
     const MethodDescriptor* method =
         google::protobuf::DescriptorPool::generated_pool()->FindMethodByName(route.rpc);
@@ -76,6 +78,9 @@ absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
 grpc::Status ApiTranscoder::Invoke(const MethodDescriptor& method, const Message& request,
                                    Message* response, absl::string_view peer) const {
   grpc::ClientContext context;
+  context.set_deadline(
+      std::chrono::system_clock::now() +
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(call_timeout_));
   context.AddMetadata(kHttpPeerMetadata, std::string(peer));
   std::promise<grpc::Status> done;
   stub_.UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),

@@ -6,6 +6,7 @@
 #ifndef MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_
 #define MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
@@ -41,9 +42,10 @@ struct HttpCall {
 
 class ApiTranscoder {
  public:
-  // INTERNAL when a route names a method that no linked service has.
+  // Calls through `channel`, each with a deadline `call_timeout_s` from its start. INTERNAL when
+  // a route names a method that no linked service has.
   static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
-      std::shared_ptr<grpc::Channel> channel);
+      std::shared_ptr<grpc::Channel> channel, double call_timeout_s);
 
   // The route's call: its request from the path values and the query parameters, or the body
   // (json_body); 400 with the error body for a request that does not convert, else the call's
@@ -57,7 +59,7 @@ class ApiTranscoder {
   using GenericStub =
       grpc::TemplatedGenericStub<google::protobuf::Message, google::protobuf::Message>;
 
-  explicit ApiTranscoder(std::shared_ptr<grpc::Channel> channel);
+  ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s);
   // Calls `method` in-process and waits for its answer.
   grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
                       const google::protobuf::Message& request, google::protobuf::Message* response,
@@ -66,6 +68,7 @@ class ApiTranscoder {
                            google::protobuf::Message* request) const;
 
   mutable GenericStub stub_;  // UnaryCall is not const, but the stub keeps no per-call state
+  const std::chrono::duration<double> call_timeout_;
   std::map<std::string, const google::protobuf::MethodDescriptor*> methods_;  // by rpc name
 };
 

@@ -300,7 +300,8 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
                                                               MotionDbServer& server) {
   MOTIONDB_ASSIGN_OR_RETURN(const auto host_port, SplitHostPort(options.listen));
   auto state = std::make_unique<State>(server);
-  MOTIONDB_ASSIGN_OR_RETURN(state->api, ApiTranscoder::Create(server.InProcessChannel()));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      state->api, ApiTranscoder::Create(server.InProcessChannel(), options.call_timeout_s));
   MOTIONDB_ASSIGN_OR_RETURN(state->http, NewHttpServer(server.options()));
   httplib::Server& http = *state->http;
   const size_t threads = std::max<size_t>(kMinThreads, 2 * std::thread::hardware_concurrency());

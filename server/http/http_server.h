@@ -23,6 +23,10 @@ struct HttpOptions {
   std::string listen = "127.0.0.1:8080";
   // The built web UI served at / (--web-root); empty: DefaultWebRoot().
   std::string web_root;
+  // An API call still running after this many seconds ends with 504 (DEADLINE_EXCEEDED), its
+  // work stopped as a gRPC call's deadline stops it; HTTP clients send no deadline of their own
+  // (--http-timeout-s).
+  double call_timeout_s = 600;
 };
 
 // The web/dist folder of the source tree this binary was built from.

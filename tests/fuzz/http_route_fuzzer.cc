@@ -44,7 +44,10 @@ HttpFace& TheHttpFace() {
       std::abort();
     }
     made->server = *std::move(server);
-    auto transcoder = motiondb::server::ApiTranscoder::Create(made->server->InProcessChannel());
+    // A deadline as the server's default, shorter: large but valid parameters are slow, not
+    // wrong.
+    auto transcoder =
+        motiondb::server::ApiTranscoder::Create(made->server->InProcessChannel(), 0.2);
     if (!transcoder.ok()) std::abort();
     made->transcoder = *std::move(transcoder);
     for (const ApiRoute& route : motiondb::server::ApiRoutes()) {
