@@ -685,14 +685,19 @@ void PrintRow(const std::string& name, int k, int max_results, const Score& scor
   // Per calibration: coverage and accuracy at the confident value (clips only), and s0.
   std::string calibrated;
   for (int c = 0; c < kCalibrations; ++c) {
-    const auto [low, high] = std::minmax_element(score.scales[c].begin(), score.scales[c].end());
     absl::StrAppend(&calibrated,
                     score.frames > 0
                         ? " | | "
                         : absl::StrFormat(" %.3f | %.3f |", Ratio(score.confident[c], all.total),
-                                          Ratio(score.confident_right[c], score.confident[c])),
-                    absl::StrFormat(" %.3f (%.3f-%.3f) |", bench::Percentile(score.scales[c], 0.5),
-                                    *low, *high));
+                                          Ratio(score.confident_right[c], score.confident[c])));
+    const std::vector<double>& scales = score.scales[c];
+    if (scales.empty()) {  // an experiment with nothing to evaluate runs no job
+      absl::StrAppend(&calibrated, " |");
+      continue;
+    }
+    const auto [low, high] = std::minmax_element(scales.begin(), scales.end());
+    absl::StrAppend(&calibrated, absl::StrFormat(" %.3f (%.3f-%.3f) |",
+                                                 bench::Percentile(scales, 0.5), *low, *high));
   }
   std::printf("| %s | %d | %d | %d | %lld | %.3f | %.3f | %.3f%s|%s\n", name.c_str(), k,
               max_results, score.jobs, static_cast<long long>(all.total),

@@ -135,9 +135,11 @@ TEST_F(SpaceScaleTest, TheScaleDoesNotDependOnTheJob) {
       SpaceScoreScale(*registry_.Find("body"), *runner_, [] { return false; });
   ASSERT_TRUE(scale.ok()) << scale.status();
   ASSERT_NE(*scale, 1.0) << "no window of the sample got a full list: the library is too small";
+  const absl::StatusOr<storage::LabelPage> manual =
+      database_->ListLabels({.page_size = 100, .page_token = ""}, {});
+  ASSERT_TRUE(manual.ok()) << manual.status();
   std::map<int64_t, double> manual_values;
-  for (const auto& label :
-       database_->ListLabels({.page_size = 100, .page_token = ""}, {})->labels) {
+  for (const storage::LabelRecord& label : manual->labels) {
     manual_values[label.label_id] = label.value;
   }
   int checked = 0;
