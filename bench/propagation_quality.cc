@@ -15,12 +15,17 @@
 // takes of bandai2-normal's non-example clips; takes of each bandai1 style (from the 14 styles
 // recorded by one actor each) with examples from other styles. Only clips whose content has an
 // example are evaluated.
+// The similarity factor's s0, two ways: the server's (the space's scale, as the labels' values
+// imply it) and the job's own (the median last score of the examples' full result lists, the
+// server's s0 before the space's scale, from the same searches run here); per way, s0 per job
+// and the clips whose strongest covering label reaches value 0.5 (coverage and accuracy there).
 //
 // usage: propagation_quality [--seeds N] [--max-results M]... [--take-clips N]
 #include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
@@ -43,6 +48,7 @@
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/job_service.grpc.pb.h"
 #include "motiondb/v1/label_service.grpc.pb.h"
+#include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "testing/labelled_index.h"
 #include "testing/server_process.h"
@@ -64,6 +70,15 @@ struct Flags {
 constexpr int kPool = 3;  // bandai2-normal examples set aside per content and seed (k <= kPool)
 constexpr char kSpace[] = "body";
 constexpr char kNone[] = "-";  // the prediction of a clip or frame without a label
+// The value a user asking for confident labels would filter on (FindLabels' min_value): where
+// the score scale s0 matters. Which labels a job keeps and which is strongest do not depend on
+// s0 (one job's values are one decreasing function of the scores, its examples all of value 1).
+constexpr double kConfidentValue = 0.5;
+
+// The two calibrations of s0 compared: the server's (the space's scale since issue 13's
+// calibration, as the labels' values imply it) and the job's own, the median last score of the
+// job's full result lists (the server's s0 before), computed here from the same searches.
+enum Calibration { kSpaceScale, kJobScale, kCalibrations };
 
 // A clip of the corpus as ingested.
 struct CorpusClip {
@@ -103,7 +118,8 @@ class Api {
       : clips_(v1::ClipService::NewStub(channel)),
         spaces_(v1::SpaceService::NewStub(channel)),
         labels_(v1::LabelService::NewStub(channel)),
-        jobs_(v1::JobService::NewStub(channel)) {}
+        jobs_(v1::JobService::NewStub(channel)),
+        search_(v1::SearchService::NewStub(channel)) {}
 
   // The clip as stored.
   absl::StatusOr<v1::Clip> Ingest(const std::string& name, const std::string& bvh,
@@ -166,6 +182,28 @@ class Api {
     return PropagatedLabels();
   }
 
+  // The job's own s0 as the server computed it before the space's scale: the median, over the
+  // examples' searches that return all max_results hits with a positive last score, of that
+  // score; 1 when there is none.
+  absl::StatusOr<double> JobScale(const std::vector<const CorpusClip*>& examples,
+                                  const std::vector<std::string>& tags, int max_results) {
+    std::vector<double> last_scores;
+    for (const CorpusClip* example : examples) {
+      v1::SearchRequest search;
+      search.set_space(kSpace);
+      search.mutable_clip()->set_clip_id(example->id);
+      search.set_max_results(max_results);
+      for (const std::string& tag : tags) search.add_tags(tag);
+      v1::SearchResponse found;
+      grpc::ClientContext context;
+      MOTIONDB_RETURN_IF_ERROR(FromGrpc(search_->Search(&context, search, &found), "Search"));
+      if (found.results_size() == max_results && found.results().rbegin()->score() > 0) {
+        last_scores.push_back(found.results().rbegin()->score());
+      }
+    }
+    return last_scores.empty() ? 1 : bench::Percentile(last_scores, 0.5);
+  }
+
  private:
   absl::StatusOr<v1::Job> WaitForJob(const std::string& job_id) {
     v1::GetJobRequest get;
@@ -198,6 +236,7 @@ class Api {
   std::unique_ptr<v1::SpaceService::Stub> spaces_;
   std::unique_ptr<v1::LabelService::Stub> labels_;
   std::unique_ptr<v1::JobService::Stub> jobs_;
+  std::unique_ptr<v1::SearchService::Stub> search_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -442,6 +481,10 @@ absl::StatusOr<std::vector<Take>> IngestStyleTakes(Api& api,
 // Counts of (true content, prediction), and the frame and segment counts of takes.
 struct Score {
   std::map<std::string, std::map<std::string, int64_t>> confusion;
+  // Per calibration: clips whose strongest covering label has a value of at least
+  // kConfidentValue, how many of those are right, and each job's s0.
+  int64_t confident[kCalibrations] = {}, confident_right[kCalibrations] = {};
+  std::vector<double> scales[kCalibrations];
   int64_t frames = 0, frames_right = 0;
   int64_t segments_true = 0, segments_predicted = 0, segments_matched = 0;
   int jobs = 0;
@@ -449,22 +492,46 @@ struct Score {
 
 using LabelsByClip = std::map<int64_t, std::vector<const v1::Label*>>;
 
-// The strongest descriptor among `labels` that cover at least `min_frames` of their clip.
-std::string Strongest(const std::vector<const v1::Label*>& labels, int64_t min_frames) {
+// The strongest among `labels` that cover at least `min_frames` of their clip, or null.
+const v1::Label* Strongest(const std::vector<const v1::Label*>& labels, int64_t min_frames) {
   const v1::Label* best = nullptr;
   for (const v1::Label* label : labels) {
     if (label->last_frame() - label->first_frame() + 1 < min_frames) continue;
     if (best == nullptr || label->value() > best->value()) best = label;
   }
-  return best == nullptr ? kNone : best->descriptor_name();
+  return best;
 }
 
-void ScoreClips(const Experiment& experiment, const LabelsByClip& labels, Score* score) {
+// server/propagation.h's factor, for examples of value 1.
+double Factor(double score, double scale) { return std::exp2(-std::pow(score / scale, 2)); }
+
+// The s0 of a job whose examples have value 1: each propagated label of value v < 1 and score s
+// gives s / sqrt(-log2 v), inverting Factor; the median of those, 0 if none.
+double ImpliedScale(const std::vector<v1::Label>& labels) {
+  std::vector<double> scales;
+  for (const v1::Label& label : labels) {
+    if (label.value() > 0 && label.value() < 1 && label.score() > 0) {
+      scales.push_back(label.score() / std::sqrt(-std::log2(label.value())));
+    }
+  }
+  return bench::Percentile(scales, 0.5);
+}
+
+// `scales`: the job's s0 per calibration.
+void ScoreClips(const Experiment& experiment, const LabelsByClip& labels,
+                const double (&scales)[kCalibrations], Score* score) {
   for (const CorpusClip* clip : experiment.clips) {
     const auto found = labels.find(clip->id);
-    const std::string predicted =
-        found == labels.end() ? kNone : Strongest(found->second, (clip->frames + 1) / 2);
+    const v1::Label* best =
+        found == labels.end() ? nullptr : Strongest(found->second, (clip->frames + 1) / 2);
+    const std::string predicted = best == nullptr ? kNone : best->descriptor_name();
     ++score->confusion[clip->content][predicted];
+    for (int c = 0; c < kCalibrations; ++c) {
+      if (best != nullptr && Factor(best->score(), scales[c]) >= kConfidentValue) {
+        ++score->confident[c];
+        score->confident_right[c] += predicted == clip->content;
+      }
+    }
   }
 }
 
@@ -553,8 +620,13 @@ absl::Status RunExperiment(Api& api, const Experiment& experiment, int max_resul
   LabelsByClip by_clip;
   for (const v1::Label& label : labels) by_clip[label.clip_id()].push_back(&label);
   ++score->jobs;
+  double scales[kCalibrations];
+  scales[kSpaceScale] = ImpliedScale(labels);
+  MOTIONDB_ASSIGN_OR_RETURN(scales[kJobScale],
+                            api.JobScale(experiment.examples, experiment.tags, max_results));
+  for (int c = 0; c < kCalibrations; ++c) score->scales[c].push_back(scales[c]);
   ScoreTakes(experiment, by_clip, score);
-  ScoreClips(experiment, by_clip, score);
+  ScoreClips(experiment, by_clip, scales, score);
   return absl::OkStatus();
 }
 
@@ -610,9 +682,27 @@ void PrintRow(const std::string& name, int k, int max_results, const Score& scor
                         precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0,
                         precision, recall);
   }
-  std::printf("| %s | %d | %d | %d | %lld | %.3f | %.3f | %.3f%s|\n", name.c_str(), k, max_results,
-              score.jobs, static_cast<long long>(all.total), Ratio(all.covered, all.total),
-              Ratio(all.right, all.covered), Ratio(all.right, all.total), takes.c_str());
+  // Per calibration: coverage and accuracy at the confident value (clips only), and s0.
+  std::string calibrated;
+  for (int c = 0; c < kCalibrations; ++c) {
+    absl::StrAppend(&calibrated,
+                    score.frames > 0
+                        ? " | | "
+                        : absl::StrFormat(" %.3f | %.3f |", Ratio(score.confident[c], all.total),
+                                          Ratio(score.confident_right[c], score.confident[c])));
+    const std::vector<double>& scales = score.scales[c];
+    if (scales.empty()) {  // an experiment with nothing to evaluate runs no job
+      absl::StrAppend(&calibrated, " |");
+      continue;
+    }
+    const auto [low, high] = std::minmax_element(scales.begin(), scales.end());
+    absl::StrAppend(&calibrated, absl::StrFormat(" %.3f (%.3f-%.3f) |",
+                                                 bench::Percentile(scales, 0.5), *low, *high));
+  }
+  std::printf("| %s | %d | %d | %d | %lld | %.3f | %.3f | %.3f%s|%s\n", name.c_str(), k,
+              max_results, score.jobs, static_cast<long long>(all.total),
+              Ratio(all.covered, all.total), Ratio(all.right, all.covered),
+              Ratio(all.right, all.total), takes.c_str(), calibrated.c_str());
 }
 
 absl::StatusOr<std::vector<Experiment>> AllExperiments(Api& api,
@@ -653,8 +743,9 @@ absl::Status Measure(Api& api, const fs::path& mocap, const Flags& flags) {
   }
   std::printf(
       "| experiment | k | max_results | jobs | evaluated | coverage | accuracy (covered) | "
-      "accuracy (all) | frame accuracy | F1@50 "
-      "|\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+      "accuracy (all) | frame accuracy | F1@50 | space s0: coverage at value >= 0.5 | accuracy "
+      "there | s0 median (range) | job s0: coverage at value >= 0.5 | accuracy there | s0 median "
+      "(range) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|---:|---:|---|\n");
   for (const auto& [key, score] : scores) {
     PrintRow(std::get<0>(key), std::get<1>(key), std::get<2>(key), score);
   }

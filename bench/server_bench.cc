@@ -36,6 +36,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "bench/measure.h"
+#include "bench/synthetic_library.h"
 #include "bench/throughput.h"
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
@@ -375,30 +376,9 @@ absl::StatusOr<BackupRun> BackupDuringIngest(const std::string& address,
 absl::Status StartToServing(double hours, const std::filesystem::path& work) {
   const std::string db = (work / "synthetic.sqlite").string();
   Clock::time_point start = Clock::now();
-  int64_t frames = 0, first_id = 0;
-  {
-    SyntheticCorpusOptions options;
-    options.fps = 30;
-    options.target_duration_s = hours * 3600;
-    MOTIONDB_ASSIGN_OR_RETURN(SyntheticCorpus generated, GenerateSyntheticCorpus(options));
-    MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
-                              storage::Database::Open(db));
-    server::IndexRegistry registry;
-    server::Catalog catalog(*database, registry);
-    for (size_t c = 0; c < generated.clips.size(); ++c) {
-      storage::ClipRecord record;
-      record.name = absl::StrCat("synthetic_", c);
-      record.source_file = record.name + ".bvh";
-      MOTIONDB_ASSIGN_OR_RETURN(const server::IngestedClip ingested,
-                                catalog.IngestClip(record, generated.clips[c]));
-      if (c == 0) first_id = ingested.record.clip_id;
-      frames += generated.clips[c].frame_count();
-    }
-    server::SpaceRequest space;
-    space.name = "synthetic";
-    space.training = {{first_id, std::nullopt, std::nullopt}};
-    MOTIONDB_RETURN_IF_ERROR(catalog.CreateSpace(space, [] { return false; }).status());
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(const bench::StoredLibrary library,
+                            bench::StoreSyntheticLibrary(db, hours, 30, "synthetic"));
+  const int64_t frames = library.frames, first_id = library.clip_ids.front();
   const double prepare_s = SecondsSince(start);
   const double db_mib = std::filesystem::file_size(db) / 1048576.0;
 

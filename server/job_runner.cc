@@ -275,7 +275,7 @@ void JobRunner::Run(const std::string& job_id) {
     }
   };
   absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
-      database_, registry_, runner_, request, job_id,
+      database_, registry_, runner_, scales_, request, job_id,
       [this] { return stop_running_.load(std::memory_order_relaxed); }, on_progress);
   record.finished_unix_ms = NowUnixMs();
   if (stop_running_) {

@@ -117,6 +117,8 @@ class JobRunner {
   // The running job's should_stop: set by Cancel (for running_id_ only) and Stop; cleared as a
   // job starts.
   std::atomic<bool> stop_running_{false};
+  // The spaces' score scales, kept between jobs (only the worker uses it).
+  ScoreScales scales_;
   std::thread worker_;  // last: started once the rest exists
 };
 

@@ -155,11 +155,61 @@ double SimilarityFactor(double score, double scale) {
   return std::exp2(-ratio * ratio);
 }
 
-double ScoreScale(std::vector<double> last_scores) {
+absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const SearchRunner& runner,
+                                       const std::function<bool()>& should_stop) {
+  std::vector<std::pair<int64_t, ClipTiming>> clips(snapshot.clips.begin(), snapshot.clips.end());
+  std::sort(clips.begin(), clips.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  int64_t total = 0;
+  for (const auto& [clip_id, timing] : clips) total += timing.frame_count;
+  std::vector<double> last_scores;
+  size_t clip = 0;
+  int64_t clip_start = 0;  // the first frame of clips[clip] in the library's frames
+  for (int w = 0; w < kScaleWindows && total > 0; ++w) {
+    const int64_t at = (2 * w + 1) * total / (2 * kScaleWindows);
+    while (at >= clip_start + clips[clip].second.frame_count) {
+      clip_start += clips[clip++].second.frame_count;
+    }
+    const ClipTiming& timing = clips[clip].second;
+    const int length = std::max(1, static_cast<int>(std::lround(kScaleWindowSeconds * timing.fps)));
+    const int first =
+        std::max(0, std::min(static_cast<int>(at - clip_start), timing.frame_count - length));
+    SearchRequest search;
+    search.space = snapshot.record.name;
+    search.query = ClipSelection{clips[clip].first, first,
+                                 std::min(timing.frame_count - 1, first + length - 1)};
+    search.params.max_results = kScaleRank;
+    search.exclude_query = true;
+    const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
+    if (absl::IsCancelled(found.status())) return found.status();
+    // A window that cannot be a query (a clip too short) is left out like a short list.
+    if (found.ok() && static_cast<int>(found->hits.size()) == kScaleRank &&
+        found->hits.back().score > 0) {
+      last_scores.push_back(found->hits.back().score);
+    }
+  }
   if (last_scores.empty()) return 1;
   const auto middle = last_scores.begin() + last_scores.size() / 2;
   std::nth_element(last_scores.begin(), middle, last_scores.end());
-  return *middle > 0 ? *middle : 1;
+  return *middle;
+}
+
+absl::StatusOr<double> ScoreScales::Get(const std::shared_ptr<const SpaceSnapshot>& snapshot,
+                                        const SearchRunner& runner,
+                                        const std::function<bool()>& should_stop) {
+  const int64_t space_id = snapshot->record.space_id;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (const auto cached = by_space_.find(space_id);
+        cached != by_space_.end() && cached->second.snapshot.lock() == snapshot) {
+      return cached->second.scale;
+    }
+  }
+  // Measured outside the lock: two jobs measuring one space at once compute the same value.
+  MOTIONDB_ASSIGN_OR_RETURN(const double scale, SpaceScoreScale(*snapshot, runner, should_stop));
+  std::lock_guard<std::mutex> lock(mutex_);
+  by_space_[space_id] = {snapshot, scale};
+  return scale;
 }
 
 std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
@@ -189,7 +239,7 @@ std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord
 
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
-    const PropagationRequest& request, const std::string& job_id,
+    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id,
     const std::function<bool()>& should_stop,
     const std::function<void(const PropagationProgress&)>& on_progress) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
@@ -206,7 +256,6 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
   PropagationProgress progress{.total = static_cast<int64_t>(queries.size())};
   on_progress(progress);
   std::vector<storage::LabelRecord> candidates;
-  std::vector<double> last_scores;
   absl::Status last_skip;
   for (const storage::LabelRecord& label : queries) {
     if (should_stop()) return absl::CancelledError("the job was stopped between queries");
@@ -219,12 +268,6 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
     if (found.ok()) {
       ++progress.queries;
       AddCandidates(label, *found, snapshot->record.space_id, job_id, &candidates);
-      // Only full result lists with a positive last score calibrate s0: a short list's last
-      // result is not the k-th nearest, and would pull s0 toward the near matches.
-      if (static_cast<int>(found->hits.size()) == request.search.params.max_results &&
-          found->hits.back().score > 0) {
-        last_scores.push_back(found->hits.back().score);
-      }
     } else if (SkipsLabel(found.status())) {
       // A space deleted while the job ran answers NOT_FOUND too: that ends the job.
       if (absl::IsNotFound(found.status()) && !FindSpace(registry, request.space).ok()) {
@@ -247,7 +290,7 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
         "every one of the ", progress.total,
         " labels was skipped, none could be a query (the last: ", last_skip.message(), ")"));
   }
-  const double scale = ScoreScale(std::move(last_scores));
+  MOTIONDB_ASSIGN_OR_RETURN(const double scale, scales.Get(snapshot, runner, should_stop));
   for (storage::LabelRecord& candidate : candidates) {
     candidate.value *= SimilarityFactor(candidate.score, scale);
   }

@@ -4,12 +4,16 @@
 // SimilarityFactor(score). What one propagation job computes; server/job_runner.h runs it in the
 // background and stores its output.
 //
-// Pure functions, and RunPropagation, which is thread-safe as the SearchRunner and Database are.
+// Pure functions, and RunPropagation and SpaceScoreScale, which are thread-safe as the
+// SearchRunner and Database are.
 #ifndef MOTIONDB_SERVER_PROPAGATION_H_
 #define MOTIONDB_SERVER_PROPAGATION_H_
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -55,18 +59,55 @@ struct PropagationTarget {
 PropagationTarget TargetOf(const storage::JobRecord& job);
 
 // The factor a result's value is scaled by: f(s) = 2^-((s / s0)^2), with s0 the space's score
-// scale (ScoreScale). f(0) = 1 (the pose sequence itself), f(s0) = 1/2, f(2 s0) = 1/16: it
+// scale (SpaceScoreScale). f(0) = 1 (the pose sequence itself), f(s0) = 1/2, f(2 s0) = 1/16: it
 // falls slowly over near matches and fast past the scale. A score is a mean pose distance in a
 // space's own metric, which differs between spaces (their dimensions and variances), so a fixed
-// s0 would mean different things in different spaces; s0 taken from the job's own searches in
-// that space makes f(s) = 1/2 mean "as far as a typical query's last result" everywhere.
+// s0 would mean different things in different spaces; s0 measured on the space's library makes
+// f(s) = 1/2 mean "as far as a typical window's kScaleRank-th nearest range" in every space.
 double SimilarityFactor(double score, double scale);
-// s0: the median, over the job's queries that returned all max_results hits with a positive
-// last score, of that last (k-th) score; 1 when there is none. It is the job's own scale: its
-// max_results, descriptors (which labels query) and tags (which clips are searched) move it, so
-// f(s) compares a result with that job's k-th results, not with a fixed distance of the space.
 
-double ScoreScale(std::vector<double> last_scores);
+// The sample SpaceScoreScale searches: kScaleWindows windows of kScaleWindowSeconds, and the
+// rank whose score is taken. s0 was first the median k-th score of the job's own searches,
+// which moved with the job's max_results (its k), descriptors (which labels query) and tags
+// (which clips are searched), so that one score got different values in different jobs of one
+// space. bench/propagation_quality measured both on the Bandai clips (bench/RESULTS.md, "The
+// similarity factor's scale"): the job's own s0 ranged from 0.076 to 1.70 over the jobs of one
+// space (1, its fallback, when no list came back full), so that the clips whose label reached
+// 0.5 were 0.52 to 0.995 right depending on the job; with the space's (0.077 for every job) they
+// were 0.99 to 1.00 right in every experiment. Which labels a job keeps does not depend on s0.
+// The rank is kPropagationMaxResults, the results a job keeps by default; 2 s is about a
+// labelled action's length; 32 windows are 32 searches once per job and library version.
+inline constexpr int kScaleWindows = 32;
+inline constexpr double kScaleWindowSeconds = 2.0;
+inline constexpr int kScaleRank = kPropagationMaxResults;
+
+// s0 of the space of `snapshot`: the median, over kScaleWindows windows of kScaleWindowSeconds
+// placed evenly over its library (its clips in id order, a window at the middle of each equal
+// share of the frames, moved back to fit in its clip), of the score of each window's
+// kScaleRank-th nearest range (every clip searched, its own range excluded, the search's
+// defaults otherwise). Windows whose list comes back short or with a last score of 0 are left
+// out; 1 when none is left. It depends on the space and its library only, not on any job.
+// `should_stop` as in SearchRunner::Run (CANCELLED).
+absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const SearchRunner& runner,
+                                       const std::function<bool()>& should_stop);
+
+// The spaces' scales, computed on a job's first use of a space and kept while the registry
+// holds the same snapshot of it: an ingest, a deletion or a rebuild makes a new snapshot, and
+// the next job measures the library again. Thread-safe.
+class ScoreScales {
+ public:
+  // The scale of the space `snapshot` is, from the cache or measured now.
+  absl::StatusOr<double> Get(const std::shared_ptr<const SpaceSnapshot>& snapshot,
+                             const SearchRunner& runner, const std::function<bool()>& should_stop);
+
+ private:
+  struct Cached {
+    std::weak_ptr<const SpaceSnapshot> snapshot;
+    double scale = 1;
+  };
+  std::mutex mutex_;
+  std::map<int64_t, Cached> by_space_;  // by space id
+};
 
 // Of propagated candidates (any descriptors and clips), those to write: strongest first (then
 // lowest score), a candidate is dropped when it shares more than half of the shorter range's
@@ -83,13 +124,14 @@ struct PropagationProgress {
 };
 
 // Runs the propagation of a resolved `request` as job `job_id` and returns its output (labels
-// and counts; output.job holds only the counts). `should_stop` is polled between queries and
-// inside each search (CANCELLED); `on_progress` is called after each query. NOT_FOUND when the
-// space was deleted while the job ran; FAILED_PRECONDITION when every label was skipped (there
-// were some and none could be a query): a failed job leaves the earlier output as it was.
+// and counts; output.job holds only the counts), the factor's s0 from `scales`. `should_stop` is
+// polled between queries and inside each search (CANCELLED); `on_progress` is called after each
+// query. NOT_FOUND when the space was deleted while the job ran; FAILED_PRECONDITION when every
+// label was skipped (there were some and none could be a query): a failed job leaves the earlier
+// output as it was.
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
-    const PropagationRequest& request, const std::string& job_id,
+    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id,
     const std::function<bool()>& should_stop,
     const std::function<void(const PropagationProgress&)>& on_progress);
 

@@ -1,10 +1,19 @@
-// Propagation's pure parts (server/propagation.h): which candidate ranges are kept.
+// Propagation (server/propagation.h): which candidate ranges are kept, and the space's score
+// scale behind the similarity factor, on a real library and space.
 #include "server/propagation.h"
 
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "server/catalog.h"
+#include "testing/synthetic_corpus.h"
 
 namespace motiondb::server {
 namespace {
@@ -42,6 +51,122 @@ TEST(KeepStrongest, KeepsRangesSharingHalfOrLessOfTheShorterOne) {
   const std::vector<storage::LabelRecord> kept =
       KeepStrongest({Range(0, 99, 0.5), Range(90, 109, 0.9)}, {});
   EXPECT_EQ(kept.size(), 2u);
+}
+
+// 20 minutes of synthetic capture at 30 Hz in clips of a minute (tagged "even" and "odd" by
+// turns), a space over them, and manual labels "raise" and "shrug" on its first actions.
+class SpaceScaleTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::path(::testing::TempDir()) /
+           absl::StrCat("propagation_test_", ::testing::UnitTest::GetInstance()->random_seed());
+    std::filesystem::create_directories(dir_);
+    auto opened = storage::Database::Open((dir_ / "library.sqlite").string());
+    ASSERT_TRUE(opened.ok()) << opened.status();
+    database_ = std::move(*opened);
+    catalog_ = std::make_unique<Catalog>(*database_, registry_);
+    SyntheticCorpusOptions options;
+    options.fps = 30;
+    options.target_duration_s = 1200;
+    options.max_clip_duration_s = 60;
+    const absl::StatusOr<SyntheticCorpus> corpus = GenerateSyntheticCorpus(options);
+    ASSERT_TRUE(corpus.ok()) << corpus.status();
+    std::vector<int64_t> ids;
+    for (size_t c = 0; c < corpus->clips.size(); ++c) {
+      storage::ClipRecord record;
+      record.name = absl::StrCat("clip_", c);
+      record.source_file = record.name + ".bvh";
+      record.tags = {c % 2 == 0 ? "even" : "odd"};
+      const absl::StatusOr<IngestedClip> ingested = catalog_->IngestClip(record, corpus->clips[c]);
+      ASSERT_TRUE(ingested.ok()) << ingested.status();
+      ids.push_back(ingested->record.clip_id);
+    }
+    SpaceRequest space;
+    space.name = "body";
+    space.training = {{ids.front(), std::nullopt, std::nullopt}};
+    ASSERT_TRUE(catalog_->CreateSpace(space, [] { return false; }).ok());
+    std::vector<storage::LabelRecord> labels;
+    for (const SyntheticSegment& segment : corpus->segments) {
+      const bool raise = segment.action == SyntheticAction::kRightArmRaise;
+      if (!raise && segment.action != SyntheticAction::kShrug) continue;
+      storage::LabelRecord& label = labels.emplace_back();
+      label.clip_id = ids[segment.clip];
+      label.first_frame = segment.first_frame;
+      label.last_frame = segment.last_frame;
+      label.descriptor = raise ? "raise" : "shrug";
+      label.value = raise ? 1.0 : 0.8;
+      label.origin = storage::LabelOrigin::kManual;
+      if (labels.size() == 6) break;
+    }
+    ASSERT_TRUE(database_->AddLabels(labels).ok());
+    runner_ = std::make_unique<SearchRunner>(registry_, *database_, UploadLimits{});
+  }
+
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // The job's output; `scales` fresh for each job, so that none reuses another's s0.
+  storage::PropagationOutput Propagate(const std::vector<std::string>& descriptors,
+                                       const std::vector<std::string>& tags, int max_results) {
+    PropagationRequest request;
+    request.space = "body";
+    request.descriptors = descriptors;
+    request.search.params.tags = tags;
+    request.search.params.max_results = max_results;
+    ScoreScales scales;
+    absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
+        *database_, registry_, *runner_, scales, request, "job-1", [] { return false; },
+        [](const PropagationProgress&) {});
+    EXPECT_TRUE(output.ok()) << output.status();
+    return output.ok() ? *output : storage::PropagationOutput();
+  }
+
+  std::filesystem::path dir_;
+  std::unique_ptr<storage::Database> database_;
+  IndexRegistry registry_;
+  std::unique_ptr<Catalog> catalog_;
+  std::unique_ptr<SearchRunner> runner_;
+};
+
+// Each propagated label's value v of a manual value m and score s gives back the s0 its job
+// used: s / sqrt(-log2(v / m)). The jobs differ in descriptors, tags and max_results; with s0
+// taken from a job's own searches they would give different ones.
+TEST_F(SpaceScaleTest, TheScaleDoesNotDependOnTheJob) {
+  const absl::StatusOr<double> scale =
+      SpaceScoreScale(*registry_.Find("body"), *runner_, [] { return false; });
+  ASSERT_TRUE(scale.ok()) << scale.status();
+  ASSERT_NE(*scale, 1.0) << "no window of the sample got a full list: the library is too small";
+  const absl::StatusOr<storage::LabelPage> manual =
+      database_->ListLabels({.page_size = 100, .page_token = ""}, {});
+  ASSERT_TRUE(manual.ok()) << manual.status();
+  std::map<int64_t, double> manual_values;
+  for (const storage::LabelRecord& label : manual->labels) {
+    manual_values[label.label_id] = label.value;
+  }
+  int checked = 0;
+  for (const auto& output : {Propagate({"raise"}, {}, 100), Propagate({"shrug"}, {"odd"}, 10),
+                             Propagate({"raise", "shrug"}, {"even"}, 40)}) {
+    for (const storage::LabelRecord& label : output.labels) {
+      const double ratio = label.value / manual_values.at(label.source_label_id);
+      if (!(ratio > 1e-6 && ratio < 1 - 1e-6) || label.score <= 0) continue;
+      EXPECT_NEAR(label.score / std::sqrt(-std::log2(ratio)), *scale, 1e-6 * *scale);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 0);
+}
+
+// The cache answers from the scale measured for the snapshot the registry holds.
+TEST_F(SpaceScaleTest, TheCacheKeepsTheScaleOfASnapshot) {
+  ScoreScales scales;
+  const auto snapshot = registry_.Find("body");
+  const absl::StatusOr<double> first = scales.Get(snapshot, *runner_, [] { return false; });
+  ASSERT_TRUE(first.ok()) << first.status();
+  // Measured again, a stop request cancels it; answered from the cache, it is not asked.
+  const absl::StatusOr<double> cached = scales.Get(snapshot, *runner_, [] { return true; });
+  ASSERT_TRUE(cached.ok()) << cached.status();
+  EXPECT_EQ(*cached, *first);
+  EXPECT_TRUE(
+      absl::IsCancelled(ScoreScales().Get(snapshot, *runner_, [] { return true; }).status()));
 }
 
 }  // namespace

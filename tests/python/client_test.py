@@ -4,15 +4,12 @@
 Starts the real motiondb-server on a free loopback port with a temporary database.
 usage: client_test.py SERVER_BINARY EXAMPLE_SCRIPT   (PYTHONPATH must hold the stubs)
 """
-import math
 import os
 import pathlib
-import re
 import signal
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 
 import grpc
@@ -22,36 +19,9 @@ from motiondb.v1 import common_pb2
 from motiondb.v1 import search_service_pb2, search_service_pb2_grpc
 from motiondb.v1 import server_service_pb2, server_service_pb2_grpc
 from motiondb.v1 import space_service_pb2, space_service_pb2_grpc
+from server_fixtures import arm_raise_bvh, logged_port
 
 SERVER = EXAMPLE = None
-
-
-def logged_port(log_path, server, timeout=60):
-    """The port the server picked for --listen 127.0.0.1:0, read from its log."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        match = re.search(r"\(port ([0-9]+)\)", pathlib.Path(log_path).read_text())
-        if match:
-            return int(match.group(1))
-        if server.poll() is not None:
-            raise RuntimeError(f"motiondb-server exited with {server.returncode}")
-        time.sleep(0.02)
-    raise RuntimeError("motiondb-server did not report its port")
-
-
-def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):
-    """A small 3-joint skeleton raising its arm once: a valid BVH written here."""
-    rows = []
-    for f in range(frames):
-        t = f / (frames - 1)
-        angle = lift * 120.0 * math.sin(math.pi * t) ** 2
-        rows.append(f"0 90 0 {phase:.3f} 0 0 0 {angle:.4f} 0 {angle / 3:.4f} 0 0")
-    return ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n"
-            " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-            " JOINT Shoulder\n {\n  OFFSET 10 40 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
-            "  JOINT Elbow\n  {\n   OFFSET 25 0 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
-            "   End Site\n   {\n    OFFSET 25 0 0\n   }\n  }\n }\n}\n"
-            f"MOTION\nFrames: {frames}\nFrame Time: 0.0333333\n" + "\n".join(rows) + "\n")
 
 
 class ServerTest(unittest.TestCase):

@@ -5,20 +5,21 @@ Installs client/python with `pip install --no-index --no-deps --target DIR` (the
 from proto/ on the way; nothing written into the source tree),
 imports motiondb from DIR only, starts the real motiondb-server on a free loopback port with a
 temporary database, and drives it through the package: ingest, a space, search, labels, a
-propagation job watched to its end, curves; then runs examples/propagate_markup.py end to end.
+propagation job watched to its end, curves; then runs examples/propagate_markup.py end to end;
+and connects with a token, and over TLS.
 usage: package_test.py SERVER_BINARY REPO_ROOT
 """
 import csv
-import math
 import os
 import pathlib
-import re
+import shutil
 import signal
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
+
+from server_fixtures import arm_raise_bvh, logged_port
 
 SERVER = REPO = None
 motiondb = None  # imported from the installed copy in setUpModule
@@ -53,34 +54,6 @@ def setUpModule():
 
 def tearDownModule():
     WORK.cleanup()
-
-
-def logged_port(log_path, server, timeout=60):
-    """The port the server picked for --listen 127.0.0.1:0, read from its log."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        match = re.search(r"\(port ([0-9]+)\)", pathlib.Path(log_path).read_text())
-        if match:
-            return int(match.group(1))
-        if server.poll() is not None:
-            raise RuntimeError(f"motiondb-server exited with {server.returncode}")
-        time.sleep(0.02)
-    raise RuntimeError("motiondb-server did not report its port")
-
-
-def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):
-    """A small 3-joint skeleton raising its arm once (as tests/python/client_test.py)."""
-    rows = []
-    for f in range(frames):
-        t = f / (frames - 1)
-        angle = lift * 120.0 * math.sin(math.pi * t) ** 2
-        rows.append(f"0 90 0 {phase:.3f} 0 0 0 {angle:.4f} 0 {angle / 3:.4f} 0 0")
-    return ("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n"
-            " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-            " JOINT Shoulder\n {\n  OFFSET 10 40 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
-            "  JOINT Elbow\n  {\n   OFFSET 25 0 0\n   CHANNELS 3 Zrotation Xrotation Yrotation\n"
-            "   End Site\n   {\n    OFFSET 25 0 0\n   }\n  }\n }\n}\n"
-            f"MOTION\nFrames: {frames}\nFrame Time: 0.0333333\n" + "\n".join(rows) + "\n")
 
 
 def raise_then_rest_bvh(frames=150, lift=1.0):
@@ -271,6 +244,41 @@ class TokenTest(unittest.TestCase):
                         self.assertTrue(client.server_info().auth_required)
                         self.assertEqual(list(client.clips()), [[]])
                         self.assertEqual(list(client.find_labels("anything")), [])
+                finally:
+                    server.send_signal(signal.SIGTERM)
+                    self.assertEqual(server.wait(timeout=30), 0)
+
+
+class TlsTest(unittest.TestCase):
+    def test_connects_with_the_servers_certificate(self):
+        if shutil.which("openssl") is None:
+            self.skipTest("openssl is not installed; the TLS test needs it to make a certificate")
+        with tempfile.TemporaryDirectory() as folder:
+            cert, key = pathlib.Path(folder) / "cert.pem", pathlib.Path(folder) / "key.pem"
+            # As the C++ server tests make theirs (tests/test_data.cc): self-signed, for
+            # localhost and 127.0.0.1, so that the client checks the name it dials.
+            subprocess.run(
+                ["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1",
+                 "-subj", "/CN=localhost", "-addext", "subjectAltName=DNS:localhost,IP:127.0.0.1",
+                 "-keyout", str(key), "-out", str(cert)], check=True, capture_output=True)
+            log_path = os.path.join(folder, "server.log")
+            with open(log_path, "w") as log:
+                server = subprocess.Popen(
+                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0",
+                     "--http", "off", "--tls-cert", str(cert), "--tls-key", str(key)],
+                    stdout=subprocess.DEVNULL, stderr=log)
+                try:
+                    address = f"127.0.0.1:{logged_port(log_path, server)}"
+                    with motiondb.connect(address, tls_ca=cert) as client:  # a path
+                        self.assertTrue(client.server_info().tls)
+                        self.assertEqual(list(client.clips()), [[]])
+                    with motiondb.connect(address, tls_ca=cert.read_bytes()) as client:  # bytes
+                        self.assertTrue(client.server_info().tls)
+                    # Without TLS, or trusting only the system's roots, no connection comes up.
+                    for options in ({}, {"tls": True}):
+                        with self.assertRaises(motiondb.Error) as raised:
+                            motiondb.connect(address, ready_timeout=2, **options)
+                        self.assertEqual(raised.exception.code, "UNAVAILABLE", options)
                 finally:
                     server.send_signal(signal.SIGTERM)
                     self.assertEqual(server.wait(timeout=30), 0)
