@@ -277,16 +277,28 @@ TEST_F(EditServiceTest, APlanarBlendHitsEachPoseAtItsPointAndItsResultIsAQuery) 
   EXPECT_LT(MaxAngleByName(*blended.Slice({10, 10}), *library->clips[1].Slice({60, 60})), 1e-4);
   EXPECT_LT(MaxAngleByName(*blended.Slice({20, 20}), *library->clips[2].Slice({100, 100})), 1e-4);
 
-  // The blend, stored, is a search query like any clip.
+  // The blend, stored, is indexed in the space and a search query like any clip: kept in the
+  // results, it finds itself first, whole and at no distance; left out, it finds other clips.
+  const int64_t stored = response.result().stored().clip_id();
   v1::SearchRequest search;
   search.set_space("body");
-  search.mutable_clip()->set_clip_id(response.result().stored().clip_id());
+  search.mutable_clip()->set_clip_id(stored);
   search.set_max_results(3);
+  search.set_exclude_query(false);
   v1::SearchResponse hits;
-  const grpc::Status searched =
-      v1::SearchService::NewStub(library->channel)->Search(Context().get(), search, &hits);
+  const auto searcher = v1::SearchService::NewStub(library->channel);
+  grpc::Status searched = searcher->Search(Context().get(), search, &hits);
   ASSERT_TRUE(searched.ok()) << searched.error_message();
-  EXPECT_GT(hits.results_size(), 0);
+  ASSERT_GT(hits.results_size(), 0);
+  EXPECT_EQ(hits.results(0).clip_id(), stored);
+  EXPECT_EQ(hits.results(0).start_frame(), 0);
+  EXPECT_EQ(hits.results(0).end_frame(), 30);
+  EXPECT_LT(hits.results(0).score(), 1e-3);
+  search.set_exclude_query(true);
+  searched = searcher->Search(Context().get(), search, &hits);
+  ASSERT_TRUE(searched.ok()) << searched.error_message();
+  ASSERT_GT(hits.results_size(), 0);
+  for (const v1::SearchResult& hit : hits.results()) EXPECT_NE(hit.clip_id(), stored);
 }
 
 TEST_F(EditServiceTest, AGapIsFilledSmootherThanALineAndAnOverlapIsWarped) {
@@ -377,8 +389,9 @@ TEST_F(EditServiceTest, PoseModelsAreFittedStoredListedRunAndDeleted) {
   v1::CreatePoseModelRequest create;
   create.set_name("take3-pose");
   create.set_space("body");
-  *create.add_examples() = Range(2, 40, 50);
-  *create.add_examples() = Range(2, 41, 49);
+  // Frames 44-46 are held out: the model must find the pose there without having seen them.
+  *create.add_examples() = Range(2, 38, 43);
+  *create.add_examples() = Range(2, 47, 52);
   create.set_components(1);
   v1::PoseModel model;
   grpc::Status status = edits_->CreatePoseModel(Context().get(), create, &model);
@@ -402,10 +415,13 @@ TEST_F(EditServiceTest, PoseModelsAreFittedStoredListedRunAndDeleted) {
   EXPECT_EQ(found.log_likelihood().size(), 150 * sizeof(float));
   ASSERT_GE(found.intervals_size(), 1);
   bool covers = false;
+  int covered = 0;
   for (const v1::DetectedInterval& interval : found.intervals()) {
-    covers |= interval.first_frame() <= 45 && interval.last_frame() >= 45;
+    covers |= interval.first_frame() <= 44 && interval.last_frame() >= 46;
+    covered += interval.last_frame() - interval.first_frame() + 1;
   }
   EXPECT_TRUE(covers);
+  EXPECT_LT(covered, 150) << "a model that fires everywhere finds nothing";
 
   v1::DeletePoseModelRequest erase;
   erase.set_name("take3-pose");

@@ -996,6 +996,65 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   EXPECT_GT(Insert(Named("new"), walk), c);
 }
 
+// A file of schema version 3, as builds before the operators (issue 16) wrote it, keeps its
+// clips when opened and gains what version 4 adds: each clip's provenance (none for an ingested
+// clip) and the pose models' table.
+TEST_F(StorageTest, SchemaThreeFileKeepsItsClipsAndGainsProvenanceAndPoseModels) {
+  const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
+  const int64_t a = Insert(Named("walk", {"x"}), walk);
+  const int64_t b = Insert(Named("session1/run"), Motion(testing::ChainSkeleton(), 30, 2));
+  std::map<int64_t, ClipRecord> expected;
+  for (const int64_t id : {a, b}) expected[id] = *Db().GetClipRecord(id);
+  Close();
+
+  const std::string old_path = (dir_ / "schema3.db").string();
+  {
+    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
+        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
+    ASSERT_TRUE(old.ok()) << old.status();
+    ASSERT_TRUE(MigrateSchema(**old, 3).ok());
+    const absl::Status copied = (*old)->Execute(absl::StrCat(
+        "ATTACH DATABASE '", path_, "' AS current;",
+        "INSERT INTO skeletons SELECT * FROM current.skeletons;"
+        "INSERT INTO clips SELECT clip_id, name, source_file, skeleton_id, frame_time, "
+        "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
+        "created_unix_ms, content_hash FROM current.clips;"
+        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;"
+        "DETACH DATABASE current"));
+    ASSERT_TRUE(copied.ok()) << copied;
+    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), 3);
+    EXPECT_EQ(*(*old)->QueryInt64(
+                  "SELECT count(*) FROM pragma_table_info('clips') WHERE name = 'provenance'"),
+              0);
+    EXPECT_EQ(*(*old)->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'pose_models'"),
+              0);
+  }
+  path_ = old_path;
+
+  for (const int64_t id : {a, b}) {
+    const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->name, expected[id].name);
+    EXPECT_EQ(record->tags, expected[id].tags);
+    EXPECT_EQ(record->content_hash, expected[id].content_hash);
+    EXPECT_EQ(record->frame_count, expected[id].frame_count);
+    EXPECT_EQ(record->provenance, "");
+    const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+  }
+  EXPECT_EQ(Db().GetClip(a)->clip.frame_count(), 20);
+  const absl::StatusOr<std::vector<PoseModelRecord>> models = Db().ListPoseModels();
+  ASSERT_TRUE(models.ok()) << models.status();
+  EXPECT_TRUE(models->empty());
+  EXPECT_EQ(*Raw()->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  // A clip made by an operator keeps where it came from.
+  ClipRecord made = Named("made");
+  made.provenance = R"({"operator":"smooth"})";
+  const int64_t c = Insert(made, walk);
+  EXPECT_GT(c, b);
+  EXPECT_EQ(Db().GetClipRecord(c)->provenance, made.provenance);
+}
+
 TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {
   { std::ofstream(path_) << "name,frames\nwalk,120\n"; }
   const std::string bytes = testing::ReadFileOrDie(path_);
