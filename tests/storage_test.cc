@@ -152,6 +152,30 @@ class StorageTest : public ::testing::Test {
     EXPECT_TRUE(counts.ok()) << counts.status();
     return counts.value_or(Counts{});
   }
+  // Closes the database and copies its skeletons, clips and tags into a new file at schema
+  // `version`, made by its own migrations, whose clips table has `clip_columns`; path_ then names
+  // that file. Checks the copy has the version and lacks `missing_column` of clips.
+  void CopyToOldSchema(int version, const std::string& clip_columns,
+                       const std::string& missing_column) {
+    Close();
+    const std::string old_path = (dir_ / absl::StrCat("schema", version, ".db")).string();
+    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
+        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
+    ASSERT_TRUE(old.ok()) << old.status();
+    ASSERT_TRUE(MigrateSchema(**old, version).ok());
+    const absl::Status copied = (*old)->Execute(absl::StrCat(
+        "ATTACH DATABASE '", path_, "' AS current;",
+        "INSERT INTO skeletons SELECT * FROM current.skeletons;", "INSERT INTO clips SELECT ",
+        clip_columns, " FROM current.clips;",
+        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;", "DETACH DATABASE current"));
+    ASSERT_TRUE(copied.ok()) << copied;
+    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), version);
+    EXPECT_EQ(
+        *(*old)->QueryInt64(absl::StrCat(
+            "SELECT count(*) FROM pragma_table_info('clips') WHERE name = '", missing_column, "'")),
+        0);
+    path_ = old_path;
+  }
   // A raw connection, to look at and damage what the Database wrote.
   std::unique_ptr<SqliteConnection> Raw() {
     auto raw = SqliteConnection::Open(path_, SqliteConnection::Mode::kReadWrite, 1000);
@@ -953,27 +977,10 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   Close();
 
   // Version 1's schema, made by its own migration, holding the same rows.
-  const std::string old_path = (dir_ / "schema1.db").string();
-  {
-    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
-        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
-    ASSERT_TRUE(old.ok()) << old.status();
-    ASSERT_TRUE(MigrateSchema(**old, 1).ok());
-    const absl::Status copied = (*old)->Execute(absl::StrCat(
-        "ATTACH DATABASE '", path_, "' AS current;",
-        "INSERT INTO skeletons SELECT * FROM current.skeletons;"
-        "INSERT INTO clips SELECT clip_id, name, source_file, skeleton_id, frame_time, "
-        "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
-        "created_unix_ms FROM current.clips;"
-        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;"
-        "DETACH DATABASE current"));
-    ASSERT_TRUE(copied.ok()) << copied;
-    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), 1);
-    EXPECT_EQ(*(*old)->QueryInt64(
-                  "SELECT count(*) FROM pragma_table_info('clips') WHERE name = 'content_hash'"),
-              0);
-  }
-  path_ = old_path;
+  CopyToOldSchema(1,
+                  "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+                  "position_joint_count, layout, rotations, positions, created_unix_ms",
+                  "content_hash");
 
   for (const int64_t id : {a, b, c}) {
     const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
@@ -1007,29 +1014,12 @@ TEST_F(StorageTest, SchemaThreeFileKeepsItsClipsAndGainsProvenanceAndPoseModels)
   for (const int64_t id : {a, b}) expected[id] = *Db().GetClipRecord(id);
   Close();
 
-  const std::string old_path = (dir_ / "schema3.db").string();
-  {
-    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
-        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
-    ASSERT_TRUE(old.ok()) << old.status();
-    ASSERT_TRUE(MigrateSchema(**old, 3).ok());
-    const absl::Status copied = (*old)->Execute(absl::StrCat(
-        "ATTACH DATABASE '", path_, "' AS current;",
-        "INSERT INTO skeletons SELECT * FROM current.skeletons;"
-        "INSERT INTO clips SELECT clip_id, name, source_file, skeleton_id, frame_time, "
-        "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
-        "created_unix_ms, content_hash FROM current.clips;"
-        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;"
-        "DETACH DATABASE current"));
-    ASSERT_TRUE(copied.ok()) << copied;
-    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), 3);
-    EXPECT_EQ(*(*old)->QueryInt64(
-                  "SELECT count(*) FROM pragma_table_info('clips') WHERE name = 'provenance'"),
-              0);
-    EXPECT_EQ(*(*old)->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'pose_models'"),
-              0);
-  }
-  path_ = old_path;
+  CopyToOldSchema(3,
+                  "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+                  "position_joint_count, layout, rotations, positions, created_unix_ms, "
+                  "content_hash",
+                  "provenance");
+  EXPECT_EQ(*Raw()->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'pose_models'"), 0);
 
   for (const int64_t id : {a, b}) {
     const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
