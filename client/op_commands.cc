@@ -23,14 +23,6 @@ namespace {
 
 using Stub = v1::EditService::Stub;
 
-constexpr char kClipHelp[] = "the clip: ID, ID:FROM-TO or ID:FRAME (frames at its own rate)";
-constexpr char kPoseHelp[] = "a pose: ID:FRAME, or ID:FROM-TO for the mean of a range";
-
-void AddClipArgument(CLI::App* command, const std::string& name, std::string* spec,
-                     const std::string& help) {
-  command->add_option(name, *spec, help)->required()->check(ClipRangeCheck());
-}
-
 // --- reconstruct ---------------------------------------------------------------------------
 
 struct ReconstructFlags {
@@ -87,7 +79,7 @@ void AddReconstruct(Commands& commands, CLI::App* op) {
   CLI::App* command = commands.AddServer(
       op, "reconstruct", "rebuild a clip from its first n dimensions, with the error (3.3.4)",
       [flags, &global](const ServerConnection& c) { return Reconstruct(*flags, global.json, c); });
-  AddClipArgument(command, "CLIP", &flags->clip, kClipHelp);
+  AddClipArgument(command, "CLIP", &flags->clip, kOpClipHelp);
   AddOpOutputFlags(command, &flags->output);
   command->add_option("--dims", flags->dims, "dimensions kept (default: all)")
       ->type_name("N")
@@ -155,8 +147,8 @@ void AddInterpolate(Commands& commands, CLI::App* op) {
   CLI::App* command = commands.AddServer(
       op, "interpolate", "two poses by MC-LERP and per-joint SLERP, and their difference (4.1)",
       [flags, &global](const ServerConnection& c) { return Interpolate(*flags, global.json, c); });
-  AddClipArgument(command, "FROM", &flags->from, kPoseHelp);
-  AddClipArgument(command, "TO", &flags->to, kPoseHelp);
+  AddClipArgument(command, "FROM", &flags->from, kOpPoseHelp);
+  AddClipArgument(command, "TO", &flags->to, kOpPoseHelp);
   AddOpOutputFlags(command, &flags->output);
   command->add_option("--t", flags->t, "the parameters, each 0..1 (default: --steps of them)")
       ->type_name("T,...")
@@ -205,13 +197,17 @@ absl::Status Blend(const BlendFlags& flags, bool json, const ServerConnection& c
   if (flags.frames_per_segment) request.set_frames_per_segment(*flags.frames_per_segment);
   if (flags.epsilon) request.set_epsilon(*flags.epsilon);
   SetOutput(flags.output, request.mutable_output());
+  FlagNames ranges;
+  for (size_t i = 0; i < flags.poses.size(); ++i) {
+    ranges.push_back({absl::StrCat("poses[", i, "].pose"), flags.poses[i]});
+  }
   MOTIONDB_ASSIGN_OR_RETURN(const v1::BlendResponse response,
                             CallUnary(connection, &Stub::Blend, request,
                                       OpFlagNames({{"poses", "--pose"},
                                                    {"path", "--path"},
                                                    {"frames_per_segment", "--frames-per-segment"},
                                                    {"epsilon", "--epsilon"}},
-                                                  {})));
+                                                  ranges)));
   nlohmann::json weights = nlohmann::json::array();
   for (const v1::BlendWeights& frame : response.frames()) {
     weights.push_back(std::vector<double>(frame.weights().begin(), frame.weights().end()));

@@ -14,6 +14,7 @@
 #include "absl/strings/strip.h"
 #include "client/clip_range_arg.h"
 #include "client/commands.h"
+#include "client/op_flags.h"
 #include "client/server_connection.h"
 #include "motiondb/v1/edit_service.grpc.pb.h"
 #include "util/byte_coding.h"
@@ -205,7 +206,7 @@ void AddRun(Commands& commands, CLI::App* detect) {
       detect, "run", "where a clip assumes a model's pose: its log-likelihood and intervals",
       [flags, &global](const ServerConnection& c) { return Run(*flags, global.json, c); });
   run->add_option("MODEL", flags->model, "the model's name")->required();
-  run->add_option("CLIP", flags->clip, "ID or ID:FROM-TO")->required()->check(ClipRangeCheck());
+  AddClipArgument(run, "CLIP", &flags->clip, kOpClipHelp);
   run->add_option("--threshold", flags->threshold, "log-likelihood to reach (default: the model's)")
       ->type_name("T");
   run->add_option("--min-duration", flags->min_duration_s, "shortest interval, seconds")

@@ -18,15 +18,13 @@ namespace {
 
 using Stub = v1::EditService::Stub;
 
-constexpr char kClipHelp[] = "the clip: ID or ID:FROM-TO (frames at its own rate)";
-constexpr char kPoseHelp[] = "a pose: ID:FRAME, or ID:FROM-TO for the mean of a range";
-
 // --- fill-gap ------------------------------------------------------------------------------
 
 struct FillGapFlags {
   OpOutputFlags output;
   std::string first, second;
   std::optional<double> gap_s, damping;
+  std::optional<int> slope_limit;
   double overlap_s = 0, smoothing = 0;
   std::string method = "hermite";
   bool no_align = false;
@@ -43,6 +41,7 @@ absl::Status FillGap(const FillGapFlags& flags, bool json, const ServerConnectio
   request.set_derivative_smoothing(flags.smoothing);
   request.set_overlap_s(flags.overlap_s);
   request.set_no_align(flags.no_align);
+  if (flags.slope_limit) request.set_slope_limit(*flags.slope_limit);
   SetOutput(flags.output, request.mutable_output());
   MOTIONDB_ASSIGN_OR_RETURN(
       const v1::FillGapResponse response,
@@ -50,7 +49,8 @@ absl::Status FillGap(const FillGapFlags& flags, bool json, const ServerConnectio
                 OpFlagNames({{"gap_s", "--gap"},
                              {"overlap_s", "--overlap"},
                              {"damping", "--damping"},
-                             {"derivative_smoothing", "--derivative-smoothing"}},
+                             {"derivative_smoothing", "--derivative-smoothing"},
+                             {"slope_limit", "--slope-limit"}},
                             {{"first", flags.first}, {"second", flags.second}})));
   nlohmann::json seams = nlohmann::json::array();
   for (const v1::SeamJump& seam : response.seams()) {
@@ -87,8 +87,8 @@ void AddFillGap(Commands& commands, CLI::App* op) {
       "join two clips: Hermite interpolation across a gap (4.3), or a time-aligned blend of an "
       "overlap",
       [flags, &global](const ServerConnection& c) { return FillGap(*flags, global.json, c); });
-  command->add_option("FIRST", flags->first, kClipHelp)->required()->check(ClipRangeCheck());
-  command->add_option("SECOND", flags->second, kClipHelp)->required()->check(ClipRangeCheck());
+  AddClipArgument(command, "FIRST", &flags->first, kOpClipHelp);
+  AddClipArgument(command, "SECOND", &flags->second, kOpClipHelp);
   AddOpOutputFlags(command, &flags->output);
   command->add_option("--gap", flags->gap_s, "seconds between the clips (default 0.5)")
       ->type_name("S");
@@ -106,6 +106,11 @@ void AddFillGap(Commands& commands, CLI::App* op) {
                    "instead: SECOND overlaps FIRST's end by S seconds, blended after a time warp")
       ->type_name("S");
   command->add_flag("--no-align", flags->no_align, "blend the overlap frame for frame");
+  command
+      ->add_option("--slope-limit", flags->slope_limit,
+                   "the overlap's time warp: the most frames of one clip to a frame of the other, "
+                   "1..8 (default 2)")
+      ->type_name("N");
 }
 
 // --- scale, translate, smooth ----------------------------------------------------------------
@@ -131,7 +136,7 @@ CLI::App* AddCurveCommand(Commands& commands, CLI::App* op, const std::string& n
                           const std::string& description, CurveFlags* flags,
                           std::function<absl::Status(const ServerConnection&)> body) {
   CLI::App* command = commands.AddServer(op, name, description, std::move(body));
-  command->add_option("CLIP", flags->clip, kClipHelp)->required()->check(ClipRangeCheck());
+  AddClipArgument(command, "CLIP", &flags->clip, kOpClipHelp);
   AddOpOutputFlags(command, &flags->output);
   AddScopeFlags(command, &flags->scope);
   return command;
@@ -187,14 +192,17 @@ absl::Status Translate(const TranslateFlags& flags, bool json, const ServerConne
     MOTIONDB_ASSIGN_OR_RETURN(*request.mutable_axis_to(), ParseClipRange(flags.axis_to));
   }
   if (flags.amount) request.set_amount(*flags.amount);
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const v1::EditResponse response,
-      CallUnary(connection, &Stub::Translate, request,
-                OpFlagNames({{"target", "--toward"}, {"amount", "--amount"}},
-                            {{"clip", flags.curve.clip},
-                             {"poses[0]", flags.toward.empty() ? flags.axis_from : flags.toward},
-                             {"poses[1]", flags.axis_to}},
-                            &flags.curve.scope)));
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::EditResponse response,
+                            CallUnary(connection, &Stub::Translate, request,
+                                      OpFlagNames({{"target", "--toward"},
+                                                   {"axis_from", "--axis-from"},
+                                                   {"axis_to", "--axis-to"},
+                                                   {"amount", "--amount"}},
+                                                  {{"clip", flags.curve.clip},
+                                                   {"target", flags.toward},
+                                                   {"axis_from", flags.axis_from},
+                                                   {"axis_to", flags.axis_to}},
+                                                  &flags.curve.scope)));
   return Report(response, flags.curve, json);
 }
 
@@ -247,9 +255,9 @@ void AddOpEditCommands(Commands& commands, CLI::App* op) {
       &translate->curve, [translate, &global](const ServerConnection& c) {
         return Translate(*translate, global.json, c);
       });
-  mover->add_option("--toward", translate->toward, kPoseHelp)->type_name("POSE");
-  mover->add_option("--axis-from", translate->axis_from, kPoseHelp)->type_name("POSE");
-  mover->add_option("--axis-to", translate->axis_to, kPoseHelp)->type_name("POSE");
+  mover->add_option("--toward", translate->toward, kOpPoseHelp)->type_name("POSE");
+  mover->add_option("--axis-from", translate->axis_from, kOpPoseHelp)->type_name("POSE");
+  mover->add_option("--axis-to", translate->axis_to, kOpPoseHelp)->type_name("POSE");
   mover
       ->add_option("--amount", translate->amount,
                    "1 takes the mean onto the pose, or moves by the whole axis (default 0.5)")

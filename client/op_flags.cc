@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "client/clip_range_arg.h"
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
@@ -39,6 +40,11 @@ absl::Status AddJointValues(const std::vector<std::string>& texts, const std::st
 }
 
 }  // namespace
+
+void AddClipArgument(CLI::App* command, const std::string& name, std::string* spec,
+                     const std::string& help) {
+  command->add_option(name, *spec, help)->required()->check(ClipRangeCheck());
+}
 
 void AddOpOutputFlags(CLI::App* command, OpOutputFlags* flags) {
   command->add_option("--space", flags->space, "the space to work in")
@@ -125,14 +131,15 @@ absl::Status SetScope(const ScopeFlags& flags, v1::EditScope* scope,
 }
 
 FlagNames OpFlagNames(FlagNames more, const FlagNames& ranges, const ScopeFlags* scope) {
-  FlagNames names = {{"gate.start_s", "--gate T0"},
-                     {"gate.end_s", "--gate T1"},
-                     {"gate.lead_in_s", "--lead-in"},
-                     {"gate.lead_out_s", "--lead-out"},
-                     {"edit_weights", "--joint-weight"},
-                     {"max_angles", "--max-angle"},
-                     {"source_margin", "--limit-from-source"},
-                     {"store", "--store"}};
+  FlagNames names = {{"scope.gate.start_s", "--gate T0"},
+                     {"scope.gate.end_s", "--gate T1"},
+                     {"scope.gate.lead_in_s", "--lead-in"},
+                     {"scope.gate.lead_out_s", "--lead-out"},
+                     {"scope.gate", "--gate"},
+                     {"constraints.edit_weights", "--joint-weight"},
+                     {"constraints.max_angles", "--max-angle"},
+                     {"constraints.source_margin", "--limit-from-source"},
+                     {"output.store_name", "--store"}};
   names.insert(names.end(), more.begin(), more.end());
   for (const auto& [field, spec] : ranges) {
     names.insert(names.end(), {{field + ".first_frame", spec + ": frame"},
@@ -143,15 +150,16 @@ FlagNames OpFlagNames(FlagNames more, const FlagNames& ranges, const ScopeFlags*
   }
   if (scope == nullptr) return names;
   for (size_t i = 0; i < scope->dims.size(); ++i) {
-    names.push_back({absl::StrCat("dims[", i, "]"), "--only-dims"});
+    names.push_back({absl::StrCat("scope.dims[", i, "]"), "--only-dims"});
   }
-  // The server names a joint's constraint as edit_weights[JOINT] or max_angles[JOINT].
+  // The server names a joint's constraint as constraints.edit_weights[JOINT] or
+  // constraints.max_angles[JOINT].
   for (const std::string& joint : scope->freeze) {
-    names.push_back({absl::StrCat("edit_weights[", joint, "]"), "--freeze " + joint});
+    names.push_back({absl::StrCat("constraints.edit_weights[", joint, "]"), "--freeze " + joint});
   }
   for (const auto& [flag, field, texts] :
-       {std::tuple{"--joint-weight", "edit_weights", &scope->joint_weights},
-        std::tuple{"--max-angle", "max_angles", &scope->max_angles}}) {
+       {std::tuple{"--joint-weight", "constraints.edit_weights", &scope->joint_weights},
+        std::tuple{"--max-angle", "constraints.max_angles", &scope->max_angles}}) {
     for (const std::string& text : *texts) {
       const std::string joint = text.substr(0, text.rfind('='));
       names.push_back({absl::StrCat(field, "[", joint, "]"), absl::StrCat(flag, " ", joint)});
@@ -164,8 +172,11 @@ absl::StatusOr<std::pair<double, double>> ParsePoint(const std::string& text,
                                                      const std::string& what) {
   const std::vector<std::string> parts = absl::StrSplit(text, ',');
   double x = 0, y = 0;
-  if (parts.size() != 2 || !absl::SimpleAtod(parts[0], &x) || !absl::SimpleAtod(parts[1], &y)) {
-    return absl::InvalidArgumentError(absl::StrCat(what, ": expected X,Y, got '", text, "'"));
+  // SimpleAtod reads "nan" and "inf" too; a point of the plane is two finite numbers.
+  if (parts.size() != 2 || !absl::SimpleAtod(parts[0], &x) || !absl::SimpleAtod(parts[1], &y) ||
+      !std::isfinite(x) || !std::isfinite(y)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": expected X,Y (two finite numbers), got '", text, "'"));
   }
   return std::make_pair(x, y);
 }

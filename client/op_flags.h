@@ -19,6 +19,15 @@
 
 namespace motiondb::cli {
 
+// The help of a clip argument and of a pose argument or option.
+inline constexpr char kOpClipHelp[] =
+    "the clip: ID, ID:FROM-TO or ID:FRAME (frames at its own rate)";
+inline constexpr char kOpPoseHelp[] = "a pose: ID:FRAME, or ID:FROM-TO for the mean of a range";
+
+// A required clip range argument NAME (ID, ID:FROM-TO or ID:FRAME) into `spec`.
+void AddClipArgument(CLI::App* command, const std::string& name, std::string* spec,
+                     const std::string& help);
+
 struct OpOutputFlags {
   std::string space;
   std::string out;  // -o: the BVH file; "-" for standard output; empty: not written

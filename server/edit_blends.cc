@@ -1,8 +1,10 @@
 #include "server/edit_blends.h"
 
+#include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 
@@ -32,6 +34,14 @@ absl::StatusOr<RowMatrixXd> PathPoints(const std::vector<Eigen::Vector2d>& path,
                                                    kMaxFramesPerSegment));
   }
   if (path.empty()) return absl::InvalidArgumentError("path: the path has no points");
+  for (size_t i = 0; i < path.size(); ++i) {
+    for (const int c : {0, 1}) {
+      if (!std::isfinite(path[i][c])) {
+        return absl::InvalidArgumentError(absl::StrCat("path[", i, "].", c == 0 ? "x" : "y", " = ",
+                                                       path[i][c], " is not a finite number"));
+      }
+    }
+  }
   const int64_t frames = static_cast<int64_t>(path.size() - 1) * per_segment + 1;
   if (frames > kMaxBlendFrames) {
     return absl::InvalidArgumentError(
@@ -48,11 +58,9 @@ absl::StatusOr<RowMatrixXd> PathPoints(const std::vector<Eigen::Vector2d>& path,
   return points;
 }
 
-}  // namespace
-
-absl::StatusOr<InterpolateOutcome> Interpolate(const EditContext& context,
-                                               const InterpolateRequest& request,
-                                               const std::function<bool()>& should_stop) {
+absl::StatusOr<InterpolateOutcome> InterpolateInSpace(const EditContext& context,
+                                                      const InterpolateRequest& request,
+                                                      const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
@@ -89,8 +97,8 @@ absl::StatusOr<InterpolateOutcome> Interpolate(const EditContext& context,
   return outcome;
 }
 
-absl::StatusOr<BlendOutcome> Blend(const EditContext& context, const BlendRequest& request,
-                                   const std::function<bool()>& should_stop) {
+absl::StatusOr<BlendOutcome> BlendInSpace(const EditContext& context, const BlendRequest& request,
+                                          const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
@@ -104,7 +112,7 @@ absl::StatusOr<BlendOutcome> Blend(const EditContext& context, const BlendReques
   for (size_t i = 0; i < request.poses.size(); ++i) {
     MOTIONDB_ASSIGN_OR_RETURN(EditSource source,
                               LoadSource(context.database, *snapshot, request.poses[i].pose,
-                                         absl::StrCat("poses[", i, "]")));
+                                         absl::StrCat("poses[", i, "].pose")));
     MOTIONDB_ASSIGN_OR_RETURN(EditPose pose, PoseOf(space, source));
     coordinates.row(i) = pose.coordinates.row(0);
     plane.row(i) << request.poses[i].x, request.poses[i].y;
@@ -124,6 +132,24 @@ absl::StatusOr<BlendOutcome> Blend(const EditContext& context, const BlendReques
       outcome.result, FinishEdit(context, space, sources.front(), edited, std::move(provenance),
                                  request.output, should_stop));
   return outcome;
+}
+
+}  // namespace
+
+absl::StatusOr<InterpolateOutcome> Interpolate(const EditContext& context,
+                                               const InterpolateRequest& request,
+                                               const std::function<bool()>& should_stop) {
+  // The two poses reach the operator as the rows of one matrix.
+  return InRequestFields(InterpolateInSpace(context, request, should_stop),
+                         {{"poses", "from and to"}});
+}
+
+absl::StatusOr<BlendOutcome> Blend(const EditContext& context, const BlendRequest& request,
+                                   const std::function<bool()>& should_stop) {
+  // The poses' places reach the operator as its plane, the path (already checked, and spread
+  // over frames_per_segment) as its points.
+  return InRequestFields(BlendInSpace(context, request, should_stop),
+                         {{"plane", "poses"}, {"points", "path"}});
 }
 
 }  // namespace motiondb::server

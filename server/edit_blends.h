@@ -59,8 +59,9 @@ struct BlendOutcome {
   RowMatrixXd weights;  // frames x poses, each row summing to 1
 };
 
-// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the field (from, to, t[i],
-// poses[i], path, frames_per_segment, epsilon, ...); nothing is stored on error.
+// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the request's field (from,
+// to, t[i], poses[i].pose, poses[i].x, path[i].y, frames_per_segment, epsilon, ...); nothing is
+// stored on error.
 absl::StatusOr<InterpolateOutcome> Interpolate(const EditContext& context,
                                                const InterpolateRequest& request,
                                                const std::function<bool()>& should_stop);

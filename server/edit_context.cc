@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_writer.h"
@@ -71,10 +72,16 @@ absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSp
   record.tags = output.store_tags;
   provenance.parameters_json = output.parameters_json;
   record.provenance = ProvenanceJson(provenance);
-  MOTIONDB_ASSIGN_OR_RETURN(
-      IngestedClip stored,
-      Prefixed("store", context.catalog.IngestClip(record, clip, OnConflict::kError, should_stop)));
-  result.stored = std::move(stored.record);
+  absl::StatusOr<IngestedClip> stored =
+      context.catalog.IngestClip(record, clip, OnConflict::kError, should_stop);
+  if (!stored.ok()) {
+    // The catalogue names a bad tag "tags[i]" ("tags[0] must not be empty"); whatever else it
+    // refuses is about the name.
+    const absl::Status& status = stored.status();
+    if (!absl::StartsWith(status.message(), "tags")) return Prefixed("output.store_name", status);
+    return absl::Status(status.code(), absl::StrCat("output.store_", status.message()));
+  }
+  result.stored = std::move(stored->record);
   return result;
 }
 

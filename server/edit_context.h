@@ -78,8 +78,8 @@ absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSn
 absl::StatusOr<EditPose> PoseOf(const MotionSpace& space, const EditSource& source);
 
 // The BVH of `motion` placed and exported with `like`'s skeleton at its rate, stored as a clip
-// when output.store_name is set (Catalog::IngestClip refusing a taken name; its errors prefixed
-// "store: "). `provenance` names the operator and its sources.
+// when output.store_name is set (Catalog::IngestClip refusing a taken name; its errors name
+// output.store_name or output.store_tags[i]). `provenance` names the operator and its sources.
 absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSpace& space,
                                       const EditSource& like, const EditedMotion& motion,
                                       Provenance provenance, const EditOutput& output,

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 
@@ -26,9 +27,9 @@ EditScope RangeScope(const EditScope& scope, const EditSource& source) {
   return shifted;
 }
 
-absl::StatusOr<EditResult> RunCurveEdit(const EditContext& context, const CurveEdit& edit,
-                                        const std::string& op, const CurveFunction& function,
-                                        const std::function<bool()>& should_stop) {
+absl::StatusOr<EditResult> EditInSpace(const EditContext& context, const CurveEdit& edit,
+                                       const std::string& op, const CurveFunction& function,
+                                       const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, edit.space));
   const MotionSpace& space = *snapshot->space;
@@ -49,6 +50,22 @@ absl::StatusOr<EditResult> RunCurveEdit(const EditContext& context, const CurveE
                     should_stop);
 }
 
+// EditInSpace with its errors in the request's fields: the operators see the scope and the
+// constraints as their own options and the clip's range as their curve; `more` names the
+// edit's own.
+absl::StatusOr<EditResult> RunCurveEdit(const EditContext& context, const CurveEdit& edit,
+                                        const std::string& op, const CurveFunction& function,
+                                        const std::function<bool()>& should_stop,
+                                        RequestFields more = {}) {
+  more.insert(more.end(), {{"gate", "scope.gate"},
+                           {"dims", "scope.dims"},
+                           {"edit_weights", "constraints.edit_weights"},
+                           {"max_angles", "constraints.max_angles"},
+                           {"source_margin", "constraints.source_margin"},
+                           {"curve", "clip"}});
+  return InRequestFields(EditInSpace(context, edit, op, function, should_stop), more);
+}
+
 }  // namespace
 
 absl::StatusOr<EditResult> Scale(const EditContext& context, const ScaleRequest& request,
@@ -66,15 +83,22 @@ absl::StatusOr<EditResult> Scale(const EditContext& context, const ScaleRequest&
 
 absl::StatusOr<EditResult> Translate(const EditContext& context, const TranslateRequest& request,
                                      const std::function<bool()>& should_stop) {
+  // The request's fields for its poses, as many as the mode takes (the operator checks that).
+  const bool toward = request.options.mode == TranslateMode::kTowardPose;
+  std::vector<std::string> pose_fields = toward ? std::vector<std::string>{"target"}
+                                                : std::vector<std::string>{"axis_from", "axis_to"};
+  for (size_t i = pose_fields.size(); i < request.poses.size(); ++i) {
+    pose_fields.push_back(absl::StrCat("poses[", i, "]"));
+  }
   return RunCurveEdit(
       context, request.edit, "translate",
       [&](const SpaceSnapshot& snapshot, const RowMatrixXd& curve, const EditScope& scope,
           double rate, std::vector<SourceRange>& sources) -> absl::StatusOr<RowMatrixXd> {
         RowMatrixXd poses(request.poses.size(), curve.cols());
         for (size_t i = 0; i < request.poses.size(); ++i) {
-          MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
-                                    LoadSource(context.database, snapshot, request.poses[i],
-                                               absl::StrCat("poses[", i, "]")));
+          MOTIONDB_ASSIGN_OR_RETURN(
+              const EditSource source,
+              LoadSource(context.database, snapshot, request.poses[i], pose_fields[i]));
           MOTIONDB_ASSIGN_OR_RETURN(const EditPose pose, PoseOf(*snapshot.space, source));
           poses.row(i) = pose.coordinates.row(0);
           sources.push_back(source.range);
@@ -83,7 +107,7 @@ absl::StatusOr<EditResult> Translate(const EditContext& context, const Translate
         options.scope = scope;
         return TranslateCurve(curve, rate, poses, options);
       },
-      should_stop);
+      should_stop, {{"poses", toward ? "target" : "axis_from and axis_to"}});
 }
 
 absl::StatusOr<EditResult> Smooth(const EditContext& context, const SmoothRequest& request,

@@ -46,8 +46,9 @@ struct SmoothRequest {
   SmoothingOptions options{};
 };
 
-// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the field (clip, poses[i],
-// factor, gate.start_s, dims[0], edit_weights[Joint], ...); nothing is stored on error.
+// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the request's field (clip,
+// target, axis_from, factor, scope.gate.start_s, scope.dims[0],
+// constraints.edit_weights[Joint], ...); nothing is stored on error.
 absl::StatusOr<EditResult> Scale(const EditContext& context, const ScaleRequest& request,
                                  const std::function<bool()>& should_stop);
 absl::StatusOr<EditResult> Translate(const EditContext& context, const TranslateRequest& request,

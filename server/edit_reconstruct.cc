@@ -1,13 +1,16 @@
 #include "server/edit_reconstruct.h"
 
+#include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
 
-absl::StatusOr<ReconstructOutcome> Reconstruct(const EditContext& context,
-                                               const ReconstructRequest& request,
-                                               const std::function<bool()>& should_stop) {
+namespace {
+
+absl::StatusOr<ReconstructOutcome> Rebuild(const EditContext& context,
+                                           const ReconstructRequest& request,
+                                           const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
@@ -29,6 +32,14 @@ absl::StatusOr<ReconstructOutcome> Reconstruct(const EditContext& context,
       FinishEdit(context, space, source, edited, {"reconstruct", request.space, {source.range}},
                  request.output, should_stop));
   return outcome;
+}
+
+}  // namespace
+
+absl::StatusOr<ReconstructOutcome> Reconstruct(const EditContext& context,
+                                               const ReconstructRequest& request,
+                                               const std::function<bool()>& should_stop) {
+  return InRequestFields(Rebuild(context, request, should_stop), {{"coordinates", "clip"}});
 }
 
 }  // namespace motiondb::server

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 
@@ -84,6 +85,13 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
                             Frames("overlap_s", request.overlap_s, space.sample_rate()));
   const SpaceMotion& a = first.motion;
   const SpaceMotion& b = second.motion;
+  // Told here in seconds; the operator would say it in frames.
+  if (options.overlap_frames > a.coordinates.rows()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "overlap_s = ", request.overlap_s, " is out of range; expected at most the first range's ",
+        a.coordinates.rows() / space.sample_rate(), " s (", a.coordinates.rows(),
+        " frames at the space rate)"));
+  }
   MOTIONDB_ASSIGN_OR_RETURN(const AlignedBlend plan,
                             PlanAlignedBlend(a.coordinates, b.coordinates, options));
   EditedMotion blended{RowMatrixXd(),
@@ -114,10 +122,8 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
   return outcome;
 }
 
-}  // namespace
-
-absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGapRequest& request,
-                                       const std::function<bool()>& should_stop) {
+absl::StatusOr<FillGapOutcome> Transition(const EditContext& context, const FillGapRequest& request,
+                                          const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource first,
@@ -128,6 +134,23 @@ absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGap
     return Overlap(context, *snapshot->space, request, first, second, should_stop);
   }
   return Gap(context, *snapshot->space, request, first, second, should_stop);
+}
+
+}  // namespace
+
+absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGapRequest& request,
+                                       const std::function<bool()>& should_stop) {
+  // The request's seconds reach the operators as frames, its ranges as curves a and b (before
+  // and after), its warp fields as the warp's options.
+  return InRequestFields(Transition(context, request, should_stop),
+                         {{"frames", "gap_s (in frames at the space rate)"},
+                          {"overlap_frames", "overlap_s (in frames at the space rate)"},
+                          {"a", "first"},
+                          {"before", "first"},
+                          {"b", "second"},
+                          {"after", "second"},
+                          {"warp.slope_limit", "slope_limit"},
+                          {"warp.dims", "warp_dims"}});
 }
 
 }  // namespace motiondb::server

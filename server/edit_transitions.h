@@ -44,8 +44,8 @@ struct FillGapOutcome {
   double warp_score = 0.0;        // an overlap's: mean distance of the matched frames
 };
 
-// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the field (first, second,
-// gap_s, overlap_s, damping, ...); nothing is stored on error.
+// NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the request's field (first,
+// second, gap_s, overlap_s, damping, slope_limit, warp_dims, ...); nothing is stored on error.
 absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGapRequest& request,
                                        const std::function<bool()>& should_stop);
 

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/ops/pose_model_serialization.h"
+#include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 
@@ -87,7 +88,9 @@ absl::Status DeletePoseModel(const EditContext& context, const std::string& name
   return context.database.DeletePoseModel(name, {should_stop});
 }
 
-absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request) {
+namespace {
+
+absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectRequest& request) {
   if (request.model.empty()) return absl::InvalidArgumentError("model: a model name is required");
   if (!(request.min_duration_s >= 0.0 && request.min_duration_s <= kMaxMinDuration)) {
     return absl::InvalidArgumentError(absl::StrCat("min_duration_s = ", request.min_duration_s,
@@ -125,6 +128,15 @@ absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const Detec
     outcome.intervals.push_back(range);
   }
   return outcome;
+}
+
+}  // namespace
+
+absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request) {
+  // The operator scores the clip's range as a curve, and takes min_duration_s in frames.
+  return InRequestFields(
+      Detect(context, request),
+      {{"curve", "clip"}, {"min_frames", "min_duration_s (in frames at the space rate)"}});
 }
 
 }  // namespace motiondb::server

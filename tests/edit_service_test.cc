@@ -277,16 +277,28 @@ TEST_F(EditServiceTest, APlanarBlendHitsEachPoseAtItsPointAndItsResultIsAQuery) 
   EXPECT_LT(MaxAngleByName(*blended.Slice({10, 10}), *library->clips[1].Slice({60, 60})), 1e-4);
   EXPECT_LT(MaxAngleByName(*blended.Slice({20, 20}), *library->clips[2].Slice({100, 100})), 1e-4);
 
-  // The blend, stored, is a search query like any clip.
+  // The blend, stored, is indexed in the space and a search query like any clip: kept in the
+  // results, it finds itself first, whole and at no distance; left out, it finds other clips.
+  const int64_t stored = response.result().stored().clip_id();
   v1::SearchRequest search;
   search.set_space("body");
-  search.mutable_clip()->set_clip_id(response.result().stored().clip_id());
+  search.mutable_clip()->set_clip_id(stored);
   search.set_max_results(3);
+  search.set_exclude_query(false);
   v1::SearchResponse hits;
-  const grpc::Status searched =
-      v1::SearchService::NewStub(library->channel)->Search(Context().get(), search, &hits);
+  const auto searcher = v1::SearchService::NewStub(library->channel);
+  grpc::Status searched = searcher->Search(Context().get(), search, &hits);
   ASSERT_TRUE(searched.ok()) << searched.error_message();
-  EXPECT_GT(hits.results_size(), 0);
+  ASSERT_GT(hits.results_size(), 0);
+  EXPECT_EQ(hits.results(0).clip_id(), stored);
+  EXPECT_EQ(hits.results(0).start_frame(), 0);
+  EXPECT_EQ(hits.results(0).end_frame(), 30);
+  EXPECT_LT(hits.results(0).score(), 1e-3);
+  search.set_exclude_query(true);
+  searched = searcher->Search(Context().get(), search, &hits);
+  ASSERT_TRUE(searched.ok()) << searched.error_message();
+  ASSERT_GT(hits.results_size(), 0);
+  for (const v1::SearchResult& hit : hits.results()) EXPECT_NE(hit.clip_id(), stored);
 }
 
 TEST_F(EditServiceTest, AGapIsFilledSmootherThanALineAndAnOverlapIsWarped) {
@@ -377,8 +389,9 @@ TEST_F(EditServiceTest, PoseModelsAreFittedStoredListedRunAndDeleted) {
   v1::CreatePoseModelRequest create;
   create.set_name("take3-pose");
   create.set_space("body");
-  *create.add_examples() = Range(2, 40, 50);
-  *create.add_examples() = Range(2, 41, 49);
+  // Frames 44-46 are held out: the model must find the pose there without having seen them.
+  *create.add_examples() = Range(2, 38, 43);
+  *create.add_examples() = Range(2, 47, 52);
   create.set_components(1);
   v1::PoseModel model;
   grpc::Status status = edits_->CreatePoseModel(Context().get(), create, &model);
@@ -402,10 +415,13 @@ TEST_F(EditServiceTest, PoseModelsAreFittedStoredListedRunAndDeleted) {
   EXPECT_EQ(found.log_likelihood().size(), 150 * sizeof(float));
   ASSERT_GE(found.intervals_size(), 1);
   bool covers = false;
+  int covered = 0;
   for (const v1::DetectedInterval& interval : found.intervals()) {
-    covers |= interval.first_frame() <= 45 && interval.last_frame() >= 45;
+    covers |= interval.first_frame() <= 44 && interval.last_frame() >= 46;
+    covered += interval.last_frame() - interval.first_frame() + 1;
   }
   EXPECT_TRUE(covers);
+  EXPECT_LT(covered, 150) << "a model that fires everywhere finds nothing";
 
   v1::DeletePoseModelRequest erase;
   erase.set_name("take3-pose");
@@ -508,6 +524,107 @@ TEST_F(EditServiceTest, BadInputIsRefusedNamingTheFieldAndStoresNothing) {
   v1::ListPoseModelsResponse models;
   ASSERT_TRUE(edits_->ListPoseModels(Context().get(), {}, &models).ok());
   for (const v1::PoseModel& m : models.models()) EXPECT_NE(m.name(), "m");
+}
+
+// Every refusal names the field as the client sends it, by its path in the request, not the
+// operator's own name for it (overlap_frames, warp.dims, b, plane, gate.start_s, ...).
+TEST_F(EditServiceTest, ErrorsNameTheRequestsOwnFields) {
+  const int64_t before = ClipCount();
+  const auto expect = [](const grpc::Status& status, const std::string& field) {
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+    EXPECT_THAT(status.error_message(), ::testing::StartsWith(field));
+  };
+  v1::FillGapRequest gap;
+  gap.set_space("body");
+  *gap.mutable_first() = Range(0, 0, 10);
+  *gap.mutable_second() = Range(1, 0, 99);
+  gap.mutable_output()->set_store_name("never-stored");
+  v1::FillGapResponse filled;
+  gap.set_gap_s(3600);  // 108000 frames at 30 fps, more than a gap may have
+  expect(edits_->FillGap(Context().get(), gap, &filled), "gap_s");
+  gap.clear_gap_s();
+  gap.set_overlap_s(1.0);  // 30 frames, longer than the 11 of the first range
+  expect(edits_->FillGap(Context().get(), gap, &filled), "overlap_s");
+  gap.set_overlap_s(0.2);
+  gap.set_slope_limit(50);
+  expect(edits_->FillGap(Context().get(), gap, &filled), "slope_limit");
+  gap.clear_slope_limit();
+  gap.set_warp_dims(5000);
+  expect(edits_->FillGap(Context().get(), gap, &filled), "warp_dims");
+  gap.clear_warp_dims();
+  *gap.mutable_second() = Range(1, 0, 1);  // 2 frames: too short for an overlap of 6
+  expect(edits_->FillGap(Context().get(), gap, &filled), "second");
+  gap.set_no_align(true);
+  expect(edits_->FillGap(Context().get(), gap, &filled), "second");
+
+  v1::BlendRequest blend;
+  blend.set_space("body");
+  for (int i = 0; i < 2; ++i) {
+    v1::PlanarPose* pose = blend.add_poses();
+    *pose->mutable_pose() = Range(i, 10, 10);
+    pose->set_x(i);
+  }
+  blend.add_path()->set_x(0.5);
+  blend.add_path()->set_y(0.5);
+  blend.mutable_output()->set_store_name("never-stored");
+  v1::BlendResponse blended;
+  blend.mutable_poses(1)->set_y(std::nan(""));
+  expect(edits_->Blend(Context().get(), blend, &blended), "poses[1].y");
+  blend.mutable_poses(1)->set_y(0);
+  blend.mutable_path(1)->set_x(HUGE_VAL);
+  blend.set_frames_per_segment(4);
+  expect(edits_->Blend(Context().get(), blend, &blended), "path[1].x");
+  blend.mutable_path(1)->set_x(0);
+  *blend.mutable_poses(1)->mutable_pose() = Range(1, 10, 900);
+  expect(edits_->Blend(Context().get(), blend, &blended), "poses[1].pose.last_frame");
+
+  v1::ScaleRequest scale;
+  scale.set_space("body");
+  *scale.mutable_clip() = Range(0, 0, 29);
+  scale.mutable_output()->set_store_name("never-stored");
+  v1::EditResponse response;
+  scale.mutable_scope()->add_dims(0);
+  scale.mutable_scope()->add_dims(500);
+  expect(edits_->Scale(Context().get(), scale, &response), "scope.dims[1]");
+  scale.mutable_scope()->clear_dims();
+  scale.mutable_scope()->mutable_gate()->set_start_s(0.5);
+  scale.mutable_scope()->mutable_gate()->set_end_s(0.2);
+  expect(edits_->Scale(Context().get(), scale, &response), "scope.gate.end_s");
+  scale.mutable_scope()->mutable_gate()->set_start_s(100);  // past the range: no frame selected
+  scale.mutable_scope()->mutable_gate()->set_end_s(101);
+  scale.set_centre(v1::SCALE_CENTRE_SELECTION_MEAN);
+  expect(edits_->Scale(Context().get(), scale, &response), "scope.gate");
+  scale.clear_scope();
+  (*scale.mutable_constraints()->mutable_edit_weights())["Head"] = 2;
+  expect(edits_->Scale(Context().get(), scale, &response), "constraints.edit_weights[Head]");
+  scale.mutable_constraints()->clear_edit_weights();
+  scale.mutable_constraints()->set_source_margin(-1);
+  expect(edits_->Scale(Context().get(), scale, &response), "constraints.source_margin");
+  scale.clear_constraints();
+  scale.mutable_sigmoid()->set_width(0);
+  expect(edits_->Scale(Context().get(), scale, &response), "sigmoid.width");
+
+  v1::TranslateRequest translate;
+  translate.set_space("body");
+  *translate.mutable_clip() = Range(0, 0, 29);
+  *translate.mutable_axis_from() = Range(1, 0, 0);
+  *translate.mutable_axis_to() = Range(1, 0, 900);
+  translate.mutable_output()->set_store_name("never-stored");
+  expect(edits_->Translate(Context().get(), translate, &response), "axis_to.last_frame");
+  translate.clear_axis_from();
+  translate.clear_axis_to();
+  *translate.mutable_target() = Range(1, 900, 900);
+  expect(edits_->Translate(Context().get(), translate, &response), "target.first_frame");
+
+  v1::SmoothRequest smooth;
+  smooth.set_space("body");
+  *smooth.mutable_clip() = Range(0, 0, 29);
+  smooth.mutable_output()->set_store_name("bad//name");
+  expect(edits_->Smooth(Context().get(), smooth, &response), "output.store_name");
+  smooth.mutable_output()->set_store_name("never-stored");
+  smooth.mutable_output()->add_store_tags("");
+  expect(edits_->Smooth(Context().get(), smooth, &response), "output.store_tags[0]");
+  EXPECT_EQ(ClipCount(), before);
 }
 
 }  // namespace

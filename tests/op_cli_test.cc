@@ -205,5 +205,43 @@ TEST_F(OpCliTest, TheServersComplaintsNameTheArgumentsAndFlags) {
   EXPECT_EQ(Json({"clips"})["clips"].size(), 2u);
 }
 
+TEST_F(OpCliTest, NonFiniteNumbersAndTheOperatorsLimitsAreToldInFlags) {
+  const std::string a = ids_[0], b = ids_[1];
+  for (const std::string& point : {"nan,0", "0,inf", "-inf,1"}) {
+    const testing::CommandResult pose =
+        Remote({"op", "blend", "--space", "body", "--pose", a + ":20@" + point, "--pose",
+                b + ":50@1,0", "--path", "0,0"});
+    EXPECT_NE(pose.exit_code, 0);
+    EXPECT_THAT(pose.err, HasSubstr("--pose: expected X,Y (two finite numbers), got '" + point));
+    const testing::CommandResult path =
+        Remote({"op", "blend", "--space", "body", "--pose", a + ":20@0,0", "--path", point});
+    EXPECT_NE(path.exit_code, 0);
+    EXPECT_THAT(path.err, HasSubstr("--path: expected X,Y (two finite numbers), got '" + point));
+  }
+  const testing::CommandResult overlap =
+      Remote({"op", "fill-gap", a + ":0-10", b, "--space", "body", "--overlap", "1"});
+  EXPECT_THAT(overlap.err, HasSubstr("--overlap 1 is out of range"));
+  EXPECT_THAT(overlap.err, Not(HasSubstr("overlap_frames")));
+  // The warp's slope limit, as the API has it.
+  EXPECT_EQ(Json({"op", "fill-gap", a + ":0-40", a + ":30-89", "--space", "body", "--overlap",
+                  "0.3", "--slope-limit", "1"})["transition_frames"],
+            9);
+  const testing::CommandResult slope =
+      Remote({"op", "fill-gap", a + ":0-40", a + ":30-89", "--space", "body", "--overlap", "0.3",
+              "--slope-limit", "9"});
+  EXPECT_THAT(slope.err, HasSubstr("--slope-limit 9 is out of range"));
+  const testing::CommandResult gate =
+      Remote({"op", "scale", a, "--space", "body", "--gate", "2,1"});
+  EXPECT_THAT(gate.err, HasSubstr("--gate T1 1 is out of range"));
+  const testing::CommandResult axis = Remote({"op", "translate", a, "--space", "body",
+                                              "--axis-from", a + ":3", "--axis-to", b + ":0-900"});
+  EXPECT_THAT(axis.err, HasSubstr(b + ":0-900: frame 900 is past the clip's last frame 89"));
+  const testing::CommandResult pose =
+      Remote({"op", "blend", "--space", "body", "--pose", a + ":20@0,0", "--pose", b + ":95@1,0",
+              "--path", "0,0"});
+  EXPECT_THAT(pose.err, HasSubstr(b + ":95: frame 95"));
+  EXPECT_EQ(Json({"clips"})["clips"].size(), 2u);
+}
+
 }  // namespace
 }  // namespace motiondb

@@ -214,6 +214,44 @@ TEST(SmoothingTest, FractionalLevelsInterpolateAndSmoothingRemovesNoise) {
   EXPECT_THAT(MessageOf(SmoothCurve(noisy, {.level = std::nan("")}).status()), HasSubstr("level"));
 }
 
+// A frame count that is not a power of two is supersampled first (5.5.1); what supersampling
+// changes must not come back as noise. White noise about a constant: each level leaves less of
+// it (within 1%: between two whole levels the result is their linear mix, whose norm need not
+// fall strictly), a whole level s no more than the mean of a block of 2^s supersampled samples
+// would (sigma / sqrt(2^s n / N)), and past the top the curve is flat.
+TEST(SmoothingTest, NoiseFallsLevelByLevelWhateverTheFrameCount) {
+  for (const int frames : {65, 100, 300}) {
+    int size = 1;
+    while (size < frames) size *= 2;
+    const RowMatrixXd clean = RowMatrixXd::Constant(frames, 2, 1.5);
+    std::mt19937_64 generator(frames);
+    std::normal_distribution<double> noise(0.0, 0.2);
+    RowMatrixXd noisy = clean;
+    for (Eigen::Index i = 0; i < noisy.size(); ++i) noisy.data()[i] += noise(generator);
+    const auto error = [&](double level) {
+      const absl::StatusOr<RowMatrixXd> smoothed = SmoothCurve(noisy, {.level = level});
+      EXPECT_TRUE(smoothed.ok()) << smoothed.status();
+      return smoothed.ok() ? (*smoothed - clean).norm() : 0.0;
+    };
+    const double raw = (noisy - clean).norm();
+    EXPECT_EQ(error(0.0), raw);
+    double previous = raw;
+    for (double level = 0.25; level <= 12.0; level += 0.25) {
+      const double left = error(level);
+      EXPECT_LT(left, raw) << frames << " frames, level " << level;
+      EXPECT_LE(left, 1.01 * previous) << frames << " frames, level " << level;
+      previous = left;
+    }
+    for (int level = 1; level <= 4; ++level) {
+      const double block_frames = std::ldexp(1.0, level) * frames / size;
+      EXPECT_LT(error(level), raw / std::sqrt(block_frames))
+          << frames << " frames, level " << level;
+    }
+    const RowMatrixXd flat = *SmoothCurve(noisy, {.level = 40.0});
+    EXPECT_EQ((flat.rowwise() - flat.row(0)).cwiseAbs().maxCoeff(), 0.0) << frames << " frames";
+  }
+}
+
 TEST(PlanarBlendTest, WeightsSumToOneAndEachPoseIsHitAtItsPoint) {
   const RowMatrixXd poses = Wave(4, 6);
   RowMatrixXd plane(4, 2);
@@ -245,6 +283,31 @@ TEST(PlanarBlendTest, WeightsSumToOneAndEachPoseIsHitAtItsPoint) {
               HasSubstr("poses"));
   EXPECT_THAT(MessageOf(BlendOnPlane(poses, plane, RowMatrixXd(0, 2)).status()),
               HasSubstr("points"));
+}
+
+// Eq. 4.2's weights at the extremes of a double: a point 1e-200 from a pose (whose squared
+// distance underflows) and points 1e200 away (whose squared distances overflow) still give
+// finite weights summing to 1: the nearest pose all of it, or the far poses alike.
+TEST(PlanarBlendTest, WeightsStayFiniteAtTinyAndHugeDistances) {
+  const RowMatrixXd poses = Wave(3, 4);
+  RowMatrixXd plane(3, 2);
+  plane << 0, 0, 1, 0, 0, 1;
+  RowMatrixXd points(4, 2);
+  points << 1e-200, 0, 1e200, 0, -1e200, 1e200, 1e-200, 1e200;
+  for (const double epsilon : {0.0, 1e-6}) {
+    const absl::StatusOr<PlanarBlend> blend =
+        BlendOnPlane(poses, plane, points, {.epsilon = epsilon});
+    ASSERT_TRUE(blend.ok()) << blend.status();
+    ASSERT_TRUE(blend->weights.allFinite()) << blend->weights;
+    ASSERT_TRUE(blend->coordinates.allFinite());
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(blend->weights.row(k).sum(), 1.0, 1e-12) << k;
+    // With epsilon the pose's own point is 1e-3 from it in eq. 4.2's terms, the others about 1.
+    EXPECT_GT(blend->weights(0, 0), epsilon == 0.0 ? 1.0 - 1e-12 : 0.99) << "epsilon " << epsilon;
+    for (int k = 1; k < 4; ++k) {
+      EXPECT_TRUE(blend->weights.row(k).isApprox(Eigen::RowVector3d::Constant(1.0 / 3), 1e-9))
+          << "epsilon " << epsilon << ", point " << k << ": " << blend->weights.row(k);
+    }
+  }
 }
 
 TEST(GapFillTest, TheHermiteCurveHitsItsEndsAndTheirDerivatives) {
@@ -295,6 +358,34 @@ TEST(GapFillTest, MotionAtConstantVelocityContinuesAcrossTheGap) {
   EXPECT_THAT(MessageOf(FillGap(before, after, {.derivative_smoothing = -1}).status()),
               HasSubstr("derivative_smoothing"));
   EXPECT_THAT(MessageOf(FillGap(before, RowMatrixXd::Zero(3, 3)).status()), HasSubstr("after"));
+}
+
+// Smoothing before the finite difference (4.3) must not flatten the ends: a clip moving at
+// constant speed keeps its speed at both ends at every level (the curve is continued past the
+// end by odd reflection, so the end is no block's edge). Levels beyond the reflected curve's
+// own make it flat, and a clip of one frame has no velocity.
+TEST(GapFillTest, SmoothedEndVelocitiesKeepARampsSlope) {
+  RowMatrixXd ramp(40, 2);
+  for (int f = 0; f < 40; ++f) ramp.row(f) << f, 3.0 - 0.5 * f;
+  const Eigen::RowVector2d slope(1.0, -0.5);
+  for (const double level : {0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0}) {
+    for (const CurveEnd end : {CurveEnd::kFirst, CurveEnd::kLast}) {
+      const absl::StatusOr<Eigen::RowVectorXd> velocity = EndVelocity(ramp, {.level = level}, end);
+      ASSERT_TRUE(velocity.ok()) << velocity.status();
+      EXPECT_TRUE(velocity->isApprox(slope, 1e-12))
+          << "level " << level << (end == CurveEnd::kFirst ? ", first" : ", last")
+          << " end: " << *velocity;
+    }
+  }
+  EXPECT_EQ(*EndVelocity(ramp.topRows(1), {.level = 2.0}, CurveEnd::kLast),
+            Eigen::RowVector2d::Zero());
+  EXPECT_THAT(MessageOf(EndVelocity(ramp, {.level = -1.0}, CurveEnd::kLast).status()),
+              HasSubstr("level"));
+  // Through FillGap: two pieces of one line, smoothed, leave the gap on the line.
+  const RowMatrixXd before = ramp.topRows(20);
+  const RowMatrixXd after = ramp.bottomRows(10);
+  const RowMatrixXd gap = *FillGap(before, after, {.frames = 10, .derivative_smoothing = 3.0});
+  for (int k = 0; k < 10; ++k) EXPECT_TRUE(gap.row(k).isApprox(ramp.row(20 + k), 1e-12)) << k;
 }
 
 TEST(AlignedBlendTest, TheWarpMatchesPhasesThatAFrameForFrameBlendMixesUp) {

@@ -152,6 +152,30 @@ class StorageTest : public ::testing::Test {
     EXPECT_TRUE(counts.ok()) << counts.status();
     return counts.value_or(Counts{});
   }
+  // Closes the database and copies its skeletons, clips and tags into a new file at schema
+  // `version`, made by its own migrations, whose clips table has `clip_columns`; path_ then names
+  // that file. Checks the copy has the version and lacks `missing_column` of clips.
+  void CopyToOldSchema(int version, const std::string& clip_columns,
+                       const std::string& missing_column) {
+    Close();
+    const std::string old_path = (dir_ / absl::StrCat("schema", version, ".db")).string();
+    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
+        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
+    ASSERT_TRUE(old.ok()) << old.status();
+    ASSERT_TRUE(MigrateSchema(**old, version).ok());
+    const absl::Status copied = (*old)->Execute(absl::StrCat(
+        "ATTACH DATABASE '", path_, "' AS current;",
+        "INSERT INTO skeletons SELECT * FROM current.skeletons;", "INSERT INTO clips SELECT ",
+        clip_columns, " FROM current.clips;",
+        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;", "DETACH DATABASE current"));
+    ASSERT_TRUE(copied.ok()) << copied;
+    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), version);
+    EXPECT_EQ(
+        *(*old)->QueryInt64(absl::StrCat(
+            "SELECT count(*) FROM pragma_table_info('clips') WHERE name = '", missing_column, "'")),
+        0);
+    path_ = old_path;
+  }
   // A raw connection, to look at and damage what the Database wrote.
   std::unique_ptr<SqliteConnection> Raw() {
     auto raw = SqliteConnection::Open(path_, SqliteConnection::Mode::kReadWrite, 1000);
@@ -953,27 +977,10 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   Close();
 
   // Version 1's schema, made by its own migration, holding the same rows.
-  const std::string old_path = (dir_ / "schema1.db").string();
-  {
-    absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
-        SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
-    ASSERT_TRUE(old.ok()) << old.status();
-    ASSERT_TRUE(MigrateSchema(**old, 1).ok());
-    const absl::Status copied = (*old)->Execute(absl::StrCat(
-        "ATTACH DATABASE '", path_, "' AS current;",
-        "INSERT INTO skeletons SELECT * FROM current.skeletons;"
-        "INSERT INTO clips SELECT clip_id, name, source_file, skeleton_id, frame_time, "
-        "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
-        "created_unix_ms FROM current.clips;"
-        "INSERT INTO clip_tags SELECT * FROM current.clip_tags;"
-        "DETACH DATABASE current"));
-    ASSERT_TRUE(copied.ok()) << copied;
-    EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), 1);
-    EXPECT_EQ(*(*old)->QueryInt64(
-                  "SELECT count(*) FROM pragma_table_info('clips') WHERE name = 'content_hash'"),
-              0);
-  }
-  path_ = old_path;
+  CopyToOldSchema(1,
+                  "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+                  "position_joint_count, layout, rotations, positions, created_unix_ms",
+                  "content_hash");
 
   for (const int64_t id : {a, b, c}) {
     const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
@@ -994,6 +1001,48 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   raw.reset();
   // New clips go on after the copied ids.
   EXPECT_GT(Insert(Named("new"), walk), c);
+}
+
+// A file of schema version 3, as builds before the operators (issue 16) wrote it, keeps its
+// clips when opened and gains what version 4 adds: each clip's provenance (none for an ingested
+// clip) and the pose models' table.
+TEST_F(StorageTest, SchemaThreeFileKeepsItsClipsAndGainsProvenanceAndPoseModels) {
+  const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
+  const int64_t a = Insert(Named("walk", {"x"}), walk);
+  const int64_t b = Insert(Named("session1/run"), Motion(testing::ChainSkeleton(), 30, 2));
+  std::map<int64_t, ClipRecord> expected;
+  for (const int64_t id : {a, b}) expected[id] = *Db().GetClipRecord(id);
+  Close();
+
+  CopyToOldSchema(3,
+                  "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+                  "position_joint_count, layout, rotations, positions, created_unix_ms, "
+                  "content_hash",
+                  "provenance");
+  EXPECT_EQ(*Raw()->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'pose_models'"), 0);
+
+  for (const int64_t id : {a, b}) {
+    const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->name, expected[id].name);
+    EXPECT_EQ(record->tags, expected[id].tags);
+    EXPECT_EQ(record->content_hash, expected[id].content_hash);
+    EXPECT_EQ(record->frame_count, expected[id].frame_count);
+    EXPECT_EQ(record->provenance, "");
+    const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+  }
+  EXPECT_EQ(Db().GetClip(a)->clip.frame_count(), 20);
+  const absl::StatusOr<std::vector<PoseModelRecord>> models = Db().ListPoseModels();
+  ASSERT_TRUE(models.ok()) << models.status();
+  EXPECT_TRUE(models->empty());
+  EXPECT_EQ(*Raw()->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  // A clip made by an operator keeps where it came from.
+  ClipRecord made = Named("made");
+  made.provenance = R"({"operator":"smooth"})";
+  const int64_t c = Insert(made, walk);
+  EXPECT_GT(c, b);
+  EXPECT_EQ(Db().GetClipRecord(c)->provenance, made.provenance);
 }
 
 TEST_F(StorageTest, ForeignFilesAreRefusedUntouched) {

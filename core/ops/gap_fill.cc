@@ -4,7 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
-#include "core/ops/wavelet_smoothing.h"
+#include "core/ops/internal/quat_rows.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -12,25 +12,34 @@ namespace {
 
 constexpr int kMaxGapFrames = 100000;
 
-// The velocity per frame at the `last` (or first) end of `curve`, after smoothing.
-absl::StatusOr<Eigen::RowVectorXd> EndVelocity(const Eigen::Ref<const RowMatrixXd>& curve,
-                                               double smoothing, bool last) {
-  const Eigen::Index n = curve.rows();
-  if (n < 2) return Eigen::RowVectorXd::Zero(curve.cols()).eval();
-  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd smooth, SmoothCurve(curve, {.level = smoothing}));
-  return last ? Eigen::RowVectorXd(smooth.row(n - 1) - smooth.row(n - 2))
-              : Eigen::RowVectorXd(smooth.row(1) - smooth.row(0));
-}
-
 // The angular velocity of one joint from frame f to f + 1, per frame.
 Eigen::Vector3d Step(const Eigen::Ref<const RowMatrixXd>& rotations, Eigen::Index f,
                      Eigen::Index j) {
-  const auto a = rotations.block<1, 4>(f, 4 * j);
-  const auto b = rotations.block<1, 4>(f + 1, 4 * j);
-  return LogMap(Quat(a[0], a[1], a[2], a[3]).conjugate() * Quat(b[0], b[1], b[2], b[3]));
+  return LogMap(ops_internal::QuatAt(rotations, f, 4 * j).conjugate() *
+                ops_internal::QuatAt(rotations, f + 1, 4 * j));
 }
 
 }  // namespace
+
+absl::StatusOr<Eigen::RowVectorXd> EndVelocity(const Eigen::Ref<const RowMatrixXd>& curve,
+                                               const SmoothingOptions& smoothing, CurveEnd end) {
+  const Eigen::Index n = curve.rows();
+  if (n < 2) return Eigen::RowVectorXd::Zero(curve.cols()).eval();
+  // The curve runs towards its end, then on past it by odd reflection about the end sample,
+  // x(end + k) = 2 x(end) - x(end - k). Smoothed as it is, the end would be a block's edge and
+  // the last block's mean would flatten it; continued, a straight line stays straight through
+  // the end, and the reflection's symmetry keeps the smoothed end at the end sample.
+  const RowMatrixXd toward =
+      end == CurveEnd::kLast ? RowMatrixXd(curve) : RowMatrixXd(curve.colwise().reverse());
+  RowMatrixXd continued(2 * n - 1, curve.cols());
+  continued.topRows(n) = toward;
+  for (Eigen::Index k = 1; k < n; ++k) {
+    continued.row(n - 1 + k) = 2.0 * toward.row(n - 1) - toward.row(n - 1 - k);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd smooth, SmoothCurve(continued, smoothing));
+  const Eigen::RowVectorXd velocity = smooth.row(n - 1) - smooth.row(n - 2);
+  return end == CurveEnd::kLast ? velocity : Eigen::RowVectorXd(-velocity);
+}
 
 AngleError VelocityJump(const Eigen::Ref<const RowMatrixXd>& rotations, int seam, double rate) {
   AngleError jump;
@@ -81,10 +90,12 @@ absl::StatusOr<RowMatrixXd> FillGap(const Eigen::Ref<const RowMatrixXd>& before,
     for (int k = 0; k < options.frames; ++k) line.row(k) = (1.0 - t[k]) * p0 + t[k] * p1;
     return line;
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::RowVectorXd d0,
-                            EndVelocity(before, options.derivative_smoothing, true));
-  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::RowVectorXd d1,
-                            EndVelocity(after, options.derivative_smoothing, false));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const Eigen::RowVectorXd d0,
+      EndVelocity(before, {.level = options.derivative_smoothing}, CurveEnd::kLast));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const Eigen::RowVectorXd d1,
+      EndVelocity(after, {.level = options.derivative_smoothing}, CurveEnd::kFirst));
   // Per frame to per unit of t, which spans `steps` frames.
   return HermiteCurve(p0, p1, d0 * steps, d1 * steps, options.damping, t);
 }

@@ -13,6 +13,7 @@
 #include "absl/status/statusor.h"
 #include "core/motion/matrix.h"
 #include "core/ops/reconstruction.h"
+#include "core/ops/wavelet_smoothing.h"
 
 namespace motiondb {
 
@@ -39,6 +40,16 @@ RowMatrixXd HermiteCurve(const Eigen::Ref<const Eigen::RowVectorXd>& p0,
                          const Eigen::Ref<const Eigen::RowVectorXd>& d0,
                          const Eigen::Ref<const Eigen::RowVectorXd>& d1, double damping,
                          const Eigen::Ref<const Eigen::VectorXd>& t);
+
+enum class CurveEnd { kFirst, kLast };
+
+// The velocity per frame at `end` of `curve` (frames x dims): the finite difference of its two
+// end frames after `smoothing` of the curve continued past that end by odd reflection, so that
+// smoothing keeps a straight line's slope at its end (a level beyond the continued curve's own,
+// about log2 of twice the frames, flattens it to 0). 0 for a curve of one frame.
+// INVALID_ARGUMENT naming level, or the curve for NaN values.
+absl::StatusOr<Eigen::RowVectorXd> EndVelocity(const Eigen::Ref<const RowMatrixXd>& curve,
+                                               const SmoothingOptions& smoothing, CurveEnd end);
 
 // The options.frames poses between `before` (ending at P0) and `after` (starting at P1), both
 // frames x dims at one rate, at t = k / (frames + 1) for k = 1..frames. A clip of one frame

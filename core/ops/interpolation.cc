@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
+#include "core/ops/internal/quat_rows.h"
 #include "core/space/pose_encoder.h"
 #include "util/status_macros.h"
 
@@ -33,14 +34,10 @@ RowMatrixXd SlerpJoints(const Eigen::Ref<const RowMatrixXd>& rotations,
                         const std::vector<double>& t) {
   RowMatrixXd slerp(t.size(), rotations.cols());
   for (Eigen::Index j = 0; j < rotations.cols(); j += 4) {
-    const auto a = rotations.block<1, 4>(0, j);
-    const auto b = rotations.block<1, 4>(1, j);
-    const Quat qa(a[0], a[1], a[2], a[3]);
-    const Quat qb(b[0], b[1], b[2], b[3]);
+    const Quat qa = ops_internal::QuatAt(rotations, 0, j);
+    const Quat qb = ops_internal::QuatAt(rotations, 1, j);
     for (size_t i = 0; i < t.size(); ++i) {
-      Quat q = Slerp(qa, qb, t[i]);
-      if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-      slerp.block<1, 4>(i, j) << q.w(), q.x(), q.y(), q.z();
+      ops_internal::SetQuatAt(Slerp(qa, qb, t[i]), slerp, static_cast<Eigen::Index>(i), j);
     }
   }
   return slerp;

@@ -7,10 +7,14 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
+#include "core/ops/internal/quat_rows.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
 namespace {
+
+using ops_internal::QuatAt;
+using ops_internal::SetQuatAt;
 
 absl::Status CheckJointValues(const Skeleton& skeleton, absl::string_view field,
                               const std::map<std::string, double>& values, double high) {
@@ -22,16 +26,6 @@ absl::Status CheckJointValues(const Skeleton& skeleton, absl::string_view field,
     MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckBetween(name, value, 0.0, high));
   }
   return absl::OkStatus();
-}
-
-Quat QuatAt(const Eigen::Ref<const RowMatrixXd>& block, Eigen::Index row, Eigen::Index column) {
-  const auto q = block.block<1, 4>(row, column);
-  return Quat(q[0], q[1], q[2], q[3]);
-}
-
-void Store(const Quat& q, RowMatrixXd* block, Eigen::Index row, Eigen::Index column) {
-  const double sign = q.w() < 0.0 ? -1.0 : 1.0;
-  block->block<1, 4>(row, column) << sign * q.w(), sign * q.x(), sign * q.y(), sign * q.z();
 }
 
 Quat Reference(const MotionSpace& space, int joint) {
@@ -90,7 +84,8 @@ absl::Status ApplyJointConstraints(const MotionSpace& space, const JointConstrai
   for (const auto& [joint, weight] : constraints.edit_weights) {
     const int j = space.skeleton().FindJoint(joint);
     for (Eigen::Index f = 0; f < edited->rows(); ++f) {
-      Store(Slerp(QuatAt(source, f, 4 * j), QuatAt(*edited, f, 4 * j), weight), edited, f, 4 * j);
+      SetQuatAt(Slerp(QuatAt(source, f, 4 * j), QuatAt(*edited, f, 4 * j), weight), *edited, f,
+                4 * j);
     }
   }
   const std::vector<double> limits = Limits(space, constraints, source);
@@ -100,7 +95,7 @@ absl::Status ApplyJointConstraints(const MotionSpace& space, const JointConstrai
     for (Eigen::Index f = 0; f < edited->rows(); ++f) {
       const Quat q = QuatAt(*edited, f, 4 * j);
       const double angle = AngleBetween(q, reference);
-      if (angle > limits[j]) Store(Slerp(reference, q, limits[j] / angle), edited, f, 4 * j);
+      if (angle > limits[j]) SetQuatAt(Slerp(reference, q, limits[j] / angle), *edited, f, 4 * j);
     }
   }
   return absl::OkStatus();

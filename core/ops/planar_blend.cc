@@ -16,8 +16,13 @@ absl::Status CheckPlanePoints(absl::string_view field, const Eigen::Ref<const Ro
     return absl::InvalidArgumentError(
         absl::StrCat(field, ": ", m.rows(), " x ", m.cols(), " values, expected ", rows, " x 2"));
   }
-  if (!m.allFinite()) {
-    return absl::InvalidArgumentError(absl::StrCat(field, ": NaN or infinite coordinates"));
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (const int c : {0, 1}) {
+      if (!std::isfinite(m(i, c))) {
+        return absl::InvalidArgumentError(absl::StrCat(field, "[", i, "].", c == 0 ? "x" : "y",
+                                                       " = ", m(i, c), " is not a finite number"));
+      }
+    }
   }
   return absl::OkStatus();
 }
@@ -37,16 +42,22 @@ absl::StatusOr<PlanarBlend> BlendOnPlane(const Eigen::Ref<const RowMatrixXd>& po
                                                       std::numeric_limits<double>::max()));
   PlanarBlend blend;
   blend.weights.resize(points.rows(), poses.rows());
+  const double root_epsilon = std::sqrt(options.epsilon);
   for (Eigen::Index k = 0; k < points.rows(); ++k) {
-    for (Eigen::Index i = 0; i < poses.rows(); ++i) {
-      const double squared = (points.row(k) - plane.row(i)).squaredNorm() + options.epsilon;
-      // On a pose's own point with epsilon 0 the weight is infinite: the limit is that pose.
-      blend.weights(k, i) =
-          squared > 0.0 ? 1.0 / std::sqrt(squared) : std::numeric_limits<double>::infinity();
-    }
+    // Eq. 4.2's 1 / sqrt(d^2 + epsilon), each divided by the smallest: the squares would
+    // underflow at 1e-200 and overflow at 1e200, hypot does neither, and the ratios lie in
+    // [0, 1]. On a pose's own point with epsilon 0 (or where every distance is infinite) the
+    // smallest is no number to divide by; the limit is the nearest poses alike.
     auto row = blend.weights.row(k);
-    if (!row.allFinite()) {
-      row = row.unaryExpr([](double w) { return std::isinf(w) ? 1.0 : 0.0; });
+    for (Eigen::Index i = 0; i < poses.rows(); ++i) {
+      const Eigen::RowVector2d d = points.row(k) - plane.row(i);
+      row[i] = std::hypot(std::hypot(d[0], d[1]), root_epsilon);
+    }
+    const double nearest = row.minCoeff();
+    if (nearest > 0.0 && std::isfinite(nearest)) {
+      row = row.unaryExpr([nearest](double r) { return nearest / r; });
+    } else {
+      row = row.unaryExpr([nearest](double r) { return r == nearest ? 1.0 : 0.0; });
     }
     row /= row.sum();
   }

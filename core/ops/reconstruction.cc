@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
+#include "core/ops/internal/quat_rows.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -15,9 +16,8 @@ void AngleErrors(const Eigen::Ref<const RowMatrixXd>& a, const Eigen::Ref<const 
   *overall = {};
   for (Eigen::Index f = 0; f < a.rows(); ++f) {
     for (Eigen::Index j = 0; j < count; ++j) {
-      const auto p = a.block<1, 4>(f, 4 * j);
-      const auto q = b.block<1, 4>(f, 4 * j);
-      const double angle = AngleBetween(Quat(p[0], p[1], p[2], p[3]), Quat(q[0], q[1], q[2], q[3]));
+      const double angle =
+          AngleBetween(ops_internal::QuatAt(a, f, 4 * j), ops_internal::QuatAt(b, f, 4 * j));
       per_joint[j].mean_rad += angle;
       per_joint[j].max_rad = std::max(per_joint[j].max_rad, angle);
     }

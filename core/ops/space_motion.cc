@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/motion/resample.h"
+#include "core/ops/internal/quat_rows.h"
 #include "core/space/heading.h"
 #include "core/space/pose_encoder.h"
 #include "core/space/root_velocity.h"
@@ -14,6 +15,8 @@
 
 namespace motiondb {
 namespace {
+
+using ops_internal::QuatAt;
 
 // The joints above the pelvis, root first.
 std::vector<int> AbovePelvis(const Skeleton& skeleton) {
@@ -23,11 +26,6 @@ std::vector<int> AbovePelvis(const Skeleton& skeleton) {
   }
   std::reverse(chain.begin(), chain.end());
   return chain;
-}
-
-Quat QuatAt(const RowMatrixXd& block, Eigen::Index row, Eigen::Index column) {
-  const auto q = block.block<1, 4>(row, column);
-  return Quat(q[0], q[1], q[2], q[3]);
 }
 
 }  // namespace
@@ -59,14 +57,6 @@ absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& cli
                             space.Project(EncodePoses(pose, space.data().references)));
   motion.rotations = std::move(pose.rotations);
   return motion;
-}
-
-Placement SlicePlacement(const Placement& placement, int first, int count) {
-  Placement slice;
-  slice.positions = placement.positions.middleRows(first, count);
-  if (placement.yaw.size() > 0) slice.yaw = placement.yaw.segment(first, count);
-  slice.above_pelvis = placement.above_pelvis.middleRows(first, count);
-  return slice;
 }
 
 Placement EmptyPlacement(const Placement& like, int frames) {

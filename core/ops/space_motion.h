@@ -41,9 +41,6 @@ struct SpaceMotion {
 // when its skeleton is not the space's.
 absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip);
 
-// `count` frames of a placement from `first`.
-Placement SlicePlacement(const Placement& placement, int first, int count);
-
 // One frame of a placement, as a mix takes it.
 struct PlacementFrame {
   const Placement* placement = nullptr;

@@ -71,12 +71,14 @@ absl::StatusOr<RowMatrixXd> SmoothCurve(const Eigen::Ref<const RowMatrixXd>& cur
   const int high = std::min(low + 1, top);
   const double fraction = level - low;
   const Eigen::Index n = curve.rows();
-  // Read back at the frames, the supersampling's own error (level 0 read back) is taken out, so
-  // that the result tends to the curve itself as the level tends to 0.
-  const RowMatrixXd base = LevelAtFrames(pyramid, 0, n);
-  RowMatrixXd smoothed = (1.0 - fraction) * LevelAtFrames(pyramid, low, n);
-  if (fraction > 0.0) smoothed += fraction * LevelAtFrames(pyramid, high, n);
-  return RowMatrixXd(curve + (smoothed - base));
+  // Level 0 is the curve itself, not its supersampled pyramid read back: away from a power of
+  // two the two differ by part of the curve's noise, which must not come back at any level.
+  const auto at_level = [&](int s) {
+    return s == 0 ? RowMatrixXd(curve) : LevelAtFrames(pyramid, s, n);
+  };
+  RowMatrixXd smoothed = (1.0 - fraction) * at_level(low);
+  if (fraction > 0.0) smoothed += fraction * at_level(high);
+  return smoothed;
 }
 
 }  // namespace motiondb

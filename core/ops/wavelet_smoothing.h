@@ -3,9 +3,10 @@
 // differences of adjacent samples, and reconstructed without its finest `level` levels of
 // differences: what remains at level s is the mean of each block of 2^s samples, read at the
 // curve's own frames by linear interpolation between block centres. A fractional level is the
-// linear interpolation of its two neighbouring whole levels (after Finkelstein and Salesin).
-// Level 0 returns the curve as it is; level L and beyond, its mean (exactly when the frame count
-// is a power of two; otherwise plus the little that supersampling and reading back change).
+// linear interpolation of its two neighbouring whole levels (after Finkelstein and Salesin),
+// level 0 being the curve as it is, so that levels between 0 and 1 mix the curve with its first
+// smoothing. Level L and beyond give every frame one value: the mean of the supersampled curve
+// (the curve's mean when the frame count is a power of two).
 //
 // Pure functions; thread-safe.
 #ifndef MOTIONDB_CORE_OPS_WAVELET_SMOOTHING_H_
