@@ -207,7 +207,7 @@ TEST_F(OpCliTest, TheServersComplaintsNameTheArgumentsAndFlags) {
 
 TEST_F(OpCliTest, NonFiniteNumbersAndTheOperatorsLimitsAreToldInFlags) {
   const std::string a = ids_[0], b = ids_[1];
-  for (const std::string& point : {"nan,0", "0,inf", "-inf,1"}) {
+  for (const std::string point : {"nan,0", "0,inf", "-inf,1"}) {
     const testing::CommandResult pose =
         Remote({"op", "blend", "--space", "body", "--pose", a + ":20@" + point, "--pose",
                 b + ":50@1,0", "--path", "0,0"});
@@ -239,7 +239,7 @@ TEST_F(OpCliTest, NonFiniteNumbersAndTheOperatorsLimitsAreToldInFlags) {
   const testing::CommandResult pose =
       Remote({"op", "blend", "--space", "body", "--pose", a + ":20@0,0", "--pose", b + ":95@1,0",
               "--path", "0,0"});
-  EXPECT_THAT(pose.err, HasSubstr(b + ":95: frame 95"));
+  EXPECT_THAT(pose.err, HasSubstr(b + ":95@1,0: frame 95 is past the clip's last frame 89"));
   EXPECT_EQ(Json({"clips"})["clips"].size(), 2u);
 }
 
