@@ -1,6 +1,7 @@
 #include "server/http/json_transcoding.h"
 
 #include <google/protobuf/struct.pb.h>
+#include <google/protobuf/stubs/common.h>
 #include <google/protobuf/util/json_util.h>
 
 #include "absl/strings/ascii.h"
@@ -139,6 +140,14 @@ absl::Status SetField(absl::string_view path, absl::string_view text, Message* m
     if (!last) {
       return absl::InvalidArgumentError(
           absl::StrCat("parameter '", path, "': '", names[i], "' has no fields"));
+    }
+    // A protobuf string holds UTF-8, and the services' side refuses a request with anything
+    // else as a whole (INTERNAL, no message); a percent-encoded path or query can carry any byte.
+    if (field->type() == FieldDescriptor::TYPE_STRING &&
+        !google::protobuf::internal::IsStructurallyValidUTF8(text.data(),
+                                                             static_cast<int>(text.size()))) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("parameter '", path, "': not UTF-8 text (percent-encode UTF-8 bytes)"));
     }
     if (!SetScalar(*field, text, owner)) {
       return absl::InvalidArgumentError(absl::StrCat("parameter '", path, "': '",
