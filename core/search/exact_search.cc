@@ -7,10 +7,10 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
-#include <thread>
 
 #include "absl/functional/function_ref.h"
 #include "core/search/internal/search_query.h"
+#include "util/parallel_for.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -228,11 +228,6 @@ class FinishedClips {
   std::atomic<float> bound_{kInfinity};
 };
 
-int ScanThreads(const SearchParams& params, int clips) {
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  return std::clamp(params.exact_threads > 0 ? params.exact_threads : cores, 1, clips);
-}
-
 }  // namespace
 
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
@@ -242,34 +237,22 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   SearchResponse response;
   const auto warps = std::chrono::steady_clock::now();
   FinishedClips finished(params.max_results, query.rows);
-  std::atomic<int> next_clip{0};
-  std::atomic<bool> failed{false};
-  const int threads = ScanThreads(params, library.clip_count());
-  std::vector<absl::Status> statuses(threads);
-  std::vector<SearchStats> stats(threads);
-  const auto scan_clips = [&](int thread) {
-    for (int c = next_clip++; c < library.clip_count() && !failed; c = next_clip++) {
-      if (!allowed.empty() && !allowed[c]) continue;
-      StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
-      ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
-      statuses[thread] = scan.Run(
-          c, params, [&] { return finished.bound(); }, top, stats[thread]);
-      if (!statuses[thread].ok()) {
-        failed = true;
-        return;
-      }
-      finished.Add(top.Take());
-    }
-  };
-  {
-    std::vector<std::jthread> helpers;
-    for (int t = 1; t < threads; ++t) helpers.emplace_back(scan_clips, t);
-    scan_clips(0);
-  }
-  for (int t = 0; t < threads; ++t) {
-    MOTIONDB_RETURN_IF_ERROR(statuses[t]);
-    response.stats.cells += stats[t].cells;
-    response.stats.pruned_blocks += stats[t].pruned_blocks;
+  std::vector<SearchStats> stats(ThreadsFor(params.exact_threads));
+  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
+      library.clip_count(), static_cast<int>(stats.size()),
+      [&](int64_t index, int thread) -> absl::Status {
+        const int c = static_cast<int>(index);
+        if (!allowed.empty() && !allowed[c]) return absl::OkStatus();
+        StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
+        ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
+        MOTIONDB_RETURN_IF_ERROR(scan.Run(
+            c, params, [&] { return finished.bound(); }, top, stats[thread]));
+        finished.Add(top.Take());
+        return absl::OkStatus();
+      }));
+  for (const SearchStats& thread_stats : stats) {
+    response.stats.cells += thread_stats.cells;
+    response.stats.pruned_blocks += thread_stats.pruned_blocks;
   }
   response.stats.warps_ms = MillisecondsSince(warps);
   response.results = FinishResults(library, finished.Take(), params);

@@ -1,0 +1,77 @@
+// util/parallel_for.h: every index once, per-thread slots, and the failure that does not depend
+// on timing.
+#include "util/parallel_for.h"
+
+#include <atomic>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+
+namespace motiondb {
+namespace {
+
+TEST(ParallelFor, CallsEveryIndexOnceOnTheThreadsAsked) {
+  constexpr int64_t kCount = 5000;
+  std::vector<std::atomic<int>> calls(kCount);
+  std::vector<std::set<std::thread::id>> ids(4);  // a slot a thread: no lock needed
+  ASSERT_TRUE(ParallelFor(kCount, 4, [&](int64_t i, int thread) {
+                ++calls[i];
+                ids[thread].insert(std::this_thread::get_id());
+                return absl::OkStatus();
+              }).ok());
+  for (int64_t i = 0; i < kCount; ++i) ASSERT_EQ(calls[i], 1) << "index " << i;
+  std::set<std::thread::id> all;
+  size_t used = 0;
+  for (const auto& slot : ids) {
+    EXPECT_LE(slot.size(), 1u) << "a thread number was used by two threads";
+    used += slot.size();
+    all.insert(slot.begin(), slot.end());
+  }
+  EXPECT_EQ(all.size(), used) << "a thread ran under two thread numbers";
+  EXPECT_TRUE(ids[0].contains(std::this_thread::get_id())) << "the caller is thread 0";
+}
+
+TEST(ParallelFor, NoIndicesNoCallsAndOneThreadIsTheCaller) {
+  bool called = false;
+  EXPECT_TRUE(ParallelFor(0, 4, [&](int64_t, int) {
+                called = true;
+                return absl::OkStatus();
+              }).ok());
+  EXPECT_FALSE(called);
+  std::set<std::thread::id> ids;
+  EXPECT_TRUE(ParallelFor(100, 1, [&](int64_t, int thread) {
+                EXPECT_EQ(thread, 0);
+                ids.insert(std::this_thread::get_id());
+                return absl::OkStatus();
+              }).ok());
+  EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
+}
+
+// Indices are handed out in order, so the lowest failing one always runs and its failure is the
+// one returned, whichever thread fails first; later indices stop being handed out.
+TEST(ParallelFor, ReturnsTheLowestFailureAndStopsHandingOut) {
+  for (int threads : {1, 2, 8}) {
+    std::atomic<int64_t> calls{0};
+    const absl::Status status = ParallelFor(100000, threads, [&](int64_t i, int) {
+      ++calls;
+      if (i == 37 || i == 38 || i == 900) {
+        return absl::InvalidArgumentError(absl::StrCat("index ", i));
+      }
+      return absl::OkStatus();
+    });
+    EXPECT_EQ(status, absl::InvalidArgumentError("index 37")) << threads << " threads";
+    EXPECT_LT(calls, 100000) << threads << " threads";
+  }
+}
+
+TEST(ThreadsFor, ZeroIsOnePerCore) {
+  EXPECT_EQ(ThreadsFor(3), 3);
+  EXPECT_EQ(ThreadsFor(0), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+}
+
+}  // namespace
+}  // namespace motiondb

@@ -1,0 +1,45 @@
+#include "util/parallel_for.h"
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace motiondb {
+
+int ThreadsFor(int requested) {
+  if (requested > 0) return requested;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+absl::Status ParallelFor(int64_t count, int threads,
+                         const std::function<absl::Status(int64_t index, int thread)>& body) {
+  const int used = static_cast<int>(std::clamp<int64_t>(threads, 1, std::max<int64_t>(count, 1)));
+  std::atomic<int64_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex mutex;
+  int64_t failed_index = count;  // the lowest failed index, under `mutex`
+  absl::Status failure;
+  const auto run = [&](int thread) {
+    for (int64_t i = next++; i < count && !failed.load(std::memory_order_relaxed); i = next++) {
+      absl::Status status = body(i, thread);
+      if (status.ok()) continue;
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (i < failed_index) {
+        failed_index = i;
+        failure = std::move(status);
+      }
+      failed = true;
+    }
+  };
+  {
+    std::vector<std::jthread> helpers;
+    helpers.reserve(used - 1);
+    for (int t = 1; t < used; ++t) helpers.emplace_back(run, t);
+    run(0);
+  }
+  return failure;
+}
+
+}  // namespace motiondb
