@@ -2,8 +2,10 @@
 // libraries with planted patterns (no space needed).
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <random>
 #include <thread>
+#include <tuple>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -613,6 +615,76 @@ TEST(SearchRecall, FastSearchFindsWhatExactSearchFinds) {
                                             r.path, params.dtw_dims),
                   r.score, 1e-5);
     }
+  }
+}
+
+// The kept set of the streaming top results, as it was kept before the per-clip grouping: one
+// vector in the order offered, every offer compared with every kept result.
+std::vector<SearchResult> ReferenceTop(const std::vector<SearchResult>& offers, int k,
+                                       double max_overlap) {
+  std::vector<SearchResult> kept;
+  const auto by_score = [](const SearchResult& a, const SearchResult& b) {
+    return a.score < b.score;
+  };
+  for (const SearchResult& candidate : offers) {
+    if (static_cast<int>(kept.size()) == k &&
+        candidate.score >= std::max_element(kept.begin(), kept.end(), by_score)->score) {
+      continue;
+    }
+    if (std::any_of(kept.begin(), kept.end(), [&](const SearchResult& other) {
+          return other.score <= candidate.score && Overlaps(candidate, other, max_overlap);
+        })) {
+      continue;
+    }
+    std::erase_if(kept, [&](const SearchResult& other) {
+      return other.score > candidate.score && Overlaps(other, candidate, max_overlap);
+    });
+    kept.push_back(candidate);
+    if (static_cast<int>(kept.size()) > k) {
+      kept.erase(std::max_element(kept.begin(), kept.end(), by_score));
+    }
+  }
+  return kept;
+}
+
+// Random offers with overlaps and tied scores: the same kept results, in the same order, and
+// the same threshold after every offer.
+TEST(StreamingTopResults, KeepsWhatOneOrderedListKeeps) {
+  std::mt19937 random(7);
+  for (int round = 0; round < 100; ++round) {
+    const int k = 1 + static_cast<int>(random() % 40);
+    const int clips = 1 + static_cast<int>(random() % 6);
+    std::vector<SearchResult> offers;
+    StreamingTopResults top(k, 0.5, 10);
+    for (int i = 0; i < 200; ++i) {
+      SearchResult& offer = offers.emplace_back();
+      offer.clip_index = static_cast<int>(random() % clips);
+      offer.first_frame = static_cast<int64_t>(random() % 400);
+      offer.last_frame = offer.first_frame + 5 + static_cast<int64_t>(random() % 30);
+      offer.score = static_cast<double>(random() % 50) / 8;  // many ties
+      top.Offer(offer);
+      const std::vector<SearchResult> reference = ReferenceTop(offers, k, 0.5);
+      const float expected =
+          static_cast<int>(reference.size()) < k
+              ? std::numeric_limits<float>::infinity()
+              : static_cast<float>(10 * std::max_element(reference.begin(), reference.end(),
+                                                         [](const auto& a, const auto& b) {
+                                                           return a.score < b.score;
+                                                         })
+                                            ->score);
+      ASSERT_EQ(top.threshold(), expected) << "round " << round << ", offer " << i;
+    }
+    const std::vector<SearchResult> kept = top.Take();
+    const std::vector<SearchResult> reference = ReferenceTop(offers, k, 0.5);
+    ASSERT_EQ(kept.size(), reference.size()) << "round " << round;
+    for (size_t i = 0; i < kept.size(); ++i) {
+      EXPECT_EQ(
+          std::tie(kept[i].clip_index, kept[i].first_frame, kept[i].last_frame, kept[i].score),
+          std::tie(reference[i].clip_index, reference[i].first_frame, reference[i].last_frame,
+                   reference[i].score))
+          << "round " << round << ", result " << i;
+    }
+    EXPECT_TRUE(top.Take().empty());
   }
 }
 

@@ -1,6 +1,9 @@
 #include "core/search/search_result.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <iterator>
 #include <limits>
 #include <tuple>
 
@@ -30,33 +33,74 @@ std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, doub
   return kept;
 }
 
-namespace {
-
-bool ByScore(const SearchResult& a, const SearchResult& b) { return a.score < b.score; }
-
-}  // namespace
-
 void StreamingTopResults::Offer(SearchResult candidate) {
-  if (static_cast<int>(kept_.size()) == k_ && candidate.score >= worst_score()) return;
-  for (const SearchResult& kept : kept_) {
-    if (kept.score <= candidate.score && Overlaps(candidate, kept, max_overlap_)) return;
+  if (kept_count_ == k_ && candidate.score >= worst_score()) return;
+  if (static_cast<int>(by_clip_.size()) <= candidate.clip_index) {
+    by_clip_.resize(candidate.clip_index + 1);
   }
-  std::erase_if(kept_, [&](const SearchResult& kept) {
-    return kept.score > candidate.score && Overlaps(kept, candidate, max_overlap_);
-  });
-  kept_.push_back(std::move(candidate));
-  if (static_cast<int>(kept_.size()) > k_) {
-    kept_.erase(std::max_element(kept_.begin(), kept_.end(), ByScore));
+  std::vector<Kept>& group = by_clip_[candidate.clip_index];
+  for (const Kept& kept : group) {
+    if (kept.result.score <= candidate.score && Overlaps(candidate, kept.result, max_overlap_)) {
+      return;
+    }
   }
+  kept_count_ -= static_cast<int>(std::erase_if(group, [&](const Kept& kept) {
+    return kept.result.score > candidate.score && Overlaps(kept.result, candidate, max_overlap_);
+  }));
+  group.push_back({std::move(candidate), offers_++});
+  ++kept_count_;
+  if (kept_count_ > k_) {
+    const auto [clip, position] = FindWorst();
+    by_clip_[clip].erase(by_clip_[clip].begin() + static_cast<std::ptrdiff_t>(position));
+    --kept_count_;
+  }
+  worst_score_cache_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 float StreamingTopResults::threshold() const {
-  if (static_cast<int>(kept_.size()) < k_) return std::numeric_limits<float>::infinity();
+  if (kept_count_ < k_) return std::numeric_limits<float>::infinity();
   return static_cast<float>(worst_score() * static_cast<double>(query_rows_));
 }
 
+std::vector<SearchResult> StreamingTopResults::Take() {
+  std::vector<Kept> all;
+  all.reserve(kept_count_);
+  for (std::vector<Kept>& group : by_clip_) {
+    std::move(group.begin(), group.end(), std::back_inserter(all));
+  }
+  std::sort(all.begin(), all.end(),
+            [](const Kept& a, const Kept& b) { return a.offered < b.offered; });
+  std::vector<SearchResult> results;
+  results.reserve(all.size());
+  for (Kept& kept : all) results.push_back(std::move(kept.result));
+  by_clip_.clear();
+  kept_count_ = 0;
+  worst_score_cache_ = std::numeric_limits<double>::quiet_NaN();
+  return results;
+}
+
+std::pair<int, size_t> StreamingTopResults::FindWorst() const {
+  std::pair<int, size_t> worst{-1, 0};
+  const Kept* worst_kept = nullptr;
+  for (size_t c = 0; c < by_clip_.size(); ++c) {
+    for (size_t i = 0; i < by_clip_[c].size(); ++i) {
+      const Kept& kept = by_clip_[c][i];
+      if (worst_kept == nullptr || kept.result.score > worst_kept->result.score ||
+          (kept.result.score == worst_kept->result.score && kept.offered < worst_kept->offered)) {
+        worst_kept = &kept;
+        worst = {static_cast<int>(c), i};
+      }
+    }
+  }
+  return worst;
+}
+
 double StreamingTopResults::worst_score() const {
-  return std::max_element(kept_.begin(), kept_.end(), ByScore)->score;
+  if (std::isnan(worst_score_cache_)) {
+    const auto [clip, position] = FindWorst();
+    worst_score_cache_ = by_clip_[clip][position].result.score;
+  }
+  return worst_score_cache_;
 }
 
 }  // namespace motiondb

@@ -3,7 +3,9 @@
 #define MOTIONDB_CORE_SEARCH_SEARCH_RESULT_H_
 
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace motiondb {
@@ -56,7 +58,10 @@ std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, doub
                                       int max_results);
 
 // The best `k` non-overlapping results seen so far, kept greedily as candidates stream in, and
-// the cost a partial warp must stay below to still have a chance (early abandoning).
+// the cost a partial warp must stay below to still have a chance (early abandoning). A fast
+// search offers each of its ~1000 warps to a pool of up to ~1200 (max_results 100): the kept
+// results are grouped by clip, so that an offer compares only its clip's (results of different
+// clips never overlap), and the worst kept score is cached.
 // Not thread-safe: one per search.
 class StreamingTopResults {
  public:
@@ -66,15 +71,26 @@ class StreamingTopResults {
   void Offer(SearchResult candidate);
   // Warp costs (sums over the query's frames) at or above this cannot enter the kept set.
   float threshold() const;
-  std::vector<SearchResult> Take() { return std::move(kept_); }
+  // The kept results in the order they were offered; the set is empty afterwards.
+  std::vector<SearchResult> Take();
 
  private:
+  struct Kept {
+    SearchResult result;
+    int64_t offered = 0;  // the offer's number: Take's order, and ties of the worst score
+  };
+  // The kept result with the highest score (the first offered among equals).
+  std::pair<int, size_t> FindWorst() const;  // (clip index, position in its group)
   double worst_score() const;
 
   int k_;
   double max_overlap_;
   int64_t query_rows_;
-  std::vector<SearchResult> kept_;
+  std::vector<std::vector<Kept>> by_clip_;  // by clip index
+  int kept_count_ = 0;
+  int64_t offers_ = 0;
+  // worst_score()'s value while kept_count_ is unchanged and full, or NaN.
+  mutable double worst_score_cache_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace motiondb
