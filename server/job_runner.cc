@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "util/parallel_for.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -57,12 +58,10 @@ bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b) {
 }
 
 JobRunner::JobRunner(storage::Database& database, const IndexRegistry& registry,
-                     const SearchRunner& runner, int test_pause_after)
-    : database_(database),
-      registry_(registry),
-      runner_(runner),
-      test_pause_after_(test_pause_after),
-      worker_([this] { Work(); }) {}
+                     const SearchRunner& runner, const JobRunnerOptions& options)
+    : database_(database), registry_(registry), runner_(runner), options_(options) {
+  worker_ = std::thread([this] { Work(); });  // once every member exists
+}
 
 JobRunner::~JobRunner() { Stop(); }
 
@@ -168,7 +167,7 @@ absl::StatusOr<storage::JobRecord> JobRunner::Cancel(const std::string& job_id) 
   // a job off the queue, and cleared in the one that ends it). Only that job is stopped.
   if (job_id == running_id_) {
     stop_running_ = true;
-    changed_.notify_all();  // wakes a job held by test_pause_after_
+    changed_.notify_all();  // wakes a job held by options_.test_pause_after
   }
   return live->second.record;
 }
@@ -267,7 +266,7 @@ void JobRunner::Run(const std::string& job_id) {
       last_write = std::chrono::steady_clock::now();
       WriteRow(database_, record);
     }
-    if (test_pause_after_ >= 0 && progress.done >= test_pause_after_ &&
+    if (options_.test_pause_after >= 0 && progress.done >= options_.test_pause_after &&
         progress.done < progress.total) {
       WriteRow(database_, record);  // its progress on disk too, for a test that kills the server
       std::unique_lock<std::mutex> lock(mutex_);
@@ -275,7 +274,7 @@ void JobRunner::Run(const std::string& job_id) {
     }
   };
   absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
-      database_, registry_, runner_, scales_, request, job_id,
+      database_, registry_, runner_, scales_, request, job_id, ThreadsFor(options_.threads),
       [this] { return stop_running_.load(std::memory_order_relaxed); }, on_progress);
   record.finished_unix_ms = NowUnixMs();
   if (stop_running_) {

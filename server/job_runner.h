@@ -1,11 +1,12 @@
-// Background jobs (SPEC §7): propagation jobs queued and run one at a time on one worker
-// thread, their rows kept in the database (storage/job_record.h) and their live progress here.
+// Background jobs (SPEC §7): propagation jobs queued and run one at a time by one worker
+// thread (a job's searches spread over JobRunnerOptions::threads), their rows kept in the
+// database (storage/job_record.h) and their live progress here.
 //
 // The worker runs at a lower CPU priority than the threads serving calls: it raises its own
-// nice value by kWorkerNiceIncrement (Linux keeps a nice value per thread, and threads a search
-// starts inherit it), so that while a job runs, interactive searches get the cores first and
-// the job takes what is left. Cancellation and shutdown are checked between queries and inside
-// each search. A job's output and its final row are written in one transaction at its end
+// nice value by kWorkerNiceIncrement (Linux keeps a nice value per thread, and the threads it
+// and a search start inherit it), so that while a job runs, interactive searches get the cores
+// first and the job takes what is left. Cancellation and shutdown are checked between queries and
+// inside each search. A job's output and its final row are written in one transaction at its end
 // (storage::Database::FinishPropagation): a job cut off by a stop or a crash leaves nothing
 // half-written and becomes `interrupted` (at Stop(), or at the next open after a crash).
 //
@@ -46,13 +47,20 @@ inline constexpr size_t kRecentlyEndedJobs = 64;
 // new").
 bool SameProgress(const storage::JobRecord& a, const storage::JobRecord& b);
 
+struct JobRunnerOptions {
+  // Threads a job's searches run on, all at the worker's lowered priority (0: one per core). One
+  // thread leaves a core idle while the machine has nothing else to do; interactive searches
+  // take their share of the cores first whatever the number.
+  int threads = 0;
+  // >= 0 (tests only): a running job with labels left waits after that many until it is
+  // cancelled or the runner stops, so that a test sees it running whatever the machine's speed.
+  int test_pause_after = -1;
+};
+
 class JobRunner {
  public:
-  // `test_pause_after` >= 0 (tests only): a running job with labels left waits after that many
-  // until it is cancelled or the runner stops, so that a test sees it running whatever the
-  // machine's speed.
   JobRunner(storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
-            int test_pause_after = -1);
+            const JobRunnerOptions& options = {});
   JobRunner(const JobRunner&) = delete;
   JobRunner& operator=(const JobRunner&) = delete;
   ~JobRunner();  // Stop()
@@ -105,7 +113,7 @@ class JobRunner {
   storage::Database& database_;
   const IndexRegistry& registry_;
   const SearchRunner& runner_;
-  const int test_pause_after_;
+  const JobRunnerOptions options_;
   mutable std::mutex mutex_;
   // Notified on every change of a live job and when stopping.
   mutable std::condition_variable changed_;

@@ -92,6 +92,9 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   flags->max_upload_buffer_mb = static_cast<int>(options->uploads.max_buffered_bytes >> 20);
   number("--max-upload-buffer-mb", flags->max_upload_buffer_mb,
          "most bytes the ingests in progress hold together, in MiB", "MB", 1, 1 << 20);
+  number("--job-threads", options->job_threads,
+         "threads a background job searches on, below calls' priority (0: one per core)", "N", 0,
+         1024);
   number("--stream-idle-timeout-s", options->stream_idle_timeout_s,
          "end a client stream silent for this long (0: never)", "S", 0, 1 << 20);
   app.add_option("--auth-token-file", flags->auth_token_file,

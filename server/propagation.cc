@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
-#include <set>
+#include <mutex>
 #include <tuple>
 #include <utility>
 
@@ -12,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "server/space_lookup.h"
+#include "util/parallel_for.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -156,13 +158,13 @@ double SimilarityFactor(double score, double scale) {
 }
 
 absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const SearchRunner& runner,
-                                       const std::function<bool()>& should_stop) {
+                                       int threads, const std::function<bool()>& should_stop) {
   std::vector<std::pair<int64_t, ClipTiming>> clips(snapshot.clips.begin(), snapshot.clips.end());
   std::sort(clips.begin(), clips.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   int64_t total = 0;
   for (const auto& [clip_id, timing] : clips) total += timing.frame_count;
-  std::vector<double> last_scores;
+  std::vector<SearchRequest> windows;
   size_t clip = 0;
   int64_t clip_start = 0;  // the first frame of clips[clip] in the library's frames
   for (int w = 0; w < kScaleWindows && total > 0; ++w) {
@@ -174,20 +176,27 @@ absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const Sear
     const int length = std::max(1, static_cast<int>(std::lround(kScaleWindowSeconds * timing.fps)));
     const int first =
         std::max(0, std::min(static_cast<int>(at - clip_start), timing.frame_count - length));
-    SearchRequest search;
+    SearchRequest& search = windows.emplace_back();
     search.space = snapshot.record.name;
     search.query = ClipSelection{clips[clip].first, first,
                                  std::min(timing.frame_count - 1, first + length - 1)};
     search.params.max_results = kScaleRank;
     search.exclude_query = true;
-    const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
-    if (absl::IsCancelled(found.status())) return found.status();
-    // A window that cannot be a query (a clip too short) is left out like a short list.
-    if (found.ok() && static_cast<int>(found->hits.size()) == kScaleRank &&
-        found->hits.back().score > 0) {
-      last_scores.push_back(found->hits.back().score);
-    }
   }
+  // NaN: the window left out.
+  std::vector<double> last_scores(windows.size(), std::nan(""));
+  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
+      static_cast<int64_t>(windows.size()), threads, [&](int64_t w, int) -> absl::Status {
+        const absl::StatusOr<SearchOutcome> found = runner.Run(windows[w], should_stop);
+        if (absl::IsCancelled(found.status())) return found.status();
+        // A window that cannot be a query (a clip too short) is left out like a short list.
+        if (found.ok() && static_cast<int>(found->hits.size()) == kScaleRank &&
+            found->hits.back().score > 0) {
+          last_scores[w] = found->hits.back().score;
+        }
+        return absl::OkStatus();
+      }));
+  std::erase_if(last_scores, [](double score) { return std::isnan(score); });
   if (last_scores.empty()) return 1;
   const auto middle = last_scores.begin() + last_scores.size() / 2;
   std::nth_element(last_scores.begin(), middle, last_scores.end());
@@ -195,7 +204,7 @@ absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const Sear
 }
 
 absl::StatusOr<double> ScoreScales::Get(const std::shared_ptr<const SpaceSnapshot>& snapshot,
-                                        const SearchRunner& runner,
+                                        const SearchRunner& runner, int threads,
                                         const std::function<bool()>& should_stop) {
   const int64_t space_id = snapshot->record.space_id;
   {
@@ -206,7 +215,8 @@ absl::StatusOr<double> ScoreScales::Get(const std::shared_ptr<const SpaceSnapsho
     }
   }
   // Measured outside the lock: two jobs measuring one space at once compute the same value.
-  MOTIONDB_ASSIGN_OR_RETURN(const double scale, SpaceScoreScale(*snapshot, runner, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(const double scale,
+                            SpaceScoreScale(*snapshot, runner, threads, should_stop));
   std::lock_guard<std::mutex> lock(mutex_);
   by_space_[space_id] = {snapshot, scale};
   return scale;
@@ -239,7 +249,7 @@ std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord
 
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
-    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id,
+    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id, int threads,
     const std::function<bool()>& should_stop,
     const std::function<void(const PropagationProgress&)>& on_progress) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
@@ -255,42 +265,59 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
   }
   PropagationProgress progress{.total = static_cast<int64_t>(queries.size())};
   on_progress(progress);
-  std::vector<storage::LabelRecord> candidates;
+  // Each label's candidates apart, so that the job's output does not depend on which thread
+  // searched what; `progress`, the callback and `last_skip` under `progress_mutex`.
+  std::vector<std::vector<storage::LabelRecord>> found_by_label(queries.size());
+  std::mutex progress_mutex;
   absl::Status last_skip;
-  for (const storage::LabelRecord& label : queries) {
-    if (should_stop()) return absl::CancelledError("the job was stopped between queries");
-    SearchRequest search = request.search;
-    search.space = request.space;
-    search.query = ClipSelection{label.clip_id, static_cast<int>(label.first_frame),
-                                 static_cast<int>(label.last_frame)};
-    search.exclude_query = true;
-    const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
-    if (found.ok()) {
-      ++progress.queries;
-      AddCandidates(label, *found, snapshot->record.space_id, job_id, &candidates);
-    } else if (SkipsLabel(found.status())) {
-      // A space deleted while the job ran answers NOT_FOUND too: that ends the job.
-      if (absl::IsNotFound(found.status()) && !FindSpace(registry, request.space).ok()) {
-        return absl::NotFoundError(
-            absl::StrCat("space '", request.space, "' was deleted while the job ran"));
-      }
-      ++progress.skipped;
-      last_skip = absl::Status(found.status().code(), absl::StrCat("label ", label.label_id, ": ",
-                                                                   found.status().message()));
-    } else {
-      return absl::Status(found.status().code(),
-                          absl::StrCat("label ", label.label_id, ": ", found.status().message()));
-    }
-    ++progress.done;
-    on_progress(progress);
-  }
+  size_t last_skip_index = 0;
+  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
+      static_cast<int64_t>(queries.size()), threads, [&](int64_t i, int) -> absl::Status {
+        const storage::LabelRecord& label = queries[i];
+        if (should_stop()) return absl::CancelledError("the job was stopped between queries");
+        SearchRequest search = request.search;
+        search.space = request.space;
+        search.query = ClipSelection{label.clip_id, static_cast<int>(label.first_frame),
+                                     static_cast<int>(label.last_frame)};
+        search.exclude_query = true;
+        const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
+        if (found.ok()) {
+          AddCandidates(label, *found, snapshot->record.space_id, job_id, &found_by_label[i]);
+        } else if (!SkipsLabel(found.status())) {
+          return absl::Status(found.status().code(), absl::StrCat("label ", label.label_id, ": ",
+                                                                  found.status().message()));
+        } else if (absl::IsNotFound(found.status()) && !FindSpace(registry, request.space).ok()) {
+          // A space deleted while the job ran answers NOT_FOUND too: that ends the job.
+          return absl::NotFoundError(
+              absl::StrCat("space '", request.space, "' was deleted while the job ran"));
+        }
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        if (found.ok()) {
+          ++progress.queries;
+        } else {
+          ++progress.skipped;
+          if (last_skip.ok() || static_cast<size_t>(i) > last_skip_index) {
+            last_skip_index = i;
+            last_skip = absl::Status(
+                found.status().code(),
+                absl::StrCat("label ", label.label_id, ": ", found.status().message()));
+          }
+        }
+        ++progress.done;
+        on_progress(progress);
+        return absl::OkStatus();
+      }));
   if (progress.total > 0 && progress.skipped == progress.total) {
     // Nothing was searched: an output would only delete the earlier one.
     return absl::FailedPreconditionError(absl::StrCat(
         "every one of the ", progress.total,
         " labels was skipped, none could be a query (the last: ", last_skip.message(), ")"));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const double scale, scales.Get(snapshot, runner, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(const double scale, scales.Get(snapshot, runner, threads, should_stop));
+  std::vector<storage::LabelRecord> candidates;
+  for (std::vector<storage::LabelRecord>& found : found_by_label) {
+    std::move(found.begin(), found.end(), std::back_inserter(candidates));
+  }
   for (storage::LabelRecord& candidate : candidates) {
     candidate.value *= SimilarityFactor(candidate.score, scale);
   }

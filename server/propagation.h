@@ -86,10 +86,11 @@ inline constexpr int kScaleRank = kPropagationMaxResults;
 // share of the frames, moved back to fit in its clip), of the score of each window's
 // kScaleRank-th nearest range (every clip searched, its own range excluded, the search's
 // defaults otherwise). Windows whose list comes back short or with a last score of 0 are left
-// out; 1 when none is left. It depends on the space and its library only, not on any job.
-// `should_stop` as in SearchRunner::Run (CANCELLED).
+// out; 1 when none is left. It depends on the space and its library only, not on any job, nor
+// on the `threads` the windows are searched on. `should_stop` as in SearchRunner::Run
+// (CANCELLED).
 absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const SearchRunner& runner,
-                                       const std::function<bool()>& should_stop);
+                                       int threads, const std::function<bool()>& should_stop);
 
 // The spaces' scales, computed on a job's first use of a space and kept while the registry
 // holds the same snapshot of it: an ingest, a deletion or a rebuild makes a new snapshot, and
@@ -98,7 +99,8 @@ class ScoreScales {
  public:
   // The scale of the space `snapshot` is, from the cache or measured now.
   absl::StatusOr<double> Get(const std::shared_ptr<const SpaceSnapshot>& snapshot,
-                             const SearchRunner& runner, const std::function<bool()>& should_stop);
+                             const SearchRunner& runner, int threads,
+                             const std::function<bool()>& should_stop);
 
  private:
   struct Cached {
@@ -124,14 +126,15 @@ struct PropagationProgress {
 };
 
 // Runs the propagation of a resolved `request` as job `job_id` and returns its output (labels
-// and counts; output.job holds only the counts), the factor's s0 from `scales`. `should_stop` is
-// polled between queries and inside each search (CANCELLED); `on_progress` is called after each
-// query. NOT_FOUND when the space was deleted while the job ran; FAILED_PRECONDITION when every
-// label was skipped (there were some and none could be a query): a failed job leaves the earlier
-// output as it was.
+// and counts; output.job holds only the counts), the factor's s0 from `scales`. The labels'
+// searches run on `threads` threads (util/parallel_for.h: at the caller's priority); the output
+// does not depend on their number. `should_stop` is polled between queries and inside each
+// search (CANCELLED); `on_progress` is called after each query, one call at a time. NOT_FOUND when
+// the space was deleted while the job ran; FAILED_PRECONDITION when every label was skipped (there
+// were some and none could be a query): a failed job leaves the earlier output as it was.
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
-    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id,
+    ScoreScales& scales, const PropagationRequest& request, const std::string& job_id, int threads,
     const std::function<bool()>& should_stop,
     const std::function<void(const PropagationProgress&)>& on_progress);
 

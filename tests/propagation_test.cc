@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -106,7 +107,8 @@ class SpaceScaleTest : public ::testing::Test {
 
   // The job's output; `scales` fresh for each job, so that none reuses another's s0.
   storage::PropagationOutput Propagate(const std::vector<std::string>& descriptors,
-                                       const std::vector<std::string>& tags, int max_results) {
+                                       const std::vector<std::string>& tags, int max_results,
+                                       int threads = 1) {
     PropagationRequest request;
     request.space = "body";
     request.descriptors = descriptors;
@@ -114,7 +116,7 @@ class SpaceScaleTest : public ::testing::Test {
     request.search.params.max_results = max_results;
     ScoreScales scales;
     absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
-        *database_, registry_, *runner_, scales, request, "job-1", [] { return false; },
+        *database_, registry_, *runner_, scales, request, "job-1", threads, [] { return false; },
         [](const PropagationProgress&) {});
     EXPECT_TRUE(output.ok()) << output.status();
     return output.ok() ? *output : storage::PropagationOutput();
@@ -132,7 +134,7 @@ class SpaceScaleTest : public ::testing::Test {
 // taken from a job's own searches they would give different ones.
 TEST_F(SpaceScaleTest, TheScaleDoesNotDependOnTheJob) {
   const absl::StatusOr<double> scale =
-      SpaceScoreScale(*registry_.Find("body"), *runner_, [] { return false; });
+      SpaceScoreScale(*registry_.Find("body"), *runner_, /*threads=*/1, [] { return false; });
   ASSERT_TRUE(scale.ok()) << scale.status();
   ASSERT_NE(*scale, 1.0) << "no window of the sample got a full list: the library is too small";
   const absl::StatusOr<storage::LabelPage> manual =
@@ -159,14 +161,43 @@ TEST_F(SpaceScaleTest, TheScaleDoesNotDependOnTheJob) {
 TEST_F(SpaceScaleTest, TheCacheKeepsTheScaleOfASnapshot) {
   ScoreScales scales;
   const auto snapshot = registry_.Find("body");
-  const absl::StatusOr<double> first = scales.Get(snapshot, *runner_, [] { return false; });
+  const absl::StatusOr<double> first = scales.Get(snapshot, *runner_, 1, [] { return false; });
   ASSERT_TRUE(first.ok()) << first.status();
   // Measured again, a stop request cancels it; answered from the cache, it is not asked.
-  const absl::StatusOr<double> cached = scales.Get(snapshot, *runner_, [] { return true; });
+  const absl::StatusOr<double> cached = scales.Get(snapshot, *runner_, 1, [] { return true; });
   ASSERT_TRUE(cached.ok()) << cached.status();
   EXPECT_EQ(*cached, *first);
   EXPECT_TRUE(
-      absl::IsCancelled(ScoreScales().Get(snapshot, *runner_, [] { return true; }).status()));
+      absl::IsCancelled(ScoreScales().Get(snapshot, *runner_, 1, [] { return true; }).status()));
+}
+
+// A job's searches spread over threads give the output one thread gives, label for label, and
+// the space's scale is measured the same on any number of threads.
+TEST_F(SpaceScaleTest, TheOutputDoesNotDependOnTheThreads) {
+  const storage::PropagationOutput one = Propagate({"raise", "shrug"}, {}, 40, 1);
+  ASSERT_FALSE(one.labels.empty());
+  for (int threads : {2, 5}) {
+    const storage::PropagationOutput many = Propagate({"raise", "shrug"}, {}, 40, threads);
+    ASSERT_EQ(many.labels.size(), one.labels.size()) << threads << " threads";
+    for (size_t i = 0; i < one.labels.size(); ++i) {
+      const storage::LabelRecord& a = one.labels[i];
+      const storage::LabelRecord& b = many.labels[i];
+      EXPECT_EQ(std::tie(a.clip_id, a.first_frame, a.last_frame, a.descriptor, a.source_label_id),
+                std::tie(b.clip_id, b.first_frame, b.last_frame, b.descriptor, b.source_label_id))
+          << "label " << i << ", " << threads << " threads";
+      EXPECT_EQ(a.value, b.value) << "label " << i << ", " << threads << " threads";
+      EXPECT_EQ(a.score, b.score) << "label " << i << ", " << threads << " threads";
+    }
+    EXPECT_EQ(many.job.queries, one.job.queries);
+    EXPECT_EQ(many.job.done, one.job.done);
+  }
+  const auto snapshot = registry_.Find("body");
+  const absl::StatusOr<double> scale_one =
+      SpaceScoreScale(*snapshot, *runner_, 1, [] { return false; });
+  const absl::StatusOr<double> scale_three =
+      SpaceScoreScale(*snapshot, *runner_, 3, [] { return false; });
+  ASSERT_TRUE(scale_one.ok() && scale_three.ok());
+  EXPECT_EQ(*scale_one, *scale_three);
 }
 
 }  // namespace

@@ -85,8 +85,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
           .count()));
 
   s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
-  s.jobs =
-      std::make_unique<JobRunner>(*s.database, s.registry, *s.runner, options.test_job_pause_after);
+  s.jobs = std::make_unique<JobRunner>(
+      *s.database, s.registry, *s.runner,
+      JobRunnerOptions{.threads = options.job_threads,
+                       .test_pause_after = options.test_job_pause_after});
   s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database);
   s.request_log = std::make_unique<RequestLog>(options.log_requests, *s.metrics);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);

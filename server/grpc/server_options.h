@@ -35,6 +35,9 @@ struct ServerOptions {
   // With a token: the health service needs it too (--health-needs-token); by default probes
   // answer without one.
   bool health_needs_token = false;
+  // Threads a background job's searches run on, at a lower priority than calls (0: one per
+  // core) (--job-threads).
+  int job_threads = 0;
   // For tests only (--test-job-pause-after, hidden): a running job waits after this many of its
   // labels until it is cancelled or the server stops, so that tests see it running whatever
   // the machine's speed; -1: never.
