@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <iterator>
+#include <map>
 #include <optional>
 #include <utility>
 
@@ -122,19 +123,37 @@ absl::Status DeleteOldOutput(SqliteConnection& db, const PropagationOutput& outp
   return absl::OkStatus();
 }
 
+// Whether each of `keys` (distinct) has a row, by `sql` ("SELECT 1 FROM t WHERE key = ?").
+absl::StatusOr<std::map<int64_t, bool>> RowsExist(SqliteConnection& db, absl::string_view sql,
+                                                  std::map<int64_t, bool> keys) {
+  for (auto& [key, exists] : keys) {
+    MOTIONDB_ASSIGN_OR_RETURN(exists, Exists(db, sql, key));
+  }
+  return keys;
+}
+
 // Inserts the labels whose clip and source label still exist (either may have been deleted
-// while the job ran); returns how many.
+// while the job ran); returns how many. Each clip and source is looked up once, not per label:
+// the two lookups in every row's INSERT took 1.7 s of 2.9 for 59,116 labels.
 absl::StatusOr<int64_t> InsertOutput(SqliteConnection& db, const PropagationOutput& output,
                                      int64_t now) {
+  std::map<int64_t, bool> clips, sources;
+  for (const LabelRecord& label : output.labels) {
+    clips.emplace(label.clip_id, false);
+    sources.emplace(label.source_label_id, false);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      clips, RowsExist(db, "SELECT 1 FROM clips WHERE clip_id = ?", std::move(clips)));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      sources, RowsExist(db, "SELECT 1 FROM labels WHERE label_id = ?", std::move(sources)));
   MOTIONDB_ASSIGN_OR_RETURN(
       SqliteStatement insert,
       db.Prepare("INSERT INTO labels (clip_id, first_frame, last_frame, descriptor, value, "
                  "origin, source_label_id, space_id, score, job_id, created_unix_ms) "
-                 "SELECT ?1, ?2, ?3, ?4, ?5, 'propagated', ?6, ?7, ?8, ?9, ?10 "
-                 "WHERE EXISTS (SELECT 1 FROM clips WHERE clip_id = ?1) "
-                 "AND EXISTS (SELECT 1 FROM labels WHERE label_id = ?6)"));
+                 "VALUES (?1, ?2, ?3, ?4, ?5, 'propagated', ?6, ?7, ?8, ?9, ?10)"));
   int64_t inserted = 0;
   for (const LabelRecord& label : output.labels) {
+    if (!clips.at(label.clip_id) || !sources.at(label.source_label_id)) continue;
     insert.Reset();
     MOTIONDB_RETURN_IF_ERROR(insert.BindInt64(1, label.clip_id)
                                  .BindInt64(2, label.first_frame)
@@ -147,7 +166,7 @@ absl::StatusOr<int64_t> InsertOutput(SqliteConnection& db, const PropagationOutp
                                  .BindText(9, label.job_id)
                                  .BindInt64(10, now)
                                  .Run());
-    inserted += db.changes();
+    ++inserted;
   }
   return inserted;
 }
