@@ -19,8 +19,12 @@
 // imply it) and the job's own (the median last score of the examples' full result lists, the
 // server's s0 before the space's scale, from the same searches run here); per way, s0 per job
 // and the clips whose strongest covering label reaches value 0.5 (coverage and accuracy there).
+// With several --space, every experiment runs in each space (the same clips, labels and
+// jobs), and a third calibration shows what one fixed s0 would do: the first space's, used in
+// every space.
 //
 // usage: propagation_quality [--seeds N] [--max-results M]... [--take-clips N]
+//                            [--space body|uniform|scaled]...
 #include <signal.h>
 #include <unistd.h>
 
@@ -65,20 +69,23 @@ struct Flags {
   int seeds = 3;
   std::vector<int> max_results = {20, 100};
   int take_clips = 20;  // bandai2-normal clips per long take
+  // The spaces the experiments run in, each trained on every clip: body (the defaults),
+  // uniform (every joint weighted 1), scaled (each dimension scaled by its eigenvalue).
+  std::vector<std::string> spaces = {"body"};
 };
 
 constexpr int kPool = 3;  // bandai2-normal examples set aside per content and seed (k <= kPool)
-constexpr char kSpace[] = "body";
 constexpr char kNone[] = "-";  // the prediction of a clip or frame without a label
 // The value a user asking for confident labels would filter on (FindLabels' min_value): where
 // the score scale s0 matters. Which labels a job keeps and which is strongest do not depend on
 // s0 (one job's values are one decreasing function of the scores, its examples all of value 1).
 constexpr double kConfidentValue = 0.5;
 
-// The two calibrations of s0 compared: the server's (the space's scale since issue 13's
-// calibration, as the labels' values imply it) and the job's own, the median last score of the
-// job's full result lists (the server's s0 before), computed here from the same searches.
-enum Calibration { kSpaceScale, kJobScale, kCalibrations };
+// The calibrations of s0 compared: the server's (the space's scale since issue 13's
+// calibration, as the labels' values imply it), the job's own, the median last score of the
+// job's full result lists (the server's s0 before), computed here from the same searches, and
+// one fixed s0 for every space (the first space's scale).
+enum Calibration { kSpaceScale, kJobScale, kFixedScale, kCalibrations };
 
 // A clip of the corpus as ingested.
 struct CorpusClip {
@@ -134,9 +141,12 @@ class Api {
     return response.clip();
   }
 
-  absl::Status CreateSpace() {
+  // A space of Flags::spaces, trained on every clip.
+  absl::Status CreateSpace(const std::string& name) {
     v1::CreateSpaceRequest request;
-    request.set_name(kSpace);
+    request.set_name(name);
+    if (name == "uniform") request.set_weight_preset(v1::WEIGHT_PRESET_UNIFORM);
+    if (name == "scaled") request.set_metric(v1::SPACE_METRIC_EIGENVALUE_SCALED);
     v1::Space space;
     grpc::ClientContext context;
     return FromGrpc(spaces_->CreateSpace(&context, request, &space), "CreateSpace");
@@ -164,10 +174,11 @@ class Api {
 
   // Propagates every manual descriptor over the clips carrying one of `tags`, waits for the
   // job and returns the propagated labels.
-  absl::StatusOr<std::vector<v1::Label>> Propagate(const std::vector<std::string>& tags,
+  absl::StatusOr<std::vector<v1::Label>> Propagate(const std::string& space,
+                                                   const std::vector<std::string>& tags,
                                                    int max_results) {
     v1::StartPropagationRequest start;
-    start.set_space(kSpace);
+    start.set_space(space);
     start.mutable_search()->set_max_results(max_results);
     for (const std::string& tag : tags) start.add_tags(tag);
     v1::Job job;
@@ -185,12 +196,13 @@ class Api {
   // The job's own s0 as the server computed it before the space's scale: the median, over the
   // examples' searches that return all max_results hits with a positive last score, of that
   // score; 1 when there is none.
-  absl::StatusOr<double> JobScale(const std::vector<const CorpusClip*>& examples,
+  absl::StatusOr<double> JobScale(const std::string& space,
+                                  const std::vector<const CorpusClip*>& examples,
                                   const std::vector<std::string>& tags, int max_results) {
     std::vector<double> last_scores;
     for (const CorpusClip* example : examples) {
       v1::SearchRequest search;
-      search.set_space(kSpace);
+      search.set_space(space);
       search.mutable_clip()->set_clip_id(example->id);
       search.set_max_results(max_results);
       for (const std::string& tag : tags) search.add_tags(tag);
@@ -612,18 +624,22 @@ void ScoreTakes(const Experiment& experiment, const LabelsByClip& labels, Score*
   }
 }
 
-absl::Status RunExperiment(Api& api, const Experiment& experiment, int max_results, Score* score) {
+// `fixed_scale`: the fixed s0 of every space, set from the first job's space scale when 0.
+absl::Status RunExperiment(Api& api, const std::string& space, const Experiment& experiment,
+                           int max_results, double* fixed_scale, Score* score) {
   if (experiment.clips.empty() && experiment.takes.empty()) return absl::OkStatus();
   MOTIONDB_RETURN_IF_ERROR(api.SetExamples(experiment.examples));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<v1::Label> labels,
-                            api.Propagate(experiment.tags, max_results));
+                            api.Propagate(space, experiment.tags, max_results));
   LabelsByClip by_clip;
   for (const v1::Label& label : labels) by_clip[label.clip_id()].push_back(&label);
   ++score->jobs;
   double scales[kCalibrations];
   scales[kSpaceScale] = ImpliedScale(labels);
   MOTIONDB_ASSIGN_OR_RETURN(scales[kJobScale],
-                            api.JobScale(experiment.examples, experiment.tags, max_results));
+                            api.JobScale(space, experiment.examples, experiment.tags, max_results));
+  if (*fixed_scale == 0) *fixed_scale = scales[kSpaceScale];
+  scales[kFixedScale] = *fixed_scale;
   for (int c = 0; c < kCalibrations; ++c) score->scales[c].push_back(scales[c]);
   ScoreTakes(experiment, by_clip, score);
   ScoreClips(experiment, by_clip, scales, score);
@@ -728,24 +744,32 @@ absl::Status Measure(Api& api, const fs::path& mocap, const Flags& flags) {
   MOTIONDB_ASSIGN_OR_RETURN(std::vector<CorpusClip> bandai2,
                             IngestFolder(api, mocap / "bandai2-normal", "bandai2"));
   corpus.insert(corpus.end(), bandai2.begin(), bandai2.end());
-  // Trained on the clips; the takes, ingested after, are projected into it.
-  MOTIONDB_RETURN_IF_ERROR(api.CreateSpace());
+  // Trained on the clips; the takes, ingested after, are projected into them.
+  for (const std::string& space : flags.spaces) MOTIONDB_RETURN_IF_ERROR(api.CreateSpace(space));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Take> style_takes, IngestStyleTakes(api, corpus));
   std::deque<Take> bandai2_takes;  // the experiments point into it
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Experiment> experiments,
                             AllExperiments(api, corpus, flags, &bandai2_takes, style_takes));
+  // By space and experiment ("body: bandai2-normal, within style"), k and max_results.
   std::map<std::tuple<std::string, int, int>, Score> scores;
-  for (const int max_results : flags.max_results) {
-    for (const Experiment& experiment : experiments) {
-      MOTIONDB_RETURN_IF_ERROR(RunExperiment(
-          api, experiment, max_results, &scores[{experiment.name, experiment.k, max_results}]));
+  double fixed_scale = 0;
+  for (const std::string& space : flags.spaces) {
+    for (const int max_results : flags.max_results) {
+      for (const Experiment& experiment : experiments) {
+        MOTIONDB_RETURN_IF_ERROR(RunExperiment(
+            api, space, experiment, max_results, &fixed_scale,
+            &scores[{absl::StrCat(space, ": ", experiment.name), experiment.k, max_results}]));
+      }
     }
   }
   std::printf(
-      "| experiment | k | max_results | jobs | evaluated | coverage | accuracy (covered) | "
+      "| space: experiment | k | max_results | jobs | evaluated | coverage | accuracy (covered) | "
       "accuracy (all) | frame accuracy | F1@50 | space s0: coverage at value >= 0.5 | accuracy "
       "there | s0 median (range) | job s0: coverage at value >= 0.5 | accuracy there | s0 median "
-      "(range) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|---:|---:|---|\n");
+      "(range) | the first space's s0: coverage at value >= 0.5 | accuracy there | s0 "
+      "|\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|---:|---:|---|---:|---:|--"
+      "-|"
+      "\n");
   for (const auto& [key, score] : scores) {
     PrintRow(std::get<0>(key), std::get<1>(key), std::get<2>(key), score);
   }
@@ -799,6 +823,11 @@ int main(int argc, char** argv) {
   app.add_option("--take-clips", flags.take_clips, "bandai2-normal clips per long take")
       ->capture_default_str()
       ->check(CLI::Range(2, 1000));
+  app.add_option("--space", flags.spaces,
+                 "run every experiment in this space (repeat for several): body (defaults), "
+                 "uniform (uniform joint weights), scaled (eigenvalue-scaled metric)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"body", "uniform", "scaled"}));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }

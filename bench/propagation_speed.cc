@@ -5,10 +5,11 @@
 //     five descriptors, value 1): from the StartPropagation call to the job's end as WatchJob
 //     reports it, its writes included; beside the baseline, the same N searches (each label's
 //     range the query, its own range excluded, the job's max_results) issued one by one by a
-//     client, as a batch script without jobs would;
+//     client, as a batch script without jobs would; the job once per --job-threads value, each
+//     on a server started with it (the propagated labels of the previous one deleted first);
 //  2. interactive search latency (2.8 s ranges spread over the library, default parameters, one
-//     client, one search at a time) while that job runs again, beside the same searches with the
-//     server idle just before and just after;
+//     client, one search at a time) while that job runs again (on the last server), beside the
+//     same searches with the server idle just before and just after;
 //  3. FindLabels over M more labels (AddLabels batches of 10,000; D descriptors, values uniform
 //     in [0, 1], ranges of 1 to 3 s): a first page and a deep page (min_value 0.7, page size 50),
 //     beside a health check's round trip, the floor of any call.
@@ -16,7 +17,7 @@
 // (the labels of earlier runs are deleted first).
 //
 // usage: propagation_speed [--hours H] [--labels N] [--find-labels M] [--descriptors D]
-//                          [--library FILE]
+//                          [--job-threads N...] [--library FILE]
 #include <signal.h>
 #include <unistd.h>
 
@@ -67,7 +68,8 @@ struct Flags {
   int labels = 1000;
   int find_labels = 1000000;
   int descriptors = 200;
-  std::string library;  // empty: a temporary one
+  std::vector<int> job_threads = {1, 0};  // the servers' --job-threads, one job each
+  std::string library;                    // empty: a temporary one
 };
 
 // A range of a stored clip, at its rate (inclusive).
@@ -135,10 +137,10 @@ class Api {
     return clips;
   }
 
-  // Deletes every manual label, and so every propagated one.
-  absl::Status DeleteLabels() {
+  // Deletes every label of `origin` (every manual label deletes every propagated one too).
+  absl::Status DeleteLabels(v1::LabelOrigin origin) {
     v1::DeleteLabelsRequest remove;
-    remove.set_origin(v1::LABEL_ORIGIN_MANUAL);
+    remove.set_origin(origin);
     v1::DeleteLabelsResponse removed;
     grpc::ClientContext context;
     return FromGrpc(labels_->DeleteLabels(&context, remove, &removed), "DeleteLabels");
@@ -238,40 +240,39 @@ std::string Latencies(const std::vector<double>& ms) {
                          *std::max_element(ms.begin(), ms.end()), ms.size());
 }
 
-// 1: the job against the same searches one by one.
-absl::Status JobAgainstClient(Api& api, v1::SearchService::Stub& search,
-                              const std::vector<Range>& labelled) {
+// 1, the baseline: the job's searches one by one from a client.
+absl::Status ClientBaseline(v1::SearchService::Stub& search, const std::vector<Range>& labelled) {
   std::vector<v1::SearchRequest> queries;
   for (const Range& range : labelled) {
     queries.push_back(RangeQuery(range));
     queries.back().set_max_results(server::kPropagationMaxResults);  // the job's default
   }
-  Clock::time_point start = Clock::now();
+  const Clock::time_point start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::vector<double> one_by_one,
       TimeSearches(search, queries, [&](size_t i) { return i < queries.size(); }));
   const double client_s = SecondsSince(start);
+  std::printf("| the same searches one by one from a client | %.2f | %.0f | client searches %s |\n",
+              client_s, queries.size() / client_s, Latencies(one_by_one).c_str());
+  return absl::OkStatus();
+}
 
-  start = Clock::now();
+// 1: one job on a server started with --job-threads `threads`.
+absl::Status TimeJob(Api& api, int threads) {
+  const Clock::time_point start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const std::string job_id, api.StartPropagation());
   Clock::time_point searched;
   MOTIONDB_ASSIGN_OR_RETURN(const v1::Job job, api.WaitForJob(job_id, &searched));
   const Clock::time_point end = Clock::now();
   const double job_s = std::chrono::duration<double>(end - start).count();
-  std::printf("## 1. %zu manual labels propagated (max_results %d a query)\n\n", labelled.size(),
-              server::kPropagationMaxResults);
-  std::printf("| way | seconds | searches/s |\n|---|---:|---:|\n");
-  std::printf("| one StartPropagation job, call to end (writes included) | **%.2f** | %.0f |\n",
-              job_s, job.queries() / job_s);
-  std::printf("| the same searches one by one from a client | %.2f | %.0f |\n\n", client_s,
-              queries.size() / client_s);
   std::printf(
-      "job %s: %lld queries (%lld skipped), %lld labels written; searches done after %.2f s, "
-      "the writes and the job's end %.2f s after that; client searches %s\n\n",
-      job_id.c_str(), static_cast<long long>(job.queries()),
+      "| one job, `--job-threads %d`, call to end (writes included) | **%.2f** | %.0f | %s: %lld "
+      "queries (%lld skipped), %lld labels written; searches done after %.2f s, the end (the "
+      "space's scale, keeping the strongest, the writes) %.2f s after that |\n",
+      threads, job_s, job.queries() / job_s, job_id.c_str(), static_cast<long long>(job.queries()),
       static_cast<long long>(job.queries_skipped()), static_cast<long long>(job.labels_written()),
       std::chrono::duration<double>(searched - start).count(),
-      std::chrono::duration<double>(end - searched).count(), Latencies(one_by_one).c_str());
+      std::chrono::duration<double>(end - searched).count());
   return absl::OkStatus();
 }
 
@@ -382,11 +383,10 @@ absl::Status FindOverMany(Api& api, const ClipFrames& clips, const Flags& flags)
   return absl::OkStatus();
 }
 
-absl::Status Measure(const std::string& address, const Flags& flags) {
-  Api api(address);
-  auto search = v1::SearchService::NewStub(OwnConnection(address));
-  MOTIONDB_ASSIGN_OR_RETURN(const ClipFrames clips, api.Clips());
-  MOTIONDB_RETURN_IF_ERROR(api.DeleteLabels());
+// The manual labels of the jobs, replacing every earlier label.
+absl::StatusOr<std::vector<Range>> AddManualLabels(Api& api, const ClipFrames& clips,
+                                                   const Flags& flags) {
+  MOTIONDB_RETURN_IF_ERROR(api.DeleteLabels(v1::LABEL_ORIGIN_MANUAL));
   const std::vector<Range> labelled =
       SpreadRanges(clips, flags.labels, [](int i) { return kFps + (i * 7919) % (2 * kFps + 1); });
   static const char* const kDescriptors[] = {"step", "raise", "shrug", "slouch", "turn"};
@@ -399,9 +399,29 @@ absl::Status Measure(const std::string& address, const Flags& flags) {
     label->set_descriptor_name(kDescriptors[i % std::size(kDescriptors)]);
   }
   MOTIONDB_RETURN_IF_ERROR(api.AddLabels(add));
-  std::printf("library: %zu clips, %lld frames at %d Hz (%.1f h)\n\n", clips.ids.size(),
-              static_cast<long long>(clips.total), kFps, clips.total / (3600.0 * kFps));
-  MOTIONDB_RETURN_IF_ERROR(JobAgainstClient(api, *search, labelled));
+  return labelled;
+}
+
+// What is measured on the server started with the `round`-th --job-threads value.
+absl::Status Measure(const std::string& address, const Flags& flags, size_t round) {
+  Api api(address);
+  auto search = v1::SearchService::NewStub(OwnConnection(address));
+  MOTIONDB_ASSIGN_OR_RETURN(const ClipFrames clips, api.Clips());
+  if (round == 0) {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Range> labelled,
+                              AddManualLabels(api, clips, flags));
+    std::printf("library: %zu clips, %lld frames at %d Hz (%.1f h)\n\n", clips.ids.size(),
+                static_cast<long long>(clips.total), kFps, clips.total / (3600.0 * kFps));
+    std::printf("## 1. %zu manual labels propagated (max_results %d a query)\n\n", labelled.size(),
+                server::kPropagationMaxResults);
+    std::printf("| way | seconds | searches/s | detail |\n|---|---:|---:|---|\n");
+    MOTIONDB_RETURN_IF_ERROR(ClientBaseline(*search, labelled));
+  } else {
+    MOTIONDB_RETURN_IF_ERROR(api.DeleteLabels(v1::LABEL_ORIGIN_PROPAGATED));
+  }
+  MOTIONDB_RETURN_IF_ERROR(TimeJob(api, flags.job_threads[round]));
+  if (round + 1 < flags.job_threads.size()) return absl::OkStatus();
+  std::printf("\n");
   MOTIONDB_RETURN_IF_ERROR(SearchDuringJob(api, *search, clips));
   if (flags.find_labels > 0) MOTIONDB_RETURN_IF_ERROR(FindOverMany(api, clips, flags));
   return absl::OkStatus();
@@ -418,16 +438,22 @@ absl::Status Run(const Flags& flags) {
     std::printf("stored %.1f h of synthetic capture and space '%s' in %.1f s\n", flags.hours,
                 kSpace, SecondsSince(start));
   }
-  testing::ServerProcess server;
-  std::string error;
-  if (!server.Start({"--db", db, "--quiet"}, &error, std::chrono::seconds(600))) {
-    return absl::InternalError(error);
+  absl::Status measured;
+  for (size_t round = 0; round < flags.job_threads.size() && measured.ok(); ++round) {
+    testing::ServerProcess server;
+    std::string error;
+    if (!server.Start(
+            {"--db", db, "--quiet", "--job-threads", std::to_string(flags.job_threads[round])},
+            &error, std::chrono::seconds(600))) {
+      return absl::InternalError(error);
+    }
+    if (!testing::WaitUntilServing(OwnConnection(server.address()), "",
+                                   std::chrono::seconds(600))) {
+      return absl::InternalError("the server did not start serving");
+    }
+    measured = Measure(server.address(), flags, round);
+    server.Stop(SIGTERM);
   }
-  if (!testing::WaitUntilServing(OwnConnection(server.address()), "", std::chrono::seconds(600))) {
-    return absl::InternalError("the server did not start serving");
-  }
-  const absl::Status measured = Measure(server.address(), flags);
-  server.Stop(SIGTERM);
   fs::remove_all(work);
   return measured;
 }
@@ -451,6 +477,10 @@ int main(int argc, char** argv) {
   app.add_option("--descriptors", flags.descriptors, "descriptors of those labels")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  app.add_option("--job-threads", flags.job_threads,
+                 "one job on a server started with each of these --job-threads (0: one per core)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   app.add_option("--library", flags.library,
                  "keep the library in this database file, and reuse it when it exists")
       ->type_name("FILE");
