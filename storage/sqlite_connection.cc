@@ -30,7 +30,7 @@ absl::StatusOr<std::unique_ptr<SqliteConnection>> SqliteConnection::Open(const s
   if (mode != Mode::kReadOnly && sqlite3_db_readonly(db, "main") == 1) {
     return absl::FailedPreconditionError(
         "the file can only be opened read-only (a read-only file system or the file's "
-        "permissions), and the server writes its database");
+        "permissions), and it was opened to be written");
   }
   sqlite3_extended_result_codes(db, 1);
   sqlite3_busy_timeout(db, busy_timeout_ms);
