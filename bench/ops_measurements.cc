@@ -3,6 +3,7 @@
 // Hermite gap filling against linear. Not part of the test suite; numbers in bench/RESULTS.md.
 //
 // usage: ops_measurements detect|interpolate|smooth|gap [--folder DIR] [options]
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -51,6 +52,7 @@ absl::Status Detect(const LabelledMotions& library,
   std::vector<std::pair<double, bool>> best;
   int positives = 0;
   for (size_t i = 0; i < library.motions.size(); ++i) {
+    if (evaluation.example[i]) continue;  // as the evaluation: the clips the model has not seen
     const Eigen::VectorXd ll = PoseLogLikelihood(evaluation.model, library.motions[i].coordinates);
     double held = -std::numeric_limits<double>::infinity();
     for (Eigen::Index k = 0; k + options.min_frames <= ll.size(); ++k) {
@@ -72,6 +74,10 @@ absl::Status Detect(const LabelledMotions& library,
   std::printf("model: %d example poses, %d dims, k %d, threshold %.3f\n", evaluation.example_poses,
               evaluation.model.dims, static_cast<int>(evaluation.model.weights.size()),
               evaluation.model.threshold);
+  const int example_clips =
+      static_cast<int>(std::count(evaluation.example.begin(), evaluation.example.end(), true));
+  std::printf("example clips: %d, of which %d fired; the other %zu clips:\n", example_clips,
+              evaluation.examples_fired, evaluation.example.size() - example_clips);
   std::printf(
       "precision %.3f (%d of %d fired), recall %.3f (%d of %d); best threshold in "
       "hindsight: precision %.3f, recall %.3f\n",

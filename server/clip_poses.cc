@@ -1,10 +1,12 @@
 #include "server/clip_poses.h"
 
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/motion/forward_kinematics.h"
 #include "core/motion/resample.h"
+#include "server/selected_frames.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -15,13 +17,12 @@ absl::StatusOr<ClipPoses> ReadClipPoses(storage::Database& database, const Poses
     return absl::InvalidArgumentError(absl::StrCat(
         "max_rate: ", max_rate, " must be 0 (the clip's own rate) or a positive rate"));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored,
-                            database.GetClip(request.clip.clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(SelectedFrames selected,
+                            ReadSelectedFrames(database, request.clip, "clip"));
   ClipPoses poses;
   poses.clip_id = request.clip.clip_id;
-  MOTIONDB_ASSIGN_OR_RETURN(poses.frames,
-                            ResolveFrameRange(request.clip, stored.clip.frame_count(), "clip"));
-  MOTIONDB_ASSIGN_OR_RETURN(Clip range, stored.clip.Slice(poses.frames));
+  poses.frames = selected.frames;
+  Clip range = std::move(selected.clip);
   if (max_rate > 0 && max_rate < range.fps()) {
     MOTIONDB_ASSIGN_OR_RETURN(range, Resample(range, max_rate));
   }

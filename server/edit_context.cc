@@ -7,6 +7,7 @@
 #include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_writer.h"
 #include "core/motion/resample.h"
+#include "server/selected_frames.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -17,16 +18,15 @@ absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSn
                                       const ClipSelection& selection, absl::string_view field) {
   MOTIONDB_RETURN_IF_ERROR(
       Prefixed(field, CheckClipInSpace(database, snapshot, selection.clip_id)));
-  MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(selection.clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(const SelectedFrames selected,
+                            ReadSelectedFrames(database, selection, field));
   EditSource source;
   source.range.clip_id = selection.clip_id;
-  MOTIONDB_ASSIGN_OR_RETURN(source.range.frames,
-                            ResolveFrameRange(selection, stored.clip.frame_count(), field));
-  source.clip_name = stored.record.name;
-  source.fps = stored.clip.fps();
-  source.skeleton = stored.clip.shared_skeleton();
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip range, stored.clip.Slice(source.range.frames));
-  MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, range));
+  source.range.frames = selected.frames;
+  source.clip_name = selected.record.name;
+  source.fps = selected.clip.fps();
+  source.skeleton = selected.clip.shared_skeleton();
+  MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, selected.clip));
   return source;
 }
 

@@ -42,4 +42,15 @@ absl::Status InRequestFields(const absl::Status& status, const RequestFields& fi
   return status;
 }
 
+absl::Status CheckDuration(absl::string_view field, double seconds, bool zero_allowed,
+                           int max_frames, double rate) {
+  // Compared as seconds x rate, so that no huge or non-finite value is ever converted to int.
+  const bool above_zero = zero_allowed ? seconds >= 0.0 : seconds > 0.0;
+  if (above_zero && seconds * rate <= max_frames) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, " = ", seconds, " is out of range; expected ",
+                   zero_allowed ? "0 or more" : "more than 0", ", at most ", max_frames / rate,
+                   " seconds (", max_frames, " frames at the space's ", rate, " fps)"));
+}
+
 }  // namespace motiondb::server

@@ -12,6 +12,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 
 namespace motiondb::server {
 
@@ -29,6 +30,14 @@ absl::StatusOr<T> InRequestFields(absl::StatusOr<T> result, const RequestFields&
   if (result.ok()) return result;
   return InRequestFields(result.status(), fields);
 }
+
+// A request's duration in seconds that an operator takes as frames at the space's `rate`, checked
+// before it is converted so that a refusal is told in the field's own unit: OK when `seconds` is
+// more than 0 (or 0 too, with `zero_allowed`) and at most `max_frames` frames at `rate`; else
+// INVALID_ARGUMENT, "gap_s = 4000 is out of range; expected more than 0, at most 3333.33
+// seconds (100000 frames at the space's 30 fps)".
+absl::Status CheckDuration(absl::string_view field, double seconds, bool zero_allowed,
+                           int max_frames, double rate);
 
 }  // namespace motiondb::server
 

@@ -11,15 +11,10 @@
 namespace motiondb::server {
 namespace {
 
-constexpr double kMaxTransitionSeconds = 3600.0;
-
-// Seconds in (0, kMaxTransitionSeconds] to frames at `rate`, at least one.
-absl::StatusOr<int> Frames(absl::string_view field, double seconds, double rate) {
-  if (!(seconds > 0.0 && seconds <= kMaxTransitionSeconds)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(field, " = ", seconds, " is out of range; expected more than 0, at most ",
-                     kMaxTransitionSeconds, " seconds"));
-  }
+// Request field `field`'s seconds, more than 0 and at most `max_frames` frames at `rate`, to
+// frames at `rate`, at least one.
+absl::StatusOr<int> Frames(absl::string_view field, double seconds, double rate, int max_frames) {
+  MOTIONDB_RETURN_IF_ERROR(CheckDuration(field, seconds, false, max_frames, rate));
   return std::max(1, static_cast<int>(std::lround(seconds * rate)));
 }
 
@@ -53,7 +48,8 @@ absl::StatusOr<FillGapOutcome> Gap(const EditContext& context, const MotionSpace
                                    const EditSource& second,
                                    const std::function<bool()>& should_stop) {
   GapFillOptions options = request.gap;
-  MOTIONDB_ASSIGN_OR_RETURN(options.frames, Frames("gap_s", request.gap_s, space.sample_rate()));
+  MOTIONDB_ASSIGN_OR_RETURN(options.frames,
+                            Frames("gap_s", request.gap_s, space.sample_rate(), kMaxGapFrames));
   GapFillOptions linear = options;
   linear.method = GapMethod::kLinear;
   MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd gap,
@@ -81,16 +77,16 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
                                        const EditSource& second,
                                        const std::function<bool()>& should_stop) {
   AlignedBlendOptions options = request.blend;
-  MOTIONDB_ASSIGN_OR_RETURN(options.overlap_frames,
-                            Frames("overlap_s", request.overlap_s, space.sample_rate()));
+  MOTIONDB_ASSIGN_OR_RETURN(options.overlap_frames, Frames("overlap_s", request.overlap_s,
+                                                           space.sample_rate(), kMaxOverlapFrames));
   const SpaceMotion& a = first.motion;
   const SpaceMotion& b = second.motion;
   // Told here in seconds; the operator would say it in frames.
   if (options.overlap_frames > a.coordinates.rows()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "overlap_s = ", request.overlap_s, " is out of range; expected at most the first range's ",
-        a.coordinates.rows() / space.sample_rate(), " s (", a.coordinates.rows(),
-        " frames at the space rate)"));
+        a.coordinates.rows() / space.sample_rate(), " seconds (", a.coordinates.rows(),
+        " frames at the space's ", space.sample_rate(), " fps)"));
   }
   MOTIONDB_ASSIGN_OR_RETURN(const AlignedBlend plan,
                             PlanAlignedBlend(a.coordinates, b.coordinates, options));
@@ -140,12 +136,10 @@ absl::StatusOr<FillGapOutcome> Transition(const EditContext& context, const Fill
 
 absl::StatusOr<FillGapOutcome> FillGap(const EditContext& context, const FillGapRequest& request,
                                        const std::function<bool()>& should_stop) {
-  // The request's seconds reach the operators as frames, its ranges as curves a and b (before
-  // and after), its warp fields as the warp's options.
+  // The request's ranges reach the operators as curves a and b (before and after), its warp
+  // fields as the warp's options; its seconds are checked before they become frames.
   return InRequestFields(Transition(context, request, should_stop),
-                         {{"frames", "gap_s (in frames at the space rate)"},
-                          {"overlap_frames", "overlap_s (in frames at the space rate)"},
-                          {"a", "first"},
+                         {{"a", "first"},
                           {"before", "first"},
                           {"b", "second"},
                           {"after", "second"},

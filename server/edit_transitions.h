@@ -20,12 +20,14 @@ struct FillGapRequest {
   std::string space;
   ClipSelection first;
   ClipSelection second;
-  // The gap between the first range's last frame and the second's first, seconds in (0, 3600],
-  // at least one frame at the space rate. Used when overlap_s is 0.
+  // The gap between the first range's last frame and the second's first, seconds more than 0
+  // and at most kMaxGapFrames frames at the space rate (3333.33 s at 30 fps); at least one frame.
+  // Used when overlap_s is 0.
   double gap_s = 0.5;
   GapFillOptions gap{};  // its frames come from gap_s
-  // Seconds, in [0, 3600], by which the second range overlaps the first's end; > 0 blends them
-  // (time-aligned unless blend.align is false) instead of filling a gap.
+  // Seconds by which the second range overlaps the first's end, at most the first range and
+  // kMaxOverlapFrames frames at the space rate; > 0 blends them (time-aligned unless
+  // blend.align is false) instead of filling a gap.
   double overlap_s = 0.0;
   AlignedBlendOptions blend{};  // its overlap_frames come from overlap_s
   EditOutput output{};

@@ -13,8 +13,6 @@
 namespace motiondb::server {
 namespace {
 
-constexpr double kMaxMinDuration = 3600.0;
-
 absl::StatusOr<StoredPoseModel> Parsed(storage::PoseModelRecord record) {
   StoredPoseModel stored;
   MOTIONDB_ASSIGN_OR_RETURN(stored.model, ParsePoseModel(record.data));
@@ -92,11 +90,6 @@ namespace {
 
 absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectRequest& request) {
   if (request.model.empty()) return absl::InvalidArgumentError("model: a model name is required");
-  if (!(request.min_duration_s >= 0.0 && request.min_duration_s <= kMaxMinDuration)) {
-    return absl::InvalidArgumentError(absl::StrCat("min_duration_s = ", request.min_duration_s,
-                                                   " is out of range; expected 0..",
-                                                   kMaxMinDuration, " seconds"));
-  }
   MOTIONDB_ASSIGN_OR_RETURN(storage::PoseModelRecord record,
                             context.database.GetPoseModel(request.model));
   MOTIONDB_ASSIGN_OR_RETURN(const StoredPoseModel stored, Parsed(std::move(record)));
@@ -105,6 +98,8 @@ absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectReq
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
                             LoadSource(context.database, *snapshot, request.clip, "clip"));
   const double rate = snapshot->space->sample_rate();
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckDuration("min_duration_s", request.min_duration_s, true, kMaxMinFrames, rate));
   DetectionOptions options;
   options.threshold = request.threshold;
   options.min_frames = std::max(1, static_cast<int>(std::ceil(request.min_duration_s * rate)));
@@ -133,10 +128,9 @@ absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectReq
 }  // namespace
 
 absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request) {
-  // The operator scores the clip's range as a curve, and takes min_duration_s in frames.
-  return InRequestFields(
-      Detect(context, request),
-      {{"curve", "clip"}, {"min_frames", "min_duration_s (in frames at the space rate)"}});
+  // The operator scores the clip's range as a curve; min_duration_s is checked before it
+  // becomes the operator's min_frames.
+  return InRequestFields(Detect(context, request), {{"curve", "clip"}});
 }
 
 }  // namespace motiondb::server

@@ -36,7 +36,8 @@ struct DetectRequest {
   std::string model;
   ClipSelection clip;
   std::optional<double> threshold{};  // unset: the model's
-  double min_duration_s = 0.0;        // shortest interval reported, seconds in [0, 3600]
+  // Shortest interval reported, seconds from 0 to kMaxMinFrames frames at the space rate.
+  double min_duration_s = 0.0;
 };
 
 // An interval where the clip holds the pose, at the clip's own rate.

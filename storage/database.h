@@ -181,7 +181,11 @@ class Database {
                                      const WriteOptions& write = {});
   // The skeleton id a clip of this topology has or would get (-1 when none is stored yet).
   absl::StatusOr<int64_t> FindSkeleton(const Skeleton& skeleton);
-  absl::StatusOr<StoredClip> GetClip(int64_t clip_id);  // NOT_FOUND
+  // The clip, or only its frames `frames`, read and decoded without the others (a 10 s range of
+  // a long take costs what 10 s costs). NOT_FOUND for an unknown clip; OUT_OF_RANGE when
+  // `frames` is empty or not inside it.
+  absl::StatusOr<StoredClip> GetClip(int64_t clip_id,
+                                     std::optional<FrameRange> frames = std::nullopt);
   absl::StatusOr<ClipRecord> GetClipRecord(int64_t clip_id);
   absl::StatusOr<ClipRecord> GetClipRecordByName(const std::string& name);  // NOT_FOUND
   // Up to `limit` clips whose content hash is `content_hash`, in id order.

@@ -292,18 +292,26 @@ absl::StatusOr<std::vector<int64_t>> Database::ClipsOfSkeleton(int64_t skeleton_
   return clip_ids;
 }
 
-absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id) {
+absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id, std::optional<FrameRange> frames) {
   std::optional<StoredClip> result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement query,
-        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ", kClipFrameColumns,
-                                " FROM clips c WHERE c.clip_id = ?")));
-    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindInt64(1, clip_id).Step());
+        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ",
+                                frames ? kClipFrameRangeColumns : kClipFrameColumns,
+                                " FROM clips c WHERE c.clip_id = ?1")));
+    query.BindInt64(1, clip_id);
+    if (frames) query.BindInt64(2, frames->first).BindInt64(3, frames->size());
+    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.Step());
     if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
     ClipRecord record = ReadClipRecord(query);
+    if (frames) {
+      MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("stored clip ", clip_id),
+                                        CheckFrameRange(*frames, record.frame_count)));
+    }
     MOTIONDB_ASSIGN_OR_RETURN(
-        Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id), ReadClip(query, record)));
+        Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id),
+                            ReadClip(query, record, frames ? frames->size() : record.frame_count)));
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
     MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
     result.emplace(StoredClip{std::move(record), std::move(clip)});

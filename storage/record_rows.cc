@@ -26,10 +26,10 @@ ClipRecord ReadClipRecord(const SqliteStatement& row) {
   return record;
 }
 
-absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record) {
-  const int64_t frames = record.frame_count;
+absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record,
+                              int64_t frames) {
   const int64_t joints = record.joint_count;
-  // kClipFrameColumns follow the record's.
+  // kClipFrameColumns (or kClipFrameRangeColumns) follow the record's.
   constexpr int kFirst = kClipRecordColumnCount;
   const int64_t position_joints = row.ColumnInt64(kFirst);
   absl::StatusOr<std::shared_ptr<const Skeleton>> skeleton =

@@ -58,6 +58,8 @@ Clip WithRotationNoise(const Clip& clip, double sigma, std::mt19937_64& generato
 
 absl::StatusOr<DetectionEvaluation> EvaluatePoseDetection(
     const LabelledMotions& library, const DetectionEvaluationOptions& options) {
+  DetectionEvaluation evaluation;
+  evaluation.example.assign(library.motions.size(), false);
   std::vector<RowMatrixXd> parts;
   std::vector<int> groups;
   for (size_t i = 0, seen = 0;
@@ -69,6 +71,7 @@ absl::StatusOr<DetectionEvaluation> EvaluatePoseDetection(
     const int last = std::min(static_cast<int>(curve.rows()) - 1, peak + options.window);
     groups.insert(groups.end(), last - first + 1, static_cast<int>(parts.size()));
     parts.push_back(curve.middleRows(first, last - first + 1));
+    evaluation.example[i] = true;
   }
   RowMatrixXd examples(groups.size(), library.space->dims());
   Eigen::Index row = 0;
@@ -76,7 +79,6 @@ absl::StatusOr<DetectionEvaluation> EvaluatePoseDetection(
     examples.middleRows(row, part.rows()) = part;
     row += part.rows();
   }
-  DetectionEvaluation evaluation;
   evaluation.example_poses = static_cast<int>(examples.rows());
   MOTIONDB_ASSIGN_OR_RETURN(evaluation.model, FitPoseModel(examples, options.model, groups));
   for (size_t i = 0; i < library.motions.size(); ++i) {
@@ -84,6 +86,10 @@ absl::StatusOr<DetectionEvaluation> EvaluatePoseDetection(
                               DetectPose(evaluation.model, library.motions[i].coordinates,
                                          {.min_frames = options.min_frames}));
     const bool fires = !detection.intervals.empty();
+    if (evaluation.example[i]) {
+      evaluation.examples_fired += fires;
+      continue;
+    }
     const bool positive = library.labels[i] == options.label;
     evaluation.fired += fires;
     evaluation.positives += positive;

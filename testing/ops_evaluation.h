@@ -53,6 +53,10 @@ struct DetectionEvaluationOptions {
 struct DetectionEvaluation {
   PoseModel model;
   int example_poses = 0;
+  std::vector<bool> example;  // per clip: its peak poses are in the model
+  int examples_fired = 0;     // of the example clips
+  // Over the other clips only, which the model has not seen: an example clip's peak poses are
+  // the model's own, so its firing says little about how the model generalises.
   int fired = 0, true_positives = 0, positives = 0;
   std::map<std::string, std::pair<int, int>> by_label;  // fired on, of
   double precision() const { return fired > 0 ? static_cast<double>(true_positives) / fired : 0; }
@@ -62,7 +66,8 @@ struct DetectionEvaluation {
 };
 
 // Fits a model to the peak poses of example clips of `options.label` (each clip a group of the
-// model's threshold) and runs it over every clip with the model's threshold.
+// model's threshold) and runs it over every clip with the model's threshold; precision and
+// recall count the clips that were not examples.
 absl::StatusOr<DetectionEvaluation> EvaluatePoseDetection(
     const LabelledMotions& library, const DetectionEvaluationOptions& options);
 

@@ -422,6 +422,18 @@ TEST_F(EditServiceTest, PoseModelsAreFittedStoredListedRunAndDeleted) {
   }
   EXPECT_TRUE(covers);
   EXPECT_LT(covered, 150) << "a model that fires everywhere finds nothing";
+  // A duration is refused in seconds, the field's own unit, with the operator's frames beside.
+  for (const double seconds : {-1.0, 1e5}) {
+    detect.set_min_duration_s(seconds);
+    status = edits_->DetectPose(Context().get(), detect, &found);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(),
+                ::testing::StartsWith(
+                    "min_duration_s = " + std::string(seconds < 0 ? "-1" : "100000") +
+                    " is out of range; expected 0 or more, at most 33333.3 seconds (1000000 "
+                    "frames at the space's 30 fps)"));
+  }
+  detect.clear_min_duration_s();
 
   v1::DeletePoseModelRequest erase;
   erase.set_name("take3-pose");
@@ -541,10 +553,19 @@ TEST_F(EditServiceTest, ErrorsNameTheRequestsOwnFields) {
   gap.mutable_output()->set_store_name("never-stored");
   v1::FillGapResponse filled;
   gap.set_gap_s(3600);  // 108000 frames at 30 fps, more than a gap may have
-  expect(edits_->FillGap(Context().get(), gap, &filled), "gap_s");
+  grpc::Status status = edits_->FillGap(Context().get(), gap, &filled);
+  expect(status, "gap_s");
+  // In seconds, the field's unit, with the operator's frames beside.
+  EXPECT_EQ(status.error_message(),
+            "gap_s = 3600 is out of range; expected more than 0, at most 3333.33 seconds (100000 "
+            "frames at the space's 30 fps)");
   gap.clear_gap_s();
   gap.set_overlap_s(1.0);  // 30 frames, longer than the 11 of the first range
-  expect(edits_->FillGap(Context().get(), gap, &filled), "overlap_s");
+  status = edits_->FillGap(Context().get(), gap, &filled);
+  expect(status, "overlap_s");
+  EXPECT_EQ(status.error_message(),
+            "overlap_s = 1 is out of range; expected at most the first range's 0.366667 seconds "
+            "(11 frames at the space's 30 fps)");
   gap.set_overlap_s(0.2);
   gap.set_slope_limit(50);
   expect(edits_->FillGap(Context().get(), gap, &filled), "slope_limit");

@@ -46,7 +46,8 @@ TEST_F(OpsRealDataTest, RaiseUpBothHandsIsDetectedFromFiveClipsPeakPoses) {
   const absl::StatusOr<testing::DetectionEvaluation> evaluation =
       testing::EvaluatePoseDetection(*library_, options);
   ASSERT_TRUE(evaluation.ok()) << evaluation.status();
-  EXPECT_EQ(evaluation->positives, 74);
+  // 74 clips of the label, 5 of them the examples: precision and recall count the other 69.
+  EXPECT_EQ(evaluation->positives, 69);
   EXPECT_GE(evaluation->precision(), 0.9) << evaluation->fired << " fired";
   EXPECT_GE(evaluation->recall(), 0.9) << evaluation->true_positives << " found";
   // The arm-waving clips, which pass through raised arms, are what the threshold must tell apart.

@@ -260,6 +260,22 @@ TEST_F(StorageTest, ClipRoundTripKeepsFramesLayoutAndRecord) {
   EXPECT_EQ(stored_empty->clip.frame_count(), 0);
 }
 
+// A range is read without the other frames and is the same as the whole clip's slice.
+TEST_F(StorageTest, AFrameRangeReadsAsTheSliceOfTheClip) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 50, 3);
+  const int64_t id = Insert(Named("walk_01"), clip);
+  for (const FrameRange range : {FrameRange{0, 49}, FrameRange{10, 20}, FrameRange{49, 49}}) {
+    const absl::StatusOr<StoredClip> stored = Db().GetClip(id, range);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+    EXPECT_EQ(stored->record.frame_count, 50);  // the record is the whole clip's
+    ExpectSameFrames(*clip.Slice(range), stored->clip);
+  }
+  for (const FrameRange range : {FrameRange{40, 50}, FrameRange{5, 4}, FrameRange{-1, 3}}) {
+    EXPECT_EQ(Db().GetClip(id, range).status().code(), absl::StatusCode::kOutOfRange);
+  }
+  EXPECT_EQ(Db().GetClip(4242, FrameRange{0, 0}).status().code(), absl::StatusCode::kNotFound);
+}
+
 TEST_F(StorageTest, TagFilterListsOnlyTaggedClips) {
   const Clip clip = Motion(testing::ChainSkeleton(), 5);
   const int64_t a = Insert(Named("a", {"walk"}), clip);

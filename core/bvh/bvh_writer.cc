@@ -5,6 +5,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "util/decimal_text.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
 
@@ -13,18 +14,13 @@ namespace {
 
 constexpr double kRadiansToDegrees = 180.0 / std::numbers::pi;
 
-// 12 significant digits: far below the 1e-6 round-trip tolerance, and short rows.
-void AppendNumber(std::string& out, double value) {
-  char buffer[32];
-  const auto result =
-      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::general, 12);
-  out.append(buffer, result.ptr);
-}
-
+// Numbers have 12 significant digits (WriteDecimal12): far below the 1e-6 round-trip tolerance,
+// and short rows.
 void AppendVector(std::string& out, const Eigen::Vector3d& v) {
+  char buffer[kMaxDecimal12Chars];
   for (int axis = 0; axis < 3; ++axis) {
     out += ' ';
-    AppendNumber(out, v[axis]);
+    out.append(buffer, WriteDecimal12(buffer, v[axis]));
   }
 }
 
@@ -74,27 +70,35 @@ class HierarchyWriter {
 
 absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange> range) {
   const FrameRange frames = range.value_or(FrameRange{0, clip.frame_count() - 1});
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip part, clip.Slice(frames));
-  const Skeleton& skeleton = part.skeleton();
+  MOTIONDB_RETURN_IF_ERROR(CheckFrameRange(frames, clip.frame_count()));
+  const Skeleton& skeleton = clip.skeleton();
 
   std::string out;
-  out.reserve(1024 + static_cast<size_t>(part.frame_count()) * skeleton.channel_count() * 12);
+  // About 15 characters a value, sign and separator included: "-32.9847707373 ".
+  out.reserve(4096 + static_cast<size_t>(frames.size()) * skeleton.channel_count() * 16);
   const std::vector<int> order = HierarchyWriter(skeleton, out).Write();
-  absl::StrAppend(&out, "MOTION\nFrames: ", part.frame_count(), "\nFrame Time: ");
+  absl::StrAppend(&out, "MOTION\nFrames: ", frames.size(), "\nFrame Time: ");
   char buffer[32];
-  out.append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), part.frame_time()).ptr);
+  out.append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), clip.frame_time()).ptr);
   out += '\n';
 
   // Each joint's previous Euler angles, so that the decomposition stays continuous.
   std::vector<Eigen::Vector3d> previous(skeleton.joint_count(), Eigen::Vector3d::Zero());
-  for (int f = 0; f < part.frame_count(); ++f) {
-    bool first_value = true;
+  // A row is written in place: room for its longest text (each value and a separator, the line
+  // end) first, cut to what it took after.
+  const size_t row_room =
+      static_cast<size_t>(skeleton.channel_count()) * (kMaxDecimal12Chars + 1) + 1;
+  for (int f = frames.first; f <= frames.last; ++f) {
+    const size_t row_start = out.size();
+    out.resize(row_start + row_room);
+    char* const row = out.data() + row_start;
+    char* p = row;
     for (int j : order) {
       const Joint& joint = skeleton.joint(j);
       Eigen::Vector3d angles = Eigen::Vector3d::Zero();
       if (skeleton.has_rotation(j)) {
         previous[j] =
-            QuaternionToEuler(part.rotation(f, j), skeleton.rotation_order(j), previous[j]);
+            QuaternionToEuler(clip.rotation(f, j), skeleton.rotation_order(j), previous[j]);
         angles = previous[j] * kRadiansToDegrees;
       }
       int rotation_index = 0;
@@ -102,13 +106,13 @@ absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange>
         const int axis = static_cast<int>(c) % 3;
         const double value = c >= Channel::kXrotation
                                  ? angles[rotation_index++]
-                                 : part.positions()(f, 3 * skeleton.position_slot(j) + axis);
-        if (!first_value) out += ' ';
-        first_value = false;
-        AppendNumber(out, value);
+                                 : clip.positions()(f, 3 * skeleton.position_slot(j) + axis);
+        if (p != row) *p++ = ' ';
+        p = WriteDecimal12(p, value);
       }
     }
-    out += '\n';
+    *p++ = '\n';
+    out.resize(p - out.data());
   }
   return out;
 }

@@ -5,8 +5,17 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
 
 namespace motiondb {
+
+absl::Status CheckFrameRange(FrameRange range, int64_t frame_count) {
+  if (range.first < 0 || range.last < range.first || range.last >= frame_count) {
+    return absl::OutOfRangeError(absl::StrCat("frame range ", range.first, "-", range.last,
+                                              " is outside the clip's frames 0-", frame_count - 1));
+  }
+  return absl::OkStatus();
+}
 
 absl::StatusOr<Clip> Clip::Create(std::shared_ptr<const Skeleton> skeleton, double frame_time,
                                   RowMatrixXd rotations, RowMatrixXd positions) {
@@ -61,11 +70,7 @@ Eigen::Vector3d Clip::root_position(int frame) const {
 }
 
 absl::StatusOr<Clip> Clip::Slice(FrameRange range) const {
-  if (range.first < 0 || range.last < range.first || range.last >= frame_count()) {
-    return absl::OutOfRangeError(absl::StrCat("frame range ", range.first, "-", range.last,
-                                              " is outside the clip's frames 0-",
-                                              frame_count() - 1));
-  }
+  MOTIONDB_RETURN_IF_ERROR(CheckFrameRange(range, frame_count()));
   return Clip(skeleton_, frame_time_, rotations_.middleRows(range.first, range.size()),
               positions_.middleRows(range.first, range.size()));
 }

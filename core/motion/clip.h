@@ -6,8 +6,10 @@
 #ifndef MOTIONDB_CORE_MOTION_CLIP_H_
 #define MOTIONDB_CORE_MOTION_CLIP_H_
 
+#include <cstdint>
 #include <memory>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/motion/matrix.h"
 #include "core/motion/rotation.h"
@@ -21,6 +23,9 @@ struct FrameRange {
   int last = 0;
   int size() const { return last - first + 1; }
 };
+
+// OK when `range` is non-empty and lies inside frames 0..frame_count - 1, else OUT_OF_RANGE.
+absl::Status CheckFrameRange(FrameRange range, int64_t frame_count);
 
 class Clip {
  public:
@@ -46,7 +51,7 @@ class Clip {
   // The root joint's translation: its position channels, or its offset when it has none.
   Eigen::Vector3d root_position(int frame) const;
 
-  // The frames in `range`, which must lie inside the clip.
+  // The frames in `range`, which must lie inside the clip (CheckFrameRange).
   absl::StatusOr<Clip> Slice(FrameRange range) const;
 
  private:

@@ -10,8 +10,6 @@
 namespace motiondb {
 namespace {
 
-constexpr int kMaxOverlapFrames = 100000;
-
 absl::Status CheckOptions(const AlignedBlendOptions& options, Eigen::Index a_frames, int dims) {
   MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckBetween(
       "overlap_frames", options.overlap_frames, 1, std::min<double>(kMaxOverlapFrames, a_frames)));

@@ -19,9 +19,12 @@
 
 namespace motiondb {
 
+// The longest overlap AlignedBlendOptions::overlap_frames may ask for.
+inline constexpr int kMaxOverlapFrames = 100000;
+
 struct AlignedBlendOptions {
-  // Frames of the first clip's end that blend into the second's start, 1..100000 and at most
-  // the first clip's length.
+  // Frames of the first clip's end that blend into the second's start, 1..kMaxOverlapFrames and
+  // at most the first clip's length.
   int overlap_frames = 15;
   // Warp the second clip onto the first before blending; false blends frame for frame.
   bool align = true;

@@ -10,8 +10,6 @@
 namespace motiondb {
 namespace {
 
-constexpr int kMaxGapFrames = 100000;
-
 // The angular velocity of one joint from frame f to f + 1, per frame.
 Eigen::Vector3d Step(const Eigen::Ref<const RowMatrixXd>& rotations, Eigen::Index f,
                      Eigen::Index j) {

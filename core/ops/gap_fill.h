@@ -22,8 +22,11 @@ enum class GapMethod {
   kLinear,   // the baseline: a straight line, which loses the clips' momentum
 };
 
+// The longest gap GapFillOptions::frames may ask for.
+inline constexpr int kMaxGapFrames = 100000;
+
 struct GapFillOptions {
-  // Frames between the clips' last and first frames, 1..100000.
+  // Frames between the clips' last and first frames, 1..kMaxGapFrames.
   int frames = 15;
   GapMethod method = GapMethod::kHermite;
   // v of eq. 4.4, in [0, 1]: 1 keeps the clips' velocities at the seams, 0 arrives at rest.

@@ -7,11 +7,6 @@
 #include "util/status_macros.h"
 
 namespace motiondb {
-namespace {
-
-constexpr int kMaxMinFrames = 1000000;
-
-}  // namespace
 
 absl::StatusOr<Detection> DetectPose(const PoseModel& model,
                                      const Eigen::Ref<const RowMatrixXd>& curve,

@@ -17,10 +17,13 @@
 
 namespace motiondb {
 
+// The longest DetectionOptions::min_frames.
+inline constexpr int kMaxMinFrames = 1000000;
+
 struct DetectionOptions {
   // Log-likelihood a frame must reach, finite; nullopt: the model's own threshold.
   std::optional<double> threshold{};
-  // Shortest interval reported, in frames of the curve, 1..1000000.
+  // Shortest interval reported, in frames of the curve, 1..kMaxMinFrames.
   int min_frames = 1;
 };
 
