@@ -270,7 +270,7 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
   std::vector<std::vector<storage::LabelRecord>> found_by_label(queries.size());
   std::mutex progress_mutex;
   absl::Status last_skip;
-  size_t last_skip_index = 0;
+  int64_t last_skip_index = -1;  // the label of last_skip, the highest skipped
   MOTIONDB_RETURN_IF_ERROR(ParallelFor(
       static_cast<int64_t>(queries.size()), threads, [&](int64_t i, int) -> absl::Status {
         const storage::LabelRecord& label = queries[i];
@@ -296,7 +296,7 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
           ++progress.queries;
         } else {
           ++progress.skipped;
-          if (last_skip.ok() || static_cast<size_t>(i) > last_skip_index) {
+          if (i > last_skip_index) {
             last_skip_index = i;
             last_skip = absl::Status(
                 found.status().code(),
