@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "core/index/library_index.h"
+#include "core/search/characteristic_points.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
 #include "core/search/pose_search.h"

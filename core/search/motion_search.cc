@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
+#include "core/search/characteristic_points.h"
 #include "core/search/internal/search_query.h"
+#include "core/search/multi_point_search.h"
 #include "core/search/pose_search.h"
 #include "core/search/warp/time_warp.h"
 #include "core/search/warp_refinement.h"
@@ -154,47 +156,19 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
 
 }  // namespace
 
-int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral) {
-  std::vector<double> centre(dims, 0.0);
-  if (neutral == NeutralPose::kQueryMean) {
-    for (int64_t f = 0; f < query.rows; ++f) {
-      for (int k = 0; k < dims; ++k) centre[k] += query.row(f)[k];
-    }
-    for (double& c : centre) c /= static_cast<double>(query.rows);
-  } else if (neutral == NeutralPose::kBoundaryMean) {
-    for (int k = 0; k < dims; ++k) {
-      centre[k] = 0.5 * (query.row(0)[k] + query.row(query.rows - 1)[k]);
-    }
-  }
-  int best = 0;
-  double best_distance = -1.0;
-  for (int64_t f = 0; f < query.rows; ++f) {
-    double sum = 0.0;
-    for (int k = 0; k < dims; ++k) {
-      const double d = query.row(f)[k] - centre[k];
-      sum += d * d;
-    }
-    if (sum > best_distance) {
-      best_distance = sum;
-      best = static_cast<int>(f);
-    }
-  }
-  return best;
-}
-
 absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateView query,
                                       const SearchParams& params) {
   if (query.rows == 1) return PoseSearch(library, query, params);
   const Clock::time_point start = Clock::now();
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
+  Clock::time_point stage = Clock::now();
+  const std::vector<int> anchors = CharacteristicFrames(query, library.rate(), params);
+  if (anchors.size() > 1) return MultiPointSearch(library, query, anchors, params);
   SearchResponse response;
   SearchStats& stats = response.stats;
-
-  Clock::time_point stage = Clock::now();
-  const int anchor = params.characteristic_frame >= 0
-                         ? params.characteristic_frame
-                         : FindCharacteristicFrame(query, params.ann_dims, params.neutral);
+  const int anchor = anchors.front();
   stats.characteristic_frame = anchor;
+  stats.characteristic_frames = anchors;
   stats.characteristic_ms = MillisecondsSince(stage);
 
   stage = Clock::now();

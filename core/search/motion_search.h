@@ -15,12 +15,10 @@
 
 namespace motiondb {
 
-// The query frame farthest, over the first `dims` coordinates, from the neutral pose.
-int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral);
-
 // `query`: the query's projection at the library's rate, pre-scaled like the library, with the
-// library's dimensions; a query of one frame is a pose query (pose_search.h). Thread-safe: any
-// number of searches may run on one library at once.
+// library's dimensions; a query of one frame is a pose query (pose_search.h), one with several
+// characteristic points a multi-point search (multi_point_search.h). Thread-safe: any number of
+// searches may run on one library at once.
 absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateView query,
                                       const SearchParams& params);
 

@@ -44,6 +44,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   SearchResponse response;
   SearchStats& stats = response.stats;
   stats.characteristic_frame = 0;
+  stats.characteristic_frames = {0};
   const int64_t separation =
       std::max<int64_t>(std::llround(params.cluster_gap_s * library.rate()) + 1,
                         std::llround(kPoseSeparationS * library.rate()));

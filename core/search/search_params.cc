@@ -48,6 +48,23 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (!std::isfinite(params.max_overlap) || params.max_overlap < 0 || params.max_overlap > 1) {
     return OutOfRange("max_overlap", params.max_overlap, "0..1");
   }
+  if (params.characteristic_points < 0 || params.characteristic_points > kMaxCharacteristicPoints) {
+    return OutOfRange("characteristic_points", params.characteristic_points,
+                      absl::StrCat("0..", kMaxCharacteristicPoints, " (0: by the query's length)"));
+  }
+  if (params.characteristic_frames.size() > kMaxCharacteristicPoints) {
+    return absl::InvalidArgumentError(absl::StrCat("characteristic_frames has ",
+                                                   params.characteristic_frames.size(),
+                                                   " frames; at most ", kMaxCharacteristicPoints));
+  }
+  if (!params.characteristic_frames.empty() && params.characteristic_frame != -1) {
+    return absl::InvalidArgumentError(
+        "characteristic_frame and characteristic_frames are both set; give one");
+  }
+  if (!std::isfinite(params.max_point_gap_s) || params.max_point_gap_s < 0 ||
+      params.max_point_gap_s > 3600) {
+    return OutOfRange("max_point_gap_s", params.max_point_gap_s, "0..3600 seconds");
+  }
   return absl::OkStatus();
 }
 

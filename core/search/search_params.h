@@ -36,6 +36,8 @@ enum class SeedSelection {
 
 // The most results one search returns (max_results' upper bound).
 inline constexpr int kMaxSearchResults = 10'000;
+// The most characteristic points of one query.
+inline constexpr int kMaxCharacteristicPoints = 16;
 
 struct SearchParams {
   // Dimensions of the nearest-neighbour seed search (the index's kd-tree dimensions: others
@@ -59,6 +61,19 @@ struct SearchParams {
   // automatically as the pose farthest from `neutral`.
   int characteristic_frame = -1;
   NeutralPose neutral = NeutralPose::kQueryMean;
+  // Several characteristic points (thesis 7.2.3; core/search/multi_point_search.h): query frames
+  // at the space rate, increasing, each the anchor of its own part of the query. A result
+  // matches the parts in order, with any pause up to max_point_gap_s between adjacent ones.
+  // Empty: one point (characteristic_frame), or characteristic_points found.
+  std::vector<int> characteristic_frames;
+  // With neither characteristic_frame nor characteristic_frames: the points found, one the pose
+  // farthest from `neutral` in each of as many equal parts of the query; 1 is the thesis's one
+  // point; 0 takes one per kSecondsPerCharacteristicPoint of query.
+  int characteristic_points = 1;
+  // Several points: the most time, in seconds, between the library frames matched to the end
+  // of one part and to the start of the next (a held pose longer than the query's is absorbed
+  // there, where one slope-limited warp cannot absorb it).
+  double max_point_gap_s = 10.0;
   // Seeds of one clip closer than this in time join one cluster.
   double cluster_gap_s = 0.1;
   // A result is dropped when it overlaps a better one by more than this fraction of its length.

@@ -27,6 +27,19 @@ absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, Coor
         absl::StrCat("characteristic_frame ", params.characteristic_frame,
                      " is outside the query's frames 0-", query.rows - 1));
   }
+  for (size_t i = 0; i < params.characteristic_frames.size(); ++i) {
+    const int frame = params.characteristic_frames[i];
+    if (frame < 0 || frame >= query.rows) {
+      return absl::InvalidArgumentError(absl::StrCat("characteristic_frames[", i, "] ", frame,
+                                                     " is outside the query's frames 0-",
+                                                     query.rows - 1));
+    }
+    if (i > 0 && frame <= params.characteristic_frames[i - 1]) {
+      return absl::InvalidArgumentError(absl::StrCat("characteristic_frames[", i, "] ", frame,
+                                                     " does not follow the frame before it, ",
+                                                     params.characteristic_frames[i - 1]));
+    }
+  }
   if (params.clip_ids.empty() && params.tags.empty()) return std::vector<bool>();
   std::vector<bool> allowed(library.clip_count(), false);
   for (int64_t id : params.clip_ids) {

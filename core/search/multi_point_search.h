@@ -1,0 +1,30 @@
+// A search through several characteristic points (thesis 7.2.3): for a query made of several
+// actions, one warp through one point must fit every timing difference between the actions
+// into one slope-limited path, and a pause held longer in the library than in the query cannot
+// fit at all. Here the query is cut halfway between adjacent points into parts, each part is
+// searched through its own point (seeds, clusters, warps, refinement: Search()), and in every
+// clip the parts' matches are chained in query order through a directed graph whose edges join
+// a match of one part to a match of the next that starts after it ends, at most
+// max_point_gap_s later. The best chain ending at each match is a result: its score is the
+// mean pose distance over all the query's frames, its path the parts' paths end to end.
+#ifndef MOTIONDB_CORE_SEARCH_MULTI_POINT_SEARCH_H_
+#define MOTIONDB_CORE_SEARCH_MULTI_POINT_SEARCH_H_
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/index/coordinate_view.h"
+#include "core/index/library_index.h"
+#include "core/search/search_params.h"
+#include "core/search/search_result.h"
+
+namespace motiondb {
+
+// Search() through `anchors` (two or more increasing query frames). Thread-safe, as Search().
+absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, CoordinateView query,
+                                                const std::vector<int>& anchors,
+                                                const SearchParams& params);
+
+}  // namespace motiondb
+
+#endif  // MOTIONDB_CORE_SEARCH_MULTI_POINT_SEARCH_H_
