@@ -25,6 +25,9 @@ struct SearchFlags {
   std::string bvh;
   FrameRangeFlags range;
   std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, exact_threads;
+  std::optional<int> points;
+  std::vector<int> char_frames;
+  std::optional<double> max_point_gap;
   std::string seeds = "frames";
   std::optional<double> epsilon;
   std::string neutral = "mean";
@@ -61,15 +64,25 @@ constexpr Parameter kParameters[] = {
      &SearchFlags::slope, &v1::SearchRequest::set_slope_limit},
     {"--max", "max_results", "N", "20", "results returned", &SearchFlags::max,
      &v1::SearchRequest::set_max_results},
+    {"--points", "characteristic_points", "K", "1",
+     "characteristic points found, one in each K-th of the query, each anchoring its part "
+     "(0: one per 3 s of query)",
+     &SearchFlags::points, &v1::SearchRequest::set_characteristic_points, 0},
 };
 
 // The flags that set SearchRequest's fields, for the server's errors.
 FlagNames SearchFlagNames(const SearchFlags& flags) {
-  FlagNames names = {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"},
-                     {"bvh.first_frame", "--from"},  {"bvh.last_frame", "--to"},
-                     {"bvh", "--bvh " + flags.bvh},  {"characteristic_frame", "--char-frame"},
-                     {"epsilon", "--epsilon"},       {"neutral", "--neutral"},
-                     {"exact_threads", "--threads"}};
+  FlagNames names = {{"clip.first_frame", "--from"},
+                     {"clip.last_frame", "--to"},
+                     {"bvh.first_frame", "--from"},
+                     {"bvh.last_frame", "--to"},
+                     {"bvh", "--bvh " + flags.bvh},
+                     {"characteristic_frame", "--char-frame"},
+                     {"epsilon", "--epsilon"},
+                     {"neutral", "--neutral"},
+                     {"exact_threads", "--threads"},
+                     {"characteristic_frames", "--char-frames"},
+                     {"max_point_gap_s", "--max-point-gap"}};
   for (const Parameter& parameter : kParameters) names.push_back({parameter.field, parameter.flag});
   return names;
 }
@@ -92,6 +105,8 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
     if (const std::optional<int>& value = flags.*parameter.value) (request.*parameter.set)(*value);
   }
   if (flags.char_frame) request.set_characteristic_frame(*flags.char_frame);
+  for (const int frame : flags.char_frames) request.add_characteristic_frames(frame);
+  if (flags.max_point_gap) request.set_max_point_gap_s(*flags.max_point_gap);
   if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
   request.set_seed_selection(flags.seeds == "places" ? v1::SEED_SELECTION_DISTINCT_PLACES
                                                      : v1::SEED_SELECTION_NEAREST_FRAMES);
@@ -146,6 +161,8 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
   const v1::SearchCounts& c = response.counts();
   return {{"results", results},
           {"characteristic_frame", response.characteristic_frame()},
+          {"characteristic_frames", std::vector<int>(response.characteristic_frames().begin(),
+                                                     response.characteristic_frames().end())},
           {"timings",
            {{"characteristic_ms", t.characteristic_ms()},
             {"seeds_ms", t.seeds_ms()},
@@ -230,6 +247,19 @@ void AddSearch(Commands& commands) {
       ->type_name("F")
       ->default_str("auto")
       ->check(WholeAtLeast(-1));  // -1: automatic, as the server reads it
+  search
+      ->add_option("--char-frames", flags->char_frames,
+                   "several characteristic points: query frames, increasing, each anchoring its "
+                   "part of the query (cut halfway between them); results match the parts in order")
+      ->type_name("F,F,...")
+      ->delimiter(',')
+      ->check(WholeAtLeast(0));
+  search
+      ->add_option("--max-point-gap", flags->max_point_gap,
+                   "several points: the most seconds a result may skip between two parts")
+      ->type_name("S")
+      ->default_str("10")
+      ->check(NumberAtLeast(0));
   OneOf(search->add_option("--neutral", flags->neutral,
                            "auto --char-frame: the pose farthest from this"),
         {"mean", "boundary", "origin"})

@@ -37,10 +37,15 @@ bool IsFieldCharacter(char c) {
          c == ']';
 }
 
+// The flag of `field`, or of the list it indexes ("characteristic_frames[1]": the flag gives
+// the whole list).
 const std::string* FlagOf(const std::string& field, const FlagNames& flags) {
   for (const auto& [name, flag] : flags) {
     if (name == field) return &flag;
   }
+  static const std::regex indexed(R"(([a-z_.]+)\[\d+\])");
+  std::smatch match;
+  if (std::regex_match(field, match, indexed)) return FlagOf(match.str(1), flags);
   return nullptr;
 }
 

@@ -70,6 +70,17 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnap
   return query;
 }
 
+// A query frame (at its clip's rate, in its numbering) as a row of the query at the space rate.
+absl::StatusOr<int> QueryRow(const Query& query, int frame, absl::string_view field) {
+  if (frame < query.range.first || frame > query.range.last) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ": ", frame,
+                                                   " is outside the query's frames ",
+                                                   query.range.first, "..", query.range.last));
+  }
+  return static_cast<int>(
+      std::clamp<int64_t>(query.frames.ToSpace(frame) - query.first_row, 0, query.row_count - 1));
+}
+
 absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Query& query,
                                            int dims) {
   SearchParams params = request.params;
@@ -78,14 +89,26 @@ absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Q
   params.dtw_dims = request.dtw_dims.value_or(std::min(defaults.dtw_dims, dims));
   params.characteristic_frame = -1;
   if (request.characteristic_frame) {
-    const int frame = *request.characteristic_frame;
-    if (frame < query.range.first || frame > query.range.last) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("characteristic_frame: ", frame, " is outside the query's frames ",
-                       query.range.first, "..", query.range.last, " (or -1 for automatic)"));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        params.characteristic_frame,
+        QueryRow(query, *request.characteristic_frame, "characteristic_frame (or -1: automatic)"));
+  }
+  params.characteristic_frames.clear();
+  for (size_t i = 0; i < request.characteristic_frames.size(); ++i) {
+    const int frame = request.characteristic_frames[i];
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const int row, QueryRow(query, frame, absl::StrCat("characteristic_frames[", i, "]")));
+    if (i > 0 && frame <= request.characteristic_frames[i - 1]) {
+      return absl::InvalidArgumentError(absl::StrCat("characteristic_frames[", i, "]: ", frame,
+                                                     " does not follow the frame before it, ",
+                                                     request.characteristic_frames[i - 1]));
     }
-    params.characteristic_frame = static_cast<int>(
-        std::clamp<int64_t>(query.frames.ToSpace(frame) - query.first_row, 0, query.row_count - 1));
+    if (i > 0 && row <= params.characteristic_frames.back()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "characteristic_frames[", i, "]: ", frame, " and ", request.characteristic_frames[i - 1],
+          " fall on one frame at the space's rate; give frames further apart"));
+    }
+    params.characteristic_frames.push_back(row);
   }
   MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, dims));
   return params;
@@ -205,6 +228,9 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
     if (outcome.stats.characteristic_frame >= 0) {
       outcome.characteristic_frame =
           query.frames.ToOriginal(query.first_row + outcome.stats.characteristic_frame);
+    }
+    for (const int row : outcome.stats.characteristic_frames) {
+      outcome.characteristic_frames.push_back(query.frames.ToOriginal(query.first_row + row));
     }
   }
   outcome.request_ms =

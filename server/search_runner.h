@@ -41,6 +41,9 @@ struct SearchRequest {
   std::optional<int> dtw_dims;
   // A query frame at the query clip's own rate, inside its range; unset: found automatically.
   std::optional<int> characteristic_frame;
+  // Several characteristic points, as characteristic_frame, increasing (SearchParams'
+  // characteristic_frames); empty: none given.
+  std::vector<int> characteristic_frames;
   // The exhaustive search instead of the seeded one.
   bool exact = false;
   // A stored-clip query: drop hits in its clip overlapping its range (unset: true), filling
@@ -67,9 +70,10 @@ struct SearchHit {
 
 struct SearchOutcome {
   std::vector<SearchHit> hits;
-  SearchStats stats;              // zero when the space holds no clips
-  int characteristic_frame = -1;  // at the query clip's rate; -1 when none was used
-  int64_t query_frames = 0;       // at the space rate
+  SearchStats stats;                       // zero when the space holds no clips
+  int characteristic_frame = -1;           // at the query clip's rate; -1 when none was used
+  std::vector<int> characteristic_frames;  // every one used, as characteristic_frame
+  int64_t query_frames = 0;                // at the space rate
   int64_t library_frames = 0;
   double request_ms = 0;  // the whole request, query projection included
 };

@@ -184,6 +184,9 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--max N=20",
                              "--epsilon E=0",
                              "--char-frame F=auto",
+                             "--char-frames F,F,...",
+                             "--points K=1",
+                             "--max-point-gap S=10",
                              "--neutral mean|boundary|origin=mean",
                              "--exact",
                              "--no-refine",
@@ -388,7 +391,9 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
   for (const std::vector<std::string>& extra :
        {std::vector<std::string>{"--seeds", "places", "--places", "16"},
         {"--seeds", "frames", "--neighbours", "200"},
-        {"--exact", "--threads", "2"}}) {
+        {"--exact", "--threads", "2"},
+        {"--char-frames", "15,35"},
+        {"--points", "2", "--max-point-gap", "1"}}) {
     std::vector<std::string> args = {"search", "--space",         "body",  "--clip",
                                      clip_id_, "--from",          "10",    "--to",
                                      "40",     "--include-query", "--json"};
@@ -407,6 +412,11 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
       Remote({"search", "--space", "body", "--clip", clip_id_, "--exact", "--threads", "5000"});
   EXPECT_EQ(threads.exit_code, 1);
   EXPECT_THAT(threads.err, HasSubstr("--threads 5000 is out of range"));
+  const testing::CommandResult frames =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--char-frames", "30,20", "--json"});
+  EXPECT_EQ(frames.exit_code, 1);
+  EXPECT_THAT(frames.err, HasSubstr("--char-frames"));
+  EXPECT_THAT(frames.err, HasSubstr("20 does not follow the frame before it, 30"));
 }
 
 TEST_F(CliServerTest, SearchLeavesOutTheQuerysOwnRangeUnlessAskedToKeepIt) {

@@ -715,6 +715,20 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   ASSERT_GE(found.results_size(), 1);
   for (const v1::SearchResult& r : found.results()) EXPECT_EQ(r.clip_id(), raise_clip);
   EXPECT_NEAR(found.characteristic_frame(), filtered.characteristic_frame(), 1);
+  // Several characteristic points, given in the query's own frames, come back in them.
+  v1::SearchRequest several = query;
+  several.add_characteristic_frames(raise.first_frame + 5);
+  several.add_characteristic_frames((raise.peak_first_frame + raise.peak_last_frame) / 2);
+  ASSERT_TRUE(client.Search(several, &found).ok());
+  ASSERT_GE(found.results_size(), 1);
+  ASSERT_EQ(found.characteristic_frames_size(), 2);
+  EXPECT_NEAR(found.characteristic_frames(0), several.characteristic_frames(0), 1);
+  EXPECT_NEAR(found.characteristic_frames(1), several.characteristic_frames(1), 1);
+  EXPECT_EQ(found.characteristic_frame(), found.characteristic_frames(0));
+  v1::SearchRequest found_points = query;
+  found_points.set_characteristic_points(3);
+  ASSERT_TRUE(client.Search(found_points, &found).ok());
+  EXPECT_EQ(found.characteristic_frames_size(), 3);
   v1::SearchRequest exact = query;
   exact.set_exact(true);
   exact.set_max_results(3);
@@ -1273,6 +1287,15 @@ TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
       {[](v1::SearchRequest* r) { r->set_max_results(0); }, "max_results"},
       {[](v1::SearchRequest* r) { r->set_max_overlap(2); }, "max_overlap"},
       {[](v1::SearchRequest* r) { r->set_characteristic_frame(5000); }, "characteristic_frame"},
+      {[](v1::SearchRequest* r) {
+         r->add_characteristic_frames(30);
+         r->add_characteristic_frames(20);
+       },
+       "characteristic_frames[1]: 20 does not follow the frame before it, 30"},
+      {[](v1::SearchRequest* r) { r->add_characteristic_frames(5000); },
+       "characteristic_frames[0]: 5000 is outside the query's frames 10..60"},
+      {[](v1::SearchRequest* r) { r->set_characteristic_points(17); }, "characteristic_points"},
+      {[](v1::SearchRequest* r) { r->set_max_point_gap_s(-1); }, "max_point_gap_s"},
       {[](v1::SearchRequest* r) { r->mutable_clip()->set_last_frame(100000); }, "last_frame"},
       {[](v1::SearchRequest* r) { r->mutable_clip()->set_first_frame(-1); }, "first_frame"},
       {[](v1::SearchRequest* r) { r->set_neutral(static_cast<v1::NeutralPose>(9)); }, "neutral"},

@@ -154,6 +154,10 @@ absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
   if (request.has_max_overlap()) params.max_overlap = request.max_overlap();
   params.return_path = request.return_path();
   if (request.has_refine()) params.refine = request.refine();
+  if (request.has_characteristic_points()) {
+    params.characteristic_points = request.characteristic_points();
+  }
+  if (request.has_max_point_gap_s()) params.max_point_gap_s = request.max_point_gap_s();
   params.clip_ids.assign(request.clip_ids().begin(), request.clip_ids().end());
   params.tags.assign(request.tags().begin(), request.tags().end());
   return params;
@@ -205,6 +209,8 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
   if (request.has_characteristic_frame() && request.characteristic_frame() != -1) {
     out.characteristic_frame = request.characteristic_frame();
   }
+  out.characteristic_frames.assign(request.characteristic_frames().begin(),
+                                   request.characteristic_frames().end());
   out.exact = request.exact();
   out.exclude_query = Optional(request.has_exclude_query(), request.exclude_query());
   out.explain = request.explain();
@@ -224,7 +230,9 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
       {search.return_path(), "search.return_path: a propagation keeps no paths"},
       {search.explain(), "search.explain: a propagation keeps no explanations"},
       {search.has_exclude_query(), "search.exclude_query: a query's own range is always excluded"},
-      {search.has_characteristic_frame(), "search.characteristic_frame: each query finds its own"}};
+      {search.has_characteristic_frame(), "search.characteristic_frame: each query finds its own"},
+      {search.characteristic_frames_size() > 0,
+       "search.characteristic_frames: each query finds its own"}};
   for (const auto& [set, message] : refused) {
     if (set) return absl::InvalidArgumentError(message);
   }
@@ -413,6 +421,7 @@ void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
     if (hit.explanation) ToProto(*hit.explanation, out->mutable_explanation());
   }
   response->set_characteristic_frame(outcome.characteristic_frame);
+  for (const int frame : outcome.characteristic_frames) response->add_characteristic_frames(frame);
   const SearchStats& stats = outcome.stats;
   v1::SearchTimings* timings = response->mutable_timings();
   timings->set_characteristic_ms(stats.characteristic_ms);
