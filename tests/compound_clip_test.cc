@@ -3,10 +3,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/bvh/bvh_reader.h"
 #include "core/motion/forward_kinematics.h"
 #include "core/space/heading.h"
 #include "testing/synthetic_corpus.h"
 #include "tests/clip_builder.h"
+#include "tests/test_data.h"
 
 namespace motiondb {
 namespace {
@@ -77,6 +79,24 @@ TEST(ConcatenateWithHold, HoldsTheLastPoseThenPlaysTheSecondClipOnFromWhereTheFi
   for (int f = from + hold + 1; f <= compound.second.first; ++f) {
     EXPECT_NEAR((clip.root_position(f) - clip.root_position(f - 1) - step).norm(), 0, 1e-9) << f;
   }
+}
+
+// Bandai's layout: a still joint_Root above Hips, position channels on every joint. The pelvis
+// (Hips) carries on from where it stopped although the shift goes to joint_Root.
+TEST(ConcatenateWithHold, CarriesThePelvisOnInBandaiTakes) {
+  MOTIONDB_REQUIRE_MOCAP(mocap);
+  const std::filesystem::path folder = mocap / "bandai2-normal";
+  const Clip a =
+      ReadBvhFile((folder / "dataset-2_raise-up-right-hand_normal_001.bvh").string())->clip;
+  const Clip b = ReadBvhFile((folder / "dataset-2_wave-left-hand_normal_001.bvh").string())->clip;
+  ASSERT_EQ(a.skeleton().joint(FindPelvis(a.skeleton())).name, "Hips");
+  const testing::CompoundClip compound = *testing::ConcatenateWithHold(a, b, {1.0, 0.25});
+  const Eigen::Vector3d end = Pelvis(a, a.frame_count() - 1);
+  const Eigen::Vector3d start = Pelvis(compound.clip, compound.second.first);
+  EXPECT_NEAR(start.x(), end.x(), 1e-6);
+  EXPECT_NEAR(start.z(), end.z(), 1e-6);
+  EXPECT_NEAR(start.y(), Pelvis(b, 0).y(), 1e-6);  // the vertical is the second take's own
+  EXPECT_EQ(compound.clip.rotations().bottomRows(b.frame_count()), b.rotations());
 }
 
 TEST(ConcatenateWithHold, ResamplesTheSecondClipToTheFirstsRate) {
