@@ -173,19 +173,6 @@ SearchResult ChainResult(const std::vector<std::vector<SearchResult>>& matches,
   return result;
 }
 
-// The ids of the clips with a chain through `matches` (by `links`), ascending.
-std::vector<int64_t> ChainedClips(const LibraryIndex& library,
-                                  const std::vector<SearchResult>& matches,
-                                  const std::vector<Link>& links) {
-  std::vector<int64_t> ids;
-  for (size_t i = 0; i < matches.size(); ++i) {
-    if (links[i].cost < kInfinity) ids.push_back(library.clip(matches[i].clip_index).clip_id);
-  }
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  return ids;
-}
-
 void AddStageStats(const SearchStats& part, SearchStats& total) {
   total.seeds += part.seeds;
   total.clusters += part.clusters;
@@ -216,11 +203,7 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
   stats.characteristic_frame = anchors.front();
   stats.characteristic_frames = anchors;
 
-  const Chaining chaining{query, library, params.dtw_dims,
-                          std::llround(params.max_point_gap_s * library.rate())};
   std::vector<std::vector<SearchResult>> matches(parts.size());
-  std::vector<std::vector<Link>> links(parts.size());
-  double chaining_ms = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     part_params.characteristic_frame = parts[k].anchor;
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -228,32 +211,26 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
         Search(library, query.middle_rows(parts[k].first, parts[k].rows), part_params));
     AddStageStats(part.stats, stats);
     matches[k] = std::move(part.results);
-    const auto stage = std::chrono::steady_clock::now();
-    if (k == 0) {
-      for (const SearchResult& match : matches[0]) {
-        links[0].push_back({match.score * parts[0].rows, -1, Junction::kJump});
-      }
-    } else {
-      links[k] =
-          LinkPart(chaining, parts[k - 1], matches[k - 1], links[k - 1], parts[k], matches[k]);
-    }
-    // The next part is searched only in the clips where a chain goes on: its seeds are then
-    // spent there, not on its action's instances elsewhere (a part alone matches every
-    // instance of its action, in whatever company), which could crowd a chain's clip out.
-    part_params.clip_ids = ChainedClips(library, matches[k], links[k]);
-    chaining_ms += MillisecondsSince(stage);
-    if (part_params.clip_ids.empty()) break;
   }
 
   const auto stage = std::chrono::steady_clock::now();
+  const Chaining chaining{query, library, params.dtw_dims,
+                          std::llround(params.max_point_gap_s * library.rate())};
+  std::vector<std::vector<Link>> links(parts.size());
+  for (const SearchResult& match : matches[0]) {
+    links[0].push_back({match.score * parts[0].rows, -1, Junction::kJump});
+  }
+  for (size_t k = 1; k < parts.size(); ++k) {
+    links[k] = LinkPart(chaining, parts[k - 1], matches[k - 1], links[k - 1], parts[k], matches[k]);
+  }
   std::vector<SearchResult> candidates;
-  for (size_t i = 0; i < links.back().size(); ++i) {
+  for (size_t i = 0; i < matches.back().size(); ++i) {
     if (links.back()[i].cost == kInfinity) continue;
     candidates.push_back(
         ChainResult(matches, links, parts, static_cast<int>(i), query.rows, params.return_path));
   }
   response.results = FinishResults(library, std::move(candidates), params);
-  stats.ranking_ms += chaining_ms + MillisecondsSince(stage);
+  stats.ranking_ms += MillisecondsSince(stage);
   stats.total_ms = MillisecondsSince(start);
   return response;
 }
