@@ -208,22 +208,33 @@ double RecallAtTen(const Run& fast, const Run& exact) {
   return total > 0 ? static_cast<double>(found) / total : 0.0;
 }
 
+// The fast search's variants measured beside its defaults (the flags of the same names).
+struct VariantFlags {
+  std::vector<int> places;
+  std::vector<int> neighbours;
+  std::vector<int> points;  // characteristic points (0: by the query's length)
+};
+
 // The fast search as configured by default (the thesis's seeds, refined), without
-// refinement, with the --neighbours values, and with distinct places as seeds: 128 of them and
-// the --places values.
-std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int>& compare,
-                                                           const std::vector<int>& neighbours) {
+// refinement, with the --neighbours values, with the --points values, and with distinct places
+// as seeds: 128 of them and the --places values.
+std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& flags) {
   SearchParams unrefined;
   unrefined.refine = false;
   std::vector<std::pair<std::string, SearchParams>> variants = {{"fast", {}},
                                                                 {"fast, no refinement", unrefined}};
-  for (int count : neighbours) {
+  for (int count : flags.neighbours) {
     SearchParams params;
     params.neighbours = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " neighbours"), params);
   }
+  for (int count : flags.points) {
+    SearchParams params;
+    params.characteristic_points = count;
+    variants.emplace_back(absl::StrCat("fast, ", count, " characteristic points"), params);
+  }
   std::vector<int> places = {SearchParams().places};
-  places.insert(places.end(), compare.begin(), compare.end());
+  places.insert(places.end(), flags.places.begin(), flags.places.end());
   for (int count : places) {
     SearchParams params;
     params.seed_selection = SeedSelection::kDistinctPlaces;
@@ -234,8 +245,7 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const std::vector<int
 }
 
 absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
-                      int exact_queries, const std::vector<int>& compare,
-                      const std::vector<int>& neighbours, bool real = false) {
+                      int exact_queries, const VariantFlags& variant_flags, bool real = false) {
   MOTIONDB_ASSIGN_OR_RETURN(const Bench bench, real ? PrepareReal(duration_s, queries)
                                                     : Prepare(duration_s, rate, 16, queries));
   const LibraryIndex& library = *bench.library;
@@ -269,7 +279,7 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
              a[i].last_frame == b[i].last_frame && a[i].score == b[i].score;
     }
   }
-  for (const auto& [label, params] : Variants(compare, neighbours)) {
+  for (const auto& [label, params] : Variants(variant_flags)) {
     MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
     std::printf(
         "%s: p50 %.3f ms  p99 %.3f ms  | seeds %.3f clusters %.3f warps %.3f refine %.3f "
@@ -325,25 +335,24 @@ absl::Status Sweeps(int queries) {
   return absl::OkStatus();
 }
 
-absl::Status Main(const std::string& scenario, int q, int e, const std::vector<int>& p,
-                  const std::vector<int>& n) {
+absl::Status Main(const std::string& scenario, int q, int e, const VariantFlags& v) {
   const auto wants = [&](const char* name) { return scenario == "all" || scenario == name; };
-  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e, p, n));
-  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e, p, n));
-  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e, p, n));
-  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e, p, n));
+  if (wants("70s120")) MOTIONDB_RETURN_IF_ERROR(Scenario("70 s at 120 Hz", 70, 120, q, e, v));
+  if (wants("1h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("1 h at 30 Hz", 3600, 30, q, e, v));
+  if (wants("10h30")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz", 36000, 30, q, e, v));
+  if (wants("10h120")) MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 120 Hz", 36000, 120, q, e, v));
   // Not in "all": it needs ../shared/mocap and takes minutes.
   if (scenario == "real10h30") {
     if (!std::filesystem::is_directory(MocapRoot() / "bandai1")) {
       std::printf("search_latency: %s is absent; real10h30 not measured\n", MocapRoot().c_str());
     } else {
       MOTIONDB_RETURN_IF_ERROR(Scenario("10 h at 30 Hz of real capture and perturbed copies", 36000,
-                                        30, q, e, p, n, /*real=*/true));
+                                        30, q, e, v, /*real=*/true));
     }
   }
   // Not in "all": it takes minutes and about 3 GB.
   if (scenario == "100h30") {
-    MOTIONDB_RETURN_IF_ERROR(Scenario("100 h at 30 Hz", 360000, 30, q, e, p, n));
+    MOTIONDB_RETURN_IF_ERROR(Scenario("100 h at 30 Hz", 360000, 30, q, e, v));
   }
   if (wants("sweeps")) MOTIONDB_RETURN_IF_ERROR(Sweeps(q));
   return absl::OkStatus();
@@ -369,20 +378,24 @@ int main(int argc, char** argv) {
       ->type_name("N")
       ->capture_default_str()
       ->check(motiondb::cli::WholeAtLeast(0));
-  std::vector<int> places;
-  app.add_option("--places", places, "also measure the fast search with these numbers of places")
+  motiondb::VariantFlags variants;
+  app.add_option("--places", variants.places,
+                 "also measure the fast search with these numbers of places")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
-  std::vector<int> neighbour_counts;
-  app.add_option("--neighbours", neighbour_counts,
+  app.add_option("--neighbours", variants.neighbours,
                  "also measure the fast search with these numbers of nearest-frame seeds")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--points", variants.points,
+                 "also measure the fast search with these numbers of characteristic points (0: "
+                 "one per 3 s of query)")
+      ->type_name("K ...")
+      ->check(motiondb::cli::WholeAtLeast(0));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
-  const absl::Status status =
-      motiondb::Main(scenario, queries, exact_queries, places, neighbour_counts);
+  const absl::Status status = motiondb::Main(scenario, queries, exact_queries, variants);
   if (!status.ok()) {
     std::fprintf(stderr, "search_latency: %s\n", std::string(status.message()).c_str());
     return 1;

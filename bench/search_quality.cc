@@ -10,7 +10,7 @@
 //          [--weights mass|uniform]
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
-//          [--no-refine]
+//          [--no-refine] [--points K]
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -74,6 +74,8 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
         {"--ann-dims", &params.ann_dims, "seed search dimensions", 1},
         {"--dtw-dims", &params.dtw_dims, "time-warp dimensions", 1},
         {"--slope", &params.slope_limit, "the warp's slope limit", 1},
+        {"--points", &params.characteristic_points,
+         "characteristic points per query (0: one per 3 s of query)", 0},
         {"--exact-every", &flags->retrieval.exact_every,
          "run the exact search on every N-th query (0: never)", 0}}) {
     app.add_option(name, *field, what)
