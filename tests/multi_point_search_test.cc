@@ -127,21 +127,26 @@ TEST_F(MultiPointSearchTest, RanksEveryAThenBAboveEveryOtherKind) {
 }
 
 TEST_F(MultiPointSearchTest, AResultsPathCoversTheQueryInOrderAndGivesItsScore) {
-  SearchParams params = Params();
-  params.characteristic_points = 2;
-  const absl::StatusOr<SearchResponse> response = Search(*library_, query(), params);
-  ASSERT_TRUE(response.ok()) << response.status();
-  for (const SearchResult& r : response->results) {
-    ASSERT_EQ(static_cast<int64_t>(r.path.size()), query_.rows());
-    EXPECT_TRUE(std::is_sorted(r.path.begin(), r.path.end()));
-    EXPECT_EQ(r.path.front(), r.first_frame);
-    EXPECT_EQ(r.path.back(), r.last_frame);
-    const CoordinateView clip = library_->clip_coordinates(r.clip_index);
-    double sum = 0;
-    for (int64_t i = 0; i < query_.rows(); ++i) {
-      sum += Distance(query_.row(i).data(), clip.row(r.path[i]), kDims);
+  // Two points found; points whose parts overlap in the clip; a part of one frame (a pose).
+  for (const std::vector<int>& frames : {std::vector<int>{}, {44, 50, 84}, {0, 1, 84}}) {
+    SearchParams params = Params();
+    params.characteristic_points = 2;
+    params.characteristic_frames = frames;
+    const absl::StatusOr<SearchResponse> response = Search(*library_, query(), params);
+    ASSERT_TRUE(response.ok()) << response.status();
+    ASSERT_FALSE(response->results.empty());
+    for (const SearchResult& r : response->results) {
+      ASSERT_EQ(static_cast<int64_t>(r.path.size()), query_.rows());
+      EXPECT_TRUE(std::is_sorted(r.path.begin(), r.path.end()));
+      EXPECT_EQ(r.path.front(), r.first_frame);
+      EXPECT_EQ(r.path.back(), r.last_frame);
+      const CoordinateView clip = library_->clip_coordinates(r.clip_index);
+      double sum = 0;
+      for (int64_t i = 0; i < query_.rows(); ++i) {
+        sum += Distance(query_.row(i).data(), clip.row(r.path[i]), kDims);
+      }
+      EXPECT_NEAR(r.score, sum / static_cast<double>(query_.rows()), 1e-4);
     }
-    EXPECT_NEAR(r.score, sum / static_cast<double>(query_.rows()), 1e-4);
   }
 }
 

@@ -42,17 +42,14 @@ std::vector<Part> QueryParts(int64_t rows, const std::vector<int>& anchors) {
   return parts;
 }
 
-// Where two adjacent parts' matches meet: the path may jump forward there (a pause held longer
-// in the clip than in the query), or pause (held longer in the query), either part's end giving
-// way up to its anchor: the earlier part's rows matched past `next_first` are moved back to it,
-// or the later part's rows matched before `previous_last` forward to it, whichever costs less.
-enum class Junction { kJump, kHoldPrevious, kHoldNext };
-
 // The best chain of matches of parts 0..k that ends in one match of part k.
 struct Link {
   double cost = kInfinity;  // sum of pose distances over the chain's query rows
   int previous = -1;        // the chain's match of part k - 1
-  Junction junction = Junction::kJump;
+  // Where the chain's matches of parts k - 1 and k meet when they overlap: the clip frame that
+  // the earlier one's rows matched past it and the later one's rows matched before it are moved
+  // to (a pause at the junction); -1 when they do not overlap (the path jumps forward there).
+  int64_t meet = -1;
 };
 
 // What the links need to price a junction: the query, the library, the warp's dimensions.
@@ -79,23 +76,28 @@ double ClampCost(const Chaining& chaining, const SearchResult& match, int first,
   return change;
 }
 
-// The cheapest junction from `previous` (part rows from `previous_first`) to `next` (from
-// `next_first`), and its change in cost; nullopt when they cannot join: a jump beyond the gap,
-// or an overlap that would move either anchor.
-std::optional<std::pair<Junction, double>> Join(const Chaining& chaining,
-                                                const SearchResult& previous, int previous_first,
-                                                const SearchResult& next, int next_first) {
+// Where adjacent parts' matches join, and the change in cost: nothing when the later one
+// starts after the earlier one ends, at most max_gap later (a pause held longer in the clip than
+// in the query is skipped); when they overlap, a frame between their anchors where the path
+// pauses instead (held longer in the query): the cheapest of the later one's start, the earlier
+// one's end and the middle between the anchors, of those that lie between them. nullopt: no
+// join (a gap beyond max_gap, or the anchors out of order).
+std::optional<std::pair<int64_t, double>> Join(const Chaining& chaining,
+                                               const SearchResult& previous, int previous_first,
+                                               const SearchResult& next, int next_first) {
   const int64_t gap = next.first_frame - previous.last_frame;
   if (gap > chaining.max_gap) return std::nullopt;
-  if (gap >= 0) return std::pair{Junction::kJump, 0.0};
-  if (next.first_frame < previous.seed_frame || previous.last_frame > next.seed_frame) {
-    return std::nullopt;
+  if (gap >= 0) return std::pair<int64_t, double>{-1, 0.0};
+  if (previous.seed_frame > next.seed_frame) return std::nullopt;
+  std::optional<std::pair<int64_t, double>> best;
+  for (const int64_t meet :
+       {next.first_frame, previous.last_frame, (previous.seed_frame + next.seed_frame) / 2}) {
+    if (meet < previous.seed_frame || meet > next.seed_frame) continue;
+    const double change = ClampCost(chaining, previous, previous_first, false, meet) +
+                          ClampCost(chaining, next, next_first, true, meet);
+    if (!best || change < best->second) best = {meet, change};
   }
-  const double hold_previous =
-      ClampCost(chaining, previous, previous_first, false, next.first_frame);
-  const double hold_next = ClampCost(chaining, next, next_first, true, previous.last_frame);
-  return hold_previous <= hold_next ? std::pair{Junction::kHoldPrevious, hold_previous}
-                                    : std::pair{Junction::kHoldNext, hold_next};
+  return best;
 }
 
 // Links of part k's `matches` onto the chains of part k - 1.
@@ -146,28 +148,14 @@ SearchResult ChainResult(const std::vector<std::vector<SearchResult>>& matches,
   result.path.reserve(query_rows);
   for (size_t k = 0; k < parts.size(); ++k) {
     const SearchResult& match = matches[k][chain[k]];
-    // A part of one frame is a pose query: its match is that frame, with no path.
     const size_t from = result.path.size();
-    if (parts[k].rows == 1) {
-      result.path.push_back(match.first_frame);
-    } else {
-      result.path.insert(result.path.end(), match.path.begin(), match.path.end());
-    }
+    result.path.insert(result.path.end(), match.path.begin(), match.path.end());
     if (k == 0) continue;
-    const int64_t previous_last = matches[k - 1][chain[k - 1]].last_frame;
-    switch (links[k][chain[k]].junction) {
-      case Junction::kJump:
-        break;
-      case Junction::kHoldPrevious:
-        for (size_t r = 0; r < from; ++r) {
-          result.path[r] = std::min(result.path[r], match.first_frame);
-        }
-        break;
-      case Junction::kHoldNext:
-        for (size_t r = from; r < result.path.size(); ++r) {
-          result.path[r] = std::max(result.path[r], previous_last);
-        }
-        break;
+    const int64_t meet = links[k][chain[k]].meet;
+    if (meet < 0) continue;
+    for (size_t r = 0; r < from; ++r) result.path[r] = std::min(result.path[r], meet);
+    for (size_t r = from; r < result.path.size(); ++r) {
+      result.path[r] = std::max(result.path[r], meet);
     }
   }
   return result;
@@ -211,6 +199,10 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
         Search(library, query.middle_rows(parts[k].first, parts[k].rows), part_params));
     AddStageStats(part.stats, stats);
     matches[k] = std::move(part.results);
+    // A part of one frame is a pose query, whose matches are one frame with no path.
+    for (SearchResult& match : matches[k]) {
+      if (match.path.empty()) match.path = {match.first_frame};
+    }
   }
 
   const auto stage = std::chrono::steady_clock::now();
@@ -218,7 +210,7 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
                           std::llround(params.max_point_gap_s * library.rate())};
   std::vector<std::vector<Link>> links(parts.size());
   for (const SearchResult& match : matches[0]) {
-    links[0].push_back({match.score * parts[0].rows, -1, Junction::kJump});
+    links[0].push_back({match.score * parts[0].rows, -1, -1});
   }
   for (size_t k = 1; k < parts.size(); ++k) {
     links[k] = LinkPart(chaining, parts[k - 1], matches[k - 1], links[k - 1], parts[k], matches[k]);
