@@ -187,13 +187,25 @@ TEST_F(MultiPointSearchTest, GivenFramesAreTheAnchors) {
   EXPECT_EQ(PrecisionAt5(*response), 1.0);
 }
 
-TEST_F(MultiPointSearchTest, PointsByTheQuerysLength) {
+TEST_F(MultiPointSearchTest, PointsFoundOnePerAction) {
   SearchParams params = Params();
   params.characteristic_points = 0;
-  // 129 frames: 4.3 s at 30 Hz, 12.9 s at 10 Hz; one point per kSecondsPerCharacteristicPoint
-  // (3 s), at least one.
-  EXPECT_EQ(CharacteristicFrames(query(), kRate, params).size(), 1u);
-  EXPECT_EQ(CharacteristicFrames(query(), 10.0, params).size(), 4u);
+  // A, a 0.3 s pause, B: two actions, each point at its peak.
+  const std::vector<int> two = CharacteristicFrames(query(), kRate, params);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_NEAR(two[0], 30 + 14.5, 2);
+  EXPECT_NEAR(two[1], 69 + 14.5, 2);
+  // The same frames read at 10 Hz: a pause of 0.9 s, still two actions.
+  EXPECT_EQ(CharacteristicFrames(query(), 10.0, params).size(), 2u);
+  // Read at 120 Hz the dip (about 20 frames below the threshold) lasts under 0.2 s, shorter
+  // than a pause between actions: one.
+  EXPECT_EQ(CharacteristicFrames(query(), 120.0, params).size(), 1u);
+  // One action, and two with a long pause.
+  const RowMatrixXf one = Compound({kB}, 0, 3);
+  EXPECT_EQ(CharacteristicFrames(CoordinateView::Of(one), kRate, params).size(), 1u);
+  const RowMatrixXf apart = Compound({kA, kC}, 5.0, 3);
+  EXPECT_EQ(CharacteristicFrames(CoordinateView::Of(apart), kRate, params).size(), 2u);
+  // A frame given wins.
   params.characteristic_frame = 40;
   EXPECT_THAT(CharacteristicFrames(query(), kRate, params), ElementsAre(40));
 }

@@ -58,17 +58,58 @@ std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, Neutra
   return frames;
 }
 
+std::vector<int> FindActionFrames(CoordinateView query, int dims, NeutralPose neutral,
+                                  double rate) {
+  const std::vector<double> centre = NeutralCentre(query, dims, neutral);
+  std::vector<double> distance(query.rows);
+  for (int64_t f = 0; f < query.rows; ++f) {
+    double sum = 0.0;
+    for (int k = 0; k < dims; ++k) {
+      const double d = query.row(f)[k] - centre[k];
+      sum += d * d;
+    }
+    distance[f] = std::sqrt(sum);
+  }
+  const double threshold = kActionThreshold * *std::max_element(distance.begin(), distance.end());
+  const int64_t min_pause = std::max<int64_t>(1, std::llround(kMinActionPauseS * rate));
+  // Runs of frames beyond the threshold, joined across dips shorter than min_pause: one action
+  // each, represented by its farthest frame.
+  struct Action {
+    int64_t last = -1;  // the run's last frame beyond the threshold
+    int peak = 0;
+  };
+  std::vector<Action> actions;
+  for (int64_t f = 0; f < query.rows; ++f) {
+    if (distance[f] <= threshold) continue;
+    if (actions.empty() || f - actions.back().last > min_pause) {
+      actions.push_back({f, static_cast<int>(f)});
+    }
+    Action& action = actions.back();
+    action.last = f;
+    if (distance[f] > distance[action.peak]) action.peak = static_cast<int>(f);
+  }
+  // The most prominent, if there are more than a query may have.
+  if (actions.size() > kMaxCharacteristicPoints) {
+    std::sort(actions.begin(), actions.end(), [&](const Action& a, const Action& b) {
+      return distance[a.peak] > distance[b.peak];
+    });
+    actions.resize(kMaxCharacteristicPoints);
+  }
+  std::vector<int> frames;
+  for (const Action& action : actions) frames.push_back(action.peak);
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
 std::vector<int> CharacteristicFrames(CoordinateView query, double rate,
                                       const SearchParams& params) {
   if (!params.characteristic_frames.empty()) return params.characteristic_frames;
   if (params.characteristic_frame >= 0) return {params.characteristic_frame};
-  int count = params.characteristic_points;
-  if (count == 0) {
-    const double seconds = static_cast<double>(query.rows) / rate;
-    count = std::clamp(static_cast<int>(seconds / kSecondsPerCharacteristicPoint), 1,
-                       kMaxCharacteristicPoints);
+  if (params.characteristic_points == 0) {
+    return FindActionFrames(query, params.ann_dims, params.neutral, rate);
   }
-  return FindCharacteristicFrames(query, params.ann_dims, params.neutral, count);
+  return FindCharacteristicFrames(query, params.ann_dims, params.neutral,
+                                  params.characteristic_points);
 }
 
 }  // namespace motiondb

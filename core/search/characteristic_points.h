@@ -10,9 +10,11 @@
 
 namespace motiondb {
 
-// Query seconds per characteristic point when SearchParams::characteristic_points is 0. A query
-// of under twice this keeps the thesis's one point.
-inline constexpr double kSecondsPerCharacteristicPoint = 3.0;
+// The actions of a query (SearchParams::characteristic_points 0) are its runs of poses farther
+// from the neutral pose than this share of the farthest, joined across shorter dips than
+// kMinActionPauseS (a stride's or a wave's turn), the shortest pause between two actions.
+inline constexpr double kActionThreshold = 0.35;
+inline constexpr double kMinActionPauseS = 0.3;
 
 // The query frame farthest, over the first `dims` coordinates, from the neutral pose.
 int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral);
@@ -22,10 +24,14 @@ int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral)
 std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, NeutralPose neutral,
                                           int count);
 
+// One frame per action of the query, its farthest from the neutral pose (see kActionThreshold),
+// increasing; at most kMaxCharacteristicPoints, the farthest kept. `rate`: the query's frames
+// per second.
+std::vector<int> FindActionFrames(CoordinateView query, int dims, NeutralPose neutral, double rate);
+
 // The frames a search anchors at by SearchParams' rules: characteristic_frames, else
-// characteristic_frame, else characteristic_points found (0: one per
-// kSecondsPerCharacteristicPoint at `rate`, the query's frames per second). Assumes the
-// parameters passed PrepareQuery's checks.
+// characteristic_frame, else characteristic_points found (0: one per action,
+// FindActionFrames). Assumes the parameters passed PrepareQuery's checks.
 std::vector<int> CharacteristicFrames(CoordinateView query, double rate,
                                       const SearchParams& params);
 
