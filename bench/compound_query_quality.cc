@@ -6,8 +6,8 @@
 // with holds of 0.3 and 1 s (and 5 s, reported apart). Each query ranks the whole library
 // (max_results = its clip count; a clip's best result stands for it) with
 //   one:     SearchParams::characteristic_points = 1 (the default),
-//   several: characteristic_points = the case's action count (or --points; --by-length: 0, one
-//            point per kSecondsPerCharacteristicPoint of query), found,
+//   several: characteristic_points = the case's action count (or --points; --found: 0, the
+//            engine's own rule, one point per action it finds), found,
 //   given:   characteristic_frames = the middle frame of each action (where a user marking the
 //            actions would put them).
 // Reported: precision at N (N = true instances in the library), the margin (score of the
@@ -21,7 +21,7 @@
 // one skeleton: clips grouped by identical bone lengths, the largest group used).
 //
 // usage: compound_query_quality [--source synthetic|real]... [--case NAME]... [--instances N]
-//          [--queries N] [--points K] [--seed S] [--folder DIR] [--neighbours K] [--by-length]
+//          [--queries N] [--points K] [--seed S] [--folder DIR] [--neighbours K] [--found]
 //          [--verbose]
 #include <algorithm>
 #include <cmath>
@@ -59,9 +59,9 @@ struct Flags {
   int points = 0;  // 0: the case's action count
   uint64_t seed = 1;
   std::string folder = (bench::MocapRoot() / "bandai2-normal").string();
-  bool verbose = false;    // print every ranking
-  int neighbours = 0;      // SearchParams::neighbours (0: by the library's size)
-  bool by_length = false;  // several: characteristic_points = 0, the engine's rule by length
+  bool verbose = false;  // print every ranking
+  int neighbours = 0;    // SearchParams::neighbours (0: by the library's size)
+  bool found = false;    // several: characteristic_points = 0, the engine's rule (one per action)
 };
 
 // A case: its actions (A, B, C), the kinds of clip in its library (the first is the true kind,
@@ -349,7 +349,7 @@ absl::Status RunCase(const Case& c, const Flags& flags, const InstanceSource& so
       "several = %s. True kind %s, N = %d.\n\n",
       library->clip_count(), flags.instances, absl::StrJoin(kinds, ", ").c_str(), library_s,
       absl::StrJoin(c.holds, ", ").c_str(), bench::SecondsSince(start),
-      flags.by_length ? "one point per 3 s of query" : absl::StrCat(points, " points").c_str(),
+      flags.found ? "one point per action found" : absl::StrCat(points, " points").c_str(),
       true_kind.c_str(), flags.instances);
   std::printf(
       "| query | hold s | one P@N | one margin | several P@N | several margin | several points "
@@ -367,7 +367,7 @@ absl::Status RunCase(const Case& c, const Flags& flags, const InstanceSource& so
     params.neighbours = flags.neighbours;
     std::string line = absl::StrFormat("| q%d | %.1f |", q, hold);
     for (const std::string& config : kConfigs) {
-      params.characteristic_points = config != "several" ? 1 : flags.by_length ? 0 : points;
+      params.characteristic_points = config != "several" ? 1 : flags.found ? 0 : points;
       params.characteristic_frames.clear();
       if (flags.verbose) std::printf("  q%d %s\n", q, config.c_str());
       if (config == "given") {
@@ -486,8 +486,8 @@ int main(int argc, char** argv) {
   app.add_option("--neighbours", flags.neighbours, "seeds of every search (0: by library size)")
       ->capture_default_str()
       ->check(motiondb::cli::WholeAtLeast(0));
-  app.add_flag("--by-length", flags.by_length,
-               "several: characteristic_points = 0 (one point per 3 s of query)");
+  app.add_flag("--found", flags.found,
+               "several: characteristic_points = 0 (the engine finds one point per action)");
   app.add_flag("--verbose", flags.verbose, "print every ranking");
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;

@@ -389,7 +389,7 @@ int main(int argc, char** argv) {
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,
                  "also measure the fast search with these numbers of characteristic points (0: "
-                 "one per 3 s of query)")
+                 "one per action of the query)")
       ->type_name("K ...")
       ->check(motiondb::cli::WholeAtLeast(0));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {

@@ -75,7 +75,7 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
         {"--dtw-dims", &params.dtw_dims, "time-warp dimensions", 1},
         {"--slope", &params.slope_limit, "the warp's slope limit", 1},
         {"--points", &params.characteristic_points,
-         "characteristic points per query (0: one per 3 s of query)", 0},
+         "characteristic points per query (0: one per action of the query)", 0},
         {"--exact-every", &flags->retrieval.exact_every,
          "run the exact search on every N-th query (0: never)", 0}}) {
     app.add_option(name, *field, what)

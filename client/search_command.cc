@@ -66,7 +66,7 @@ constexpr Parameter kParameters[] = {
      &v1::SearchRequest::set_max_results},
     {"--points", "characteristic_points", "K", "1",
      "characteristic points found, one in each K-th of the query, each anchoring its part "
-     "(0: one per 3 s of query)",
+     "(0: one per action of the query)",
      &SearchFlags::points, &v1::SearchRequest::set_characteristic_points, 0},
 };
 

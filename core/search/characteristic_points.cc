@@ -58,9 +58,8 @@ std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, Neutra
   return frames;
 }
 
-std::vector<int> FindActionFrames(CoordinateView query, int dims, NeutralPose neutral,
-                                  double rate) {
-  const std::vector<double> centre = NeutralCentre(query, dims, neutral);
+std::vector<int> FindActionFrames(CoordinateView query, int dims, double rate) {
+  const std::vector<double> centre = NeutralCentre(query, dims, NeutralPose::kBoundaryMean);
   std::vector<double> distance(query.rows);
   for (int64_t f = 0; f < query.rows; ++f) {
     double sum = 0.0;
@@ -106,7 +105,7 @@ std::vector<int> CharacteristicFrames(CoordinateView query, double rate,
   if (!params.characteristic_frames.empty()) return params.characteristic_frames;
   if (params.characteristic_frame >= 0) return {params.characteristic_frame};
   if (params.characteristic_points == 0) {
-    return FindActionFrames(query, params.ann_dims, params.neutral, rate);
+    return FindActionFrames(query, params.ann_dims, rate);
   }
   return FindCharacteristicFrames(query, params.ann_dims, params.neutral,
                                   params.characteristic_points);

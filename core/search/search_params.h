@@ -68,7 +68,7 @@ struct SearchParams {
   std::vector<int> characteristic_frames;
   // With neither characteristic_frame nor characteristic_frames: the points found, one the pose
   // farthest from `neutral` in each of as many equal parts of the query; 1 is the thesis's one
-  // point; 0 takes one per kSecondsPerCharacteristicPoint of query.
+  // point; 0 takes one per action of the query (characteristic_points.h, FindActionFrames).
   int characteristic_points = 1;
   // Several points: the most time, in seconds, between the library frames matched to the end
   // of one part and to the start of the next (a held pose longer than the query's is absorbed
