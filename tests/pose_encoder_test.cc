@@ -46,7 +46,7 @@ TEST(PoseEncoderTest, BatchedLogMapMatchesTheScalarOne) {
     reference_rows.row(j) << references[j].w(), references[j].x(), references[j].y(),
         references[j].z();
   }
-  PoseRotations pose{RowMatrixXd(probes.size(), 12), Eigen::VectorXd()};
+  PoseRotations pose{RowMatrixXd(probes.size(), 12), Eigen::VectorXd(), RowMatrixXd()};
   for (size_t f = 0; f < probes.size(); ++f) {
     for (int j = 0; j < 3; ++j) {
       const Quat q = references[j] * probes[(f + 13 * j) % probes.size()];
