@@ -174,8 +174,17 @@ TEST_F(MultiPointSearchTest, APauseLongerThanTheGapBreaksTheChain) {
   ASSERT_FALSE(response->results.empty());
   EXPECT_EQ(response->results[0].clip_id, 1);  // the query's own 0.3 s hold
   for (const SearchResult& r : response->results) {
-    EXPECT_LE(LargestStep(r), 15) << r.clip_name << " " << r.clip_id;  // 0.5 s at 30 Hz
+    // 0.5 s at 30 Hz skipped: a step of 16 frames.
+    EXPECT_LE(LargestStep(r), 16) << r.clip_name << " " << r.clip_id;
   }
+
+  // No gap at all still chains parts whose matches follow one another.
+  params.max_point_gap_s = 0;
+  response = Search(*library_, query(), params);
+  ASSERT_TRUE(response.ok()) << response.status();
+  ASSERT_FALSE(response->results.empty());
+  EXPECT_EQ(response->results[0].clip_id, 1);
+  for (const SearchResult& r : response->results) EXPECT_LE(LargestStep(r), 2);
 }
 
 TEST_F(MultiPointSearchTest, GivenFramesAreTheAnchors) {
@@ -205,6 +214,11 @@ TEST_F(MultiPointSearchTest, PointsFoundOnePerAction) {
   EXPECT_EQ(CharacteristicFrames(CoordinateView::Of(one), kRate, params).size(), 1u);
   const RowMatrixXf apart = Compound({kA, kC}, 5.0, 3);
   EXPECT_EQ(CharacteristicFrames(CoordinateView::Of(apart), kRate, params).size(), 2u);
+  // A query that never moves has no action: one point, and the search answers.
+  const RowMatrixXf still = RowMatrixXf::Zero(60, kDims);
+  EXPECT_EQ(CharacteristicFrames(CoordinateView::Of(still), kRate, params).size(), 1u);
+  const absl::StatusOr<SearchResponse> found = Search(*library_, CoordinateView::Of(still), params);
+  EXPECT_TRUE(found.ok()) << found.status();
   // A frame given wins.
   params.characteristic_frame = 40;
   EXPECT_THAT(CharacteristicFrames(query(), kRate, params), ElementsAre(40));

@@ -94,6 +94,8 @@ std::vector<int> FindActionFrames(CoordinateView query, int dims, double rate) {
     });
     actions.resize(kMaxCharacteristicPoints);
   }
+  // A query that never leaves its ends' pose has no action: its one point, as the thesis finds it.
+  if (actions.empty()) return {FarthestFrame(query, centre, 0, query.rows)};
   std::vector<int> frames;
   for (const Action& action : actions) frames.push_back(action.peak);
   std::sort(frames.begin(), frames.end());

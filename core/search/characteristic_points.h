@@ -29,8 +29,9 @@ std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, Neutra
                                           int count);
 
 // One frame per action of the query (see kActionThreshold), its farthest from the first and
-// last poses' mean, increasing; at most kMaxCharacteristicPoints, the farthest kept. `rate`:
-// the query's frames per second.
+// last poses' mean, increasing; at most kMaxCharacteristicPoints, the farthest kept, and at
+// least one (a query without an action: its first frame). `rate`: the query's frames per
+// second.
 std::vector<int> FindActionFrames(CoordinateView query, int dims, double rate);
 
 // The frames a search anchors at by SearchParams' rules: characteristic_frames, else

@@ -163,7 +163,14 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
   Clock::time_point stage = Clock::now();
   const std::vector<int> anchors = CharacteristicFrames(query, library.rate(), params);
-  if (anchors.size() > 1) return MultiPointSearch(library, query, anchors, params);
+  if (anchors.size() > 1) {
+    const double characteristic_ms = MillisecondsSince(stage);
+    MOTIONDB_ASSIGN_OR_RETURN(SearchResponse response,
+                              MultiPointSearch(library, query, anchors, params));
+    response.stats.characteristic_ms += characteristic_ms;
+    response.stats.total_ms = MillisecondsSince(start);
+    return response;
+  }
   SearchResponse response;
   SearchStats& stats = response.stats;
   const int anchor = anchors.front();

@@ -86,7 +86,7 @@ std::optional<std::pair<int64_t, double>> Join(const Chaining& chaining,
                                                const SearchResult& previous, int previous_first,
                                                const SearchResult& next, int next_first) {
   const int64_t gap = next.first_frame - previous.last_frame;
-  if (gap > chaining.max_gap) return std::nullopt;
+  if (gap - 1 > chaining.max_gap) return std::nullopt;  // gap - 1 frames skipped
   if (gap >= 0) return std::pair<int64_t, double>{-1, 0.0};
   if (previous.seed_frame > next.seed_frame) return std::nullopt;
   std::optional<std::pair<int64_t, double>> best;
@@ -116,7 +116,7 @@ std::vector<Link> LinkPart(const Chaining& chaining, const Part& previous_part,
     if (clip == previous_by_clip.end()) continue;
     const double own = match.score * part.rows;
     for (const int j : clip->second) {
-      if (previous_links[j].cost + own >= links[i].cost) continue;
+      // No pruning on the previous chain's cost alone: a pause at the junction can lower it.
       const auto join = Join(chaining, previous[j], previous_part.first, match, part.first);
       if (!join) continue;
       const double cost = previous_links[j].cost + own + join->second;

@@ -20,7 +20,9 @@
 
 namespace motiondb {
 
-// Search() through `anchors` (two or more increasing query frames). Thread-safe, as Search().
+// Search() through `anchors` (two or more increasing query frames); Search() calls it when a
+// query has several points, after checking the query and the parameters (PrepareQuery), which
+// it assumes. Thread-safe, as Search().
 absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, CoordinateView query,
                                                 const std::vector<int>& anchors,
                                                 const SearchParams& params);

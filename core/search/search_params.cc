@@ -50,7 +50,7 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   }
   if (params.characteristic_points < 0 || params.characteristic_points > kMaxCharacteristicPoints) {
     return OutOfRange("characteristic_points", params.characteristic_points,
-                      absl::StrCat("0..", kMaxCharacteristicPoints, " (0: by the query's length)"));
+                      absl::StrCat("0..", kMaxCharacteristicPoints, " (0: one per action)"));
   }
   if (params.characteristic_frames.size() > kMaxCharacteristicPoints) {
     return absl::InvalidArgumentError(absl::StrCat("characteristic_frames has ",

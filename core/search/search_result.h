@@ -19,8 +19,8 @@ struct SearchResult {
   double start_s = 0;
   double end_s = 0;
   double score = 0;  // mean pose distance along the warp; lower is better
-  // The clip frame matched to the characteristic query frame: the seed the warp was anchored
-  // at, or where refinement moved it (-1 in exact mode).
+  // The clip frame matched to the characteristic query frame (the first of several): the seed
+  // the warp was anchored at, or where refinement moved it (-1 in exact mode).
   int64_t seed_frame = -1;
   std::vector<int64_t> path;  // clip frame per query frame, when requested
 };
