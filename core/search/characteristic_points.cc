@@ -21,17 +21,23 @@ std::vector<double> NeutralCentre(CoordinateView query, int dims, NeutralPose ne
   return centre;
 }
 
+// The squared distance of query frame `f` from `centre` over the centre's dimensions.
+double SquaredDistance(CoordinateView query, int64_t f, const std::vector<double>& centre) {
+  double sum = 0.0;
+  for (size_t k = 0; k < centre.size(); ++k) {
+    const double d = query.row(f)[k] - centre[k];
+    sum += d * d;
+  }
+  return sum;
+}
+
 // The frame of [first, end) farthest from `centre` (the first of equals).
 int FarthestFrame(CoordinateView query, const std::vector<double>& centre, int64_t first,
                   int64_t end) {
   int best = static_cast<int>(first);
   double best_distance = -1.0;
   for (int64_t f = first; f < end; ++f) {
-    double sum = 0.0;
-    for (size_t k = 0; k < centre.size(); ++k) {
-      const double d = query.row(f)[k] - centre[k];
-      sum += d * d;
-    }
+    const double sum = SquaredDistance(query, f, centre);
     if (sum > best_distance) {
       best_distance = sum;
       best = static_cast<int>(f);
@@ -61,14 +67,8 @@ std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, Neutra
 std::vector<int> FindActionFrames(CoordinateView query, int dims, double rate) {
   const std::vector<double> centre = NeutralCentre(query, dims, NeutralPose::kBoundaryMean);
   std::vector<double> distance(query.rows);
-  for (int64_t f = 0; f < query.rows; ++f) {
-    double sum = 0.0;
-    for (int k = 0; k < dims; ++k) {
-      const double d = query.row(f)[k] - centre[k];
-      sum += d * d;
-    }
-    distance[f] = std::sqrt(sum);
-  }
+  for (int64_t f = 0; f < query.rows; ++f)
+    distance[f] = std::sqrt(SquaredDistance(query, f, centre));
   const double threshold = kActionThreshold * *std::max_element(distance.begin(), distance.end());
   const int64_t min_pause = std::max<int64_t>(1, std::llround(kMinActionPauseS * rate));
   // Runs of frames beyond the threshold, joined across dips shorter than min_pause: one action
