@@ -85,6 +85,28 @@ void BM_ReadBvh(benchmark::State& state) {
   ReportRates(state, corpus);
 }
 
+// As an IngestClipStream receives it: each file in 64 KiB pieces (BvhStreamReader).
+void BM_ReadBvhInPieces(benchmark::State& state) {
+  const Corpus& corpus = TheCorpus();
+  constexpr size_t kPiece = 64 * 1024;
+  for (auto _ : state) {
+    for (const std::string& text : corpus.texts) {
+      motiondb::BvhStreamReader reader;
+      absl::Status appended = absl::OkStatus();
+      for (size_t at = 0; at < text.size() && appended.ok(); at += kPiece) {
+        appended = reader.Append(absl::string_view(text).substr(at, kPiece));
+      }
+      absl::StatusOr<motiondb::BvhReadResult> result = reader.Finish();
+      if (!result.ok()) {
+        state.SkipWithError(std::string(result.status().message()).c_str());
+        return;
+      }
+      benchmark::DoNotOptimize(result->clip.rotations().data());
+    }
+  }
+  ReportRates(state, corpus);
+}
+
 void BM_NaiveIstreamBaseline(benchmark::State& state) {
   const Corpus& corpus = TheCorpus();
   std::vector<double> values;
@@ -100,6 +122,7 @@ void BM_NaiveIstreamBaseline(benchmark::State& state) {
 // One thread each (the default): the target is throughput on one core. An iteration parses the
 // whole corpus (hundreds of milliseconds), hence the unit.
 BENCHMARK(BM_ReadBvh)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ReadBvhInPieces)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NaiveIstreamBaseline)->Unit(benchmark::kMillisecond);
 
 // Reads the corpus into memory and checks that both parsers see the same frames, so that the

@@ -1,5 +1,7 @@
 #include "server/clip_ingest.h"
 
+#include <utility>
+
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "util/status_macros.h"
@@ -24,11 +26,19 @@ absl::StatusOr<std::string> ClipName(const IngestRequest& request) {
 absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
                                            absl::string_view bvh, const UploadLimits& limits,
                                            const std::function<bool()>& should_stop) {
+  // The name is checked before the file is parsed, as a stream checks it before it is read.
+  MOTIONDB_RETURN_IF_ERROR(ClipName(request).status());
+  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
+  return IngestParsedUpload(catalog, request, std::move(read), should_stop);
+}
+
+absl::StatusOr<IngestOutcome> IngestParsedUpload(Catalog& catalog, const IngestRequest& request,
+                                                 BvhReadResult read,
+                                                 const std::function<bool()>& should_stop) {
   storage::ClipRecord record;
   MOTIONDB_ASSIGN_OR_RETURN(record.name, ClipName(request));
   record.source_file = request.file_name;
   record.tags = request.tags;
-  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
   MOTIONDB_ASSIGN_OR_RETURN(
       IngestedClip ingested,
       catalog.IngestClip(record, read.clip, request.on_conflict, should_stop));

@@ -46,6 +46,11 @@ absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest
                                            absl::string_view bvh, const UploadLimits& limits,
                                            const std::function<bool()>& should_stop = {});
 
+// The same for a file parsed as it arrived (StreamedUpload).
+absl::StatusOr<IngestOutcome> IngestParsedUpload(Catalog& catalog, const IngestRequest& request,
+                                                 BvhReadResult read,
+                                                 const std::function<bool()>& should_stop = {});
+
 }  // namespace motiondb::server
 
 #endif  // MOTIONDB_SERVER_CLIP_INGEST_H_

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -27,7 +28,10 @@ int ExitCode(int status) {
 
 }  // namespace
 
-std::string ServerPath() { return MOTIONDB_SERVER_PATH; }
+std::string ServerPath() {
+  const char* given = std::getenv("MOTIONDB_SERVER_BIN");
+  return given != nullptr && *given != '\0' ? given : MOTIONDB_SERVER_PATH;
+}
 
 ServerProcess::~ServerProcess() {
   if (pid_ > 0) {

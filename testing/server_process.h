@@ -49,7 +49,7 @@ class ServerProcess {
   std::string log_path_;
 };
 
-// The built motiondb-server.
+// The built motiondb-server, or the one MOTIONDB_SERVER_BIN names (a benchmark's baseline).
 std::string ServerPath();
 
 // A channel to `address` without TLS and without message size limits on what it receives.

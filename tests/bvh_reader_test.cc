@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -357,18 +359,26 @@ TEST(BvhReaderLimits, TooManyJointsAreRefused) {
   EXPECT_EQ(Read(kMinimal, options).status().code(), absl::StatusCode::kResourceExhausted);
 }
 
-TEST(BvhReaderLimits, DeepHierarchiesDoNotOverflowTheStack) {
+// A chain of `depth` + 1 joints, each inside the last, and `frames` rows.
+std::string DeepChainBvh(int depth, int frames) {
   std::string text =
       "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n";
-  const int depth = 999;
   for (int i = 1; i <= depth; ++i) {
     text += "JOINT j" + std::to_string(i) +
             "\n{\nOFFSET 0 1 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n";
   }
   for (int i = 0; i <= depth; ++i) text += "}\n";
-  text += "MOTION\nFrames: 1\nFrame Time: 0.01\n";
-  for (int i = 0; i <= depth; ++i) text += "0 0 0 ";
-  absl::StatusOr<BvhReadResult> result = Read(text);
+  text += "MOTION\nFrames: " + std::to_string(frames) + "\nFrame Time: 0.01\n";
+  for (int row = 0; row < frames; ++row) {
+    for (int i = 0; i <= depth; ++i) text += std::to_string((i + row) % 90) + " 1 2 ";
+    text += "\n";
+  }
+  return text;
+}
+
+TEST(BvhReaderLimits, DeepHierarchiesDoNotOverflowTheStack) {
+  const int depth = 999;
+  absl::StatusOr<BvhReadResult> result = Read(DeepChainBvh(depth, 1));
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->clip.skeleton().joint_count(), depth + 1);
 }
@@ -454,6 +464,155 @@ TEST_F(ConformanceTest, FramesHeaderMismatchKeepsRowsAndWarns) {
   EXPECT_EQ(r.clip.frame_count(), 3070);
   ASSERT_EQ(r.warnings.size(), 1u);
   EXPECT_THAT(r.warnings[0], HasSubstr("Frames: 3069"));
+}
+
+// BvhStreamReader: whatever the pieces, ReadBvh's result or error for the whole text.
+
+// `text` appended in the pieces that `cuts` (increasing offsets) make, then Finish().
+absl::StatusOr<BvhReadResult> ReadInPieces(absl::string_view text, const std::vector<size_t>& cuts,
+                                           const BvhReadOptions& options = {}) {
+  BvhStreamReader reader(options);
+  size_t begin = 0;
+  for (size_t cut : cuts) {
+    if (absl::Status status = reader.Append(text.substr(begin, cut - begin)); !status.ok()) {
+      return status;
+    }
+    begin = cut;
+  }
+  if (absl::Status status = reader.Append(text.substr(begin)); !status.ok()) return status;
+  return reader.Finish();
+}
+
+// The cuts tried: every single cut, every byte a piece, and random pieces of 1-16 bytes.
+std::vector<std::vector<size_t>> CutsToTry(size_t size) {
+  std::vector<std::vector<size_t>> tries;
+  for (size_t cut = 0; cut <= size; ++cut) tries.push_back({cut});
+  std::vector<size_t> bytes;
+  for (size_t cut = 1; cut < size; ++cut) bytes.push_back(cut);
+  tries.push_back(bytes);
+  std::mt19937 random(7);
+  for (int run = 0; run < 20; ++run) {
+    std::vector<size_t> cuts;
+    for (size_t cut = 1 + random() % 16; cut < size; cut += 1 + random() % 16) cuts.push_back(cut);
+    tries.push_back(cuts);
+  }
+  return tries;
+}
+
+std::string Describe(const std::vector<size_t>& cuts) {
+  std::string text = "cuts:";
+  for (size_t cut : cuts) text += " " + std::to_string(cut);
+  return text;
+}
+
+void ExpectSameInEveryPieces(const std::string& text, const BvhReadOptions& options = {}) {
+  const absl::StatusOr<BvhReadResult> whole = ReadBvh(text, options);
+  for (const std::vector<size_t>& cuts : CutsToTry(text.size())) {
+    const absl::StatusOr<BvhReadResult> pieces = ReadInPieces(text, cuts, options);
+    ASSERT_EQ(pieces.status(), whole.status()) << Describe(cuts);
+    if (!whole.ok()) continue;
+    ASSERT_EQ(pieces->clip.rotations(), whole->clip.rotations()) << Describe(cuts);
+    ASSERT_EQ(pieces->clip.positions(), whole->clip.positions()) << Describe(cuts);
+    ASSERT_EQ(pieces->clip.frame_time(), whole->clip.frame_time()) << Describe(cuts);
+    ASSERT_EQ(pieces->clip.skeleton().joints().size(), whole->clip.skeleton().joints().size());
+    for (int j = 0; j < whole->clip.skeleton().joint_count(); ++j) {
+      ASSERT_EQ(pieces->clip.skeleton().joint(j).name, whole->clip.skeleton().joint(j).name);
+    }
+    ASSERT_EQ(pieces->warnings, whole->warnings) << Describe(cuts);
+  }
+}
+
+TEST(BvhStreamReader, EveryDialectParsesTheSameInAnyPieces) {
+  std::string no_final_newline = kMinimal;
+  no_final_newline.pop_back();
+  for (const std::string& text :
+       {std::string(kMinimal), Replace(kMinimal, "\n", "\r\n"), no_final_newline,
+        Replace(no_final_newline, "\n", "\r\n"),
+        "\xEF\xBB\xBF" + Replace(kMinimal, "\n1.5", "\n\n   \n1.5") + "\n\n",
+        Replace(kMinimal, "Frames: 2", "Frames:2"), Replace(kMinimal, "Frames: 2", "Frames: 5"),
+        Replace(kMinimal, "JOINT Chest\n\t{\n", "JOINT Chest {\n"),
+        Replace(Replace(kMinimal, "90.0 -2.5", "9.0E+01 -2.5e0"), "1.5 ", "+1.5 ")}) {
+    SCOPED_TRACE(text);
+    ExpectSameInEveryPieces(text);
+  }
+}
+
+TEST_P(BvhReaderMalformed, IsRejectedTheSameWhenStreamedInAnyPieces) {
+  ExpectSameInEveryPieces(GetParam().text);
+}
+
+TEST(BvhStreamReader, LimitsHoldInAnyPieces) {
+  BvhReadOptions frames;
+  frames.max_frames = 1;
+  ExpectSameInEveryPieces(Replace(kMinimal, "Frames: 2", "Frames: 1"), frames);
+  BvhReadOptions joints;
+  joints.max_joints = 1;
+  ExpectSameInEveryPieces(kMinimal, joints);
+  BvhReadOptions rotation;
+  rotation.max_abs_rotation_degrees = 45;
+  ExpectSameInEveryPieces(kMinimal, rotation);
+}
+
+TEST(BvhStreamReader, TheSizeLimitCountsEveryPiece) {
+  BvhReadOptions options;
+  options.max_bytes = 100;
+  BvhStreamReader reader(options);
+  const absl::string_view text = kMinimal;
+  ASSERT_TRUE(reader.Append(text.substr(0, 60)).ok());
+  const absl::Status over = reader.Append(text.substr(60, 60));
+  EXPECT_EQ(over.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(std::string(over.message()), HasSubstr("over the limit of 100"));
+  EXPECT_EQ(reader.Finish().status(), over);
+}
+
+// The error comes with the piece that completes its line: a client streaming a large file learns
+// of it without sending the rest.
+TEST(BvhStreamReader, AnErrorIsReportedByThePieceThatCompletesItsLine) {
+  const std::string text = Replace(kMinimal, "50.0", "5O.0");
+  const size_t row_end = text.find('\n', text.find("5O.0"));
+  BvhStreamReader reader;
+  ASSERT_TRUE(reader.Append(text.substr(0, row_end)).ok());
+  const absl::Status error = reader.Append("\n");
+  EXPECT_THAT(std::string(error.message()), HasSubstr("line 19"));
+  EXPECT_EQ(reader.Append("1.5 91.0 -2.0 11.0 21.0 31.0 -41.0 51.0 61.0\n"), error);
+  EXPECT_EQ(reader.Finish().status(), error);
+}
+
+TEST(BvhStreamReader, AHierarchyOfAThousandJointsArrivesAByteAtATime) {
+  const int depth = 999;
+  const std::string text = DeepChainBvh(depth, 2);
+  BvhStreamReader reader;
+  for (char c : text) ASSERT_TRUE(reader.Append(absl::string_view(&c, 1)).ok());
+  absl::StatusOr<BvhReadResult> streamed = reader.Finish();
+  ASSERT_TRUE(streamed.ok()) << streamed.status();
+  EXPECT_EQ(streamed->clip.skeleton().joint_count(), depth + 1);
+  EXPECT_EQ(streamed->clip.rotations(), ReadBvh(text)->clip.rotations());
+}
+
+// Real files of every quirk, in random pieces.
+TEST(BvhStreamReader, ConformanceFilesParseTheSameInRandomPieces) {
+  if (!testing::MocapDir()) GTEST_SKIP() << "../shared/mocap is absent; skipped";
+  const std::vector<std::filesystem::path> files =
+      testing::BvhFilesUnder(*testing::MocapDir() / "conformance");
+  ASSERT_FALSE(files.empty());
+  std::mt19937 random(11);
+  for (const std::filesystem::path& file : files) {
+    const std::string text = testing::ReadFileOrDie(file);
+    const absl::StatusOr<BvhReadResult> whole = ReadBvh(text);
+    for (size_t max_piece : {size_t{7}, size_t{4096}, size_t{65536}}) {
+      std::vector<size_t> cuts;
+      for (size_t cut = 1 + random() % max_piece; cut < text.size();
+           cut += 1 + random() % max_piece) {
+        cuts.push_back(cut);
+      }
+      const absl::StatusOr<BvhReadResult> pieces = ReadInPieces(text, cuts);
+      ASSERT_EQ(pieces.status(), whole.status()) << file;
+      if (!whole.ok()) continue;
+      EXPECT_EQ(pieces->clip.rotations(), whole->clip.rotations()) << file;
+      EXPECT_EQ(pieces->clip.positions(), whole->clip.positions()) << file;
+      EXPECT_EQ(pieces->warnings, whole->warnings) << file;
+    }
+  }
 }
 
 }  // namespace

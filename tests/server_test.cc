@@ -284,6 +284,40 @@ TEST_F(ServerTest, IngestsRealBvhFilesStreamedInChunks) {
   EXPECT_THAT(response.clip().tags(), ::testing::ElementsAre("cmu"));
 }
 
+// A stream is parsed as it arrives: a malformed row is refused at the chunk that carries it, so
+// the client cannot send the 64 MiB after it (the server stops reading; before, it read them all
+// and only then parsed), and nothing is stored.
+TEST_F(ServerTest, AStreamIsRefusedAtTheChunkThatShowsItsError) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::string text = BvhText(ChainClip());
+  const size_t second_row = text.find('\n', text.find("Frame Time:")) + 1;
+  const std::string row = text.substr(second_row, text.find('\n', second_row) + 1 - second_row);
+
+  auto context = client.Context();
+  v1::IngestClipResponse response;
+  auto writer = client.clips().IngestClipStream(context.get(), &response);
+  v1::IngestClipStreamRequest message;
+  message.set_file_name("chain.bvh");
+  message.set_chunk(text + "1 2 x\n");
+  ASSERT_TRUE(writer->Write(message));
+  message.clear_file_name();
+  message.clear_chunk();
+  while (message.chunk().size() < (1 << 20)) *message.mutable_chunk() += row;
+  int written = 0;
+  while (written < 64 && writer->Write(message)) ++written;
+  EXPECT_LT(written, 64) << "the server read the whole stream";
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("chain.bvh: line "));
+  EXPECT_THAT(status.error_message(), HasSubstr("'x'"));
+  v1::ListClipsResponse page;
+  ASSERT_TRUE(client.clips().ListClips(client.Context().get(), {}, &page).ok());
+  EXPECT_EQ(page.clips_size(), 0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Clip names that fit a studio's folders: names with '/', conflicts, content hashes, updates.
 

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -61,6 +64,7 @@ class Scanner {
     token_line_ = line_;
     const size_t start = pos_;
     while (pos_ < text_.size() && !IsSpace(text_[pos_])) ++pos_;
+    if (pos_ == text_.size()) reached_end_ = true;
     return text_.substr(start, pos_ - start);
   }
 
@@ -75,6 +79,8 @@ class Scanner {
     if (pos_ < text_.size()) {
       ++pos_;
       ++line_;
+    } else {
+      reached_end_ = true;
     }
     return text_.substr(start, stop - start);
   }
@@ -82,6 +88,8 @@ class Scanner {
   int token_line() const { return token_line_; }
   int line() const { return line_; }
   size_t pos() const { return pos_; }
+  // Whether a token or line ran into the end of the text: more text could have continued it.
+  bool reached_end() const { return reached_end_; }
 
  private:
   void SkipSpace() {
@@ -95,6 +103,7 @@ class Scanner {
   size_t pos_ = 0;
   int line_ = 1;
   int token_line_ = 1;
+  bool reached_end_ = false;
 };
 
 absl::Status Expect(Scanner& scanner, absl::string_view keyword) {
@@ -299,9 +308,14 @@ struct RowLayout {
   }
 };
 
-absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scanner,
-                                          std::shared_ptr<const Skeleton> skeleton,
-                                          const BvhReadOptions& options) {
+// What the lines from MOTION to the frame time say.
+struct MotionHeader {
+  int64_t frames = 0;   // as the header says
+  int frames_line = 0;  // the line of `Frames:`
+  double frame_time = 0.0;
+};
+
+absl::StatusOr<MotionHeader> ParseMotionHeader(Scanner& scanner, const BvhReadOptions& options) {
   {
     const absl::string_view token = scanner.NextToken();
     if (token == "ROOT") {
@@ -310,20 +324,21 @@ absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scann
     }
     if (token != "MOTION") return ErrorAt(scanner.token_line(), "'MOTION'", token);
   }
+  MotionHeader header;
   MOTIONDB_ASSIGN_OR_RETURN(const absl::string_view frames_token, ValueAfter(scanner, "Frames:"));
-  const int frames_line = scanner.token_line();
-  int64_t header_frames = -1;
+  header.frames_line = scanner.token_line();
   {
     const char* end = frames_token.data() + frames_token.size();
-    const auto [ptr, ec] = std::from_chars(frames_token.data(), end, header_frames);
+    const auto [ptr, ec] = std::from_chars(frames_token.data(), end, header.frames);
     if (ec == std::errc::result_out_of_range ||
-        (ec == std::errc() && ptr == end && header_frames > options.max_frames)) {
-      return absl::ResourceExhaustedError(absl::StrCat("line ", frames_line, ": frame count ",
-                                                       frames_token, " is over the limit of ",
-                                                       options.max_frames));
+        (ec == std::errc() && ptr == end && header.frames > options.max_frames)) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("line ", header.frames_line, ": frame count ", frames_token,
+                       " is over the limit of ", options.max_frames));
     }
-    if (ec != std::errc() || ptr != end || header_frames < 0) {
-      return ErrorAt(frames_line, "a non-negative frame count after 'Frames:'", frames_token);
+    if (ec != std::errc() || ptr != end || header.frames < 0) {
+      return ErrorAt(header.frames_line, "a non-negative frame count after 'Frames:'",
+                     frames_token);
     }
   }
   MOTIONDB_RETURN_IF_ERROR(Expect(scanner, "Frame"));
@@ -332,35 +347,59 @@ absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scann
   if (!frame_time || *frame_time <= 0.0) {
     return ErrorAt(scanner.token_line(), "a positive frame time after 'Frame Time:'", time_token);
   }
+  header.frame_time = *frame_time;
   const int time_line = scanner.token_line();
   if (absl::string_view rest = scanner.RestOfLine(); !rest.empty()) {
     return ErrorAt(time_line, "end of line after the frame time", rest);
   }
+  return header;
+}
 
-  const int channels = skeleton->channel_count();
-  if (channels == 0) return absl::InvalidArgumentError("the hierarchy has no channels");
-  const RowLayout layout(*skeleton);
-  const int joints = skeleton->joint_count();
-  const int positions = 3 * skeleton->position_joint_count();
+}  // namespace
 
-  // Each value takes at least two bytes, which bounds the rows the rest of the text can hold.
-  const size_t remaining = text.size() - scanner.pos();
-  Eigen::Index capacity = static_cast<Eigen::Index>(
-      std::min<size_t>(static_cast<size_t>(header_frames), remaining / (2 * channels) + 1));
-  capacity = std::max<Eigen::Index>(capacity, 1);
-  RowMatrixXd rotations(capacity, 4 * joints);
-  RowMatrixXd translations(capacity, positions);
-  std::vector<double> values(channels);
+// The frame rows: parsed a line at a time into the clip's matrices as they grow.
+class BvhStreamReader::Motion {
+ public:
+  // `first_line`: the line number of the first row; `bytes_hint`: the size of the text of the
+  // rows when known (the whole text was given), else of what has arrived of it.
+  Motion(std::shared_ptr<const Skeleton> skeleton, const MotionHeader& header, int first_line,
+         size_t bytes_hint, const BvhReadOptions& options)
+      : skeleton_(std::move(skeleton)),
+        header_(header),
+        options_(options),
+        layout_(*skeleton_),
+        values_(skeleton_->channel_count()),
+        line_(first_line) {
+    // Each value takes at least two bytes, which bounds the rows the text can hold; beyond the
+    // hint the matrices grow by doubling, up to what the header says and then past it.
+    capacity_ = static_cast<Eigen::Index>(std::min<size_t>(static_cast<size_t>(header.frames),
+                                                           bytes_hint / (2 * values_.size()) + 1));
+    capacity_ = std::max<Eigen::Index>(capacity_, 1);
+    rotations_.resize(capacity_, 4 * skeleton_->joint_count());
+    positions_.resize(capacity_, 3 * skeleton_->position_joint_count());
+  }
 
-  const char* p = text.data() + scanner.pos();
-  const char* const end = text.data() + text.size();
-  int line = scanner.line();
-  Eigen::Index rows = 0;
-  for (; p < end; ++line) {
+  // Every line of `text`, which ends with a newline.
+  absl::Status ParseLines(absl::string_view text) {
+    const char* p = text.data();
+    const char* const end = p + text.size();
+    while (p < end) {
+      const char* newline = static_cast<const char*>(std::memchr(p, '\n', end - p));
+      MOTIONDB_RETURN_IF_ERROR(ParseLine(absl::string_view(p, newline - p), false));
+      p = newline + 1;
+    }
+    return absl::OkStatus();
+  }
+
+  // One line without its newline; `unterminated`: the text ended inside it.
+  absl::Status ParseLine(absl::string_view text, bool unterminated) {
+    const int channels = static_cast<int>(values_.size());
+    const char* p = text.data();
+    const char* const end = p + text.size();
     int count = 0;
     while (true) {
       while (p < end && IsBlank(*p)) ++p;
-      if (p == end || *p == '\n') break;
+      if (p == end) break;
       const char* start = p;
       if (*p == '+') ++p;
       double value;
@@ -368,77 +407,187 @@ absl::StatusOr<BvhReadResult> ParseMotion(absl::string_view text, Scanner& scann
       if (ec != std::errc() || (next < end && !IsSpace(*next))) {
         const char* stop = start;
         while (stop < end && !IsSpace(*stop)) ++stop;
-        return ErrorAt(line, absl::StrCat("a number (value ", count + 1, " of ", channels, ")"),
+        return ErrorAt(line_, absl::StrCat("a number (value ", count + 1, " of ", channels, ")"),
                        absl::string_view(start, stop - start));
       }
       if (!std::isfinite(value)) {
-        return absl::InvalidArgumentError(absl::StrCat("line ", line, ": value ", count + 1, " is ",
-                                                       absl::string_view(start, next - start),
-                                                       "; expected a finite number"));
+        return absl::InvalidArgumentError(
+            absl::StrCat("line ", line_, ": value ", count + 1, " is ",
+                         absl::string_view(start, next - start), "; expected a finite number"));
       }
       if (count == channels) {
         return absl::InvalidArgumentError(
-            absl::StrCat("line ", line, ": expected ", channels, " values, found more"));
+            absl::StrCat("line ", line_, ": expected ", channels, " values, found more"));
       }
-      if (const RowLayout::Value what = layout.value_channels[count];
+      if (const RowLayout::Value what = layout_.value_channels[count];
           what.channel >= Channel::kXrotation &&
-          std::abs(value) > options.max_abs_rotation_degrees) {
+          std::abs(value) > options_.max_abs_rotation_degrees) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "line ", line, ": value ", count + 1, " (", skeleton->joint(what.joint).name, " ",
+            "line ", line_, ": value ", count + 1, " (", skeleton_->joint(what.joint).name, " ",
             ChannelName(what.channel), ") is ", absl::string_view(start, next - start),
-            " degrees; rotations beyond +-", options.max_abs_rotation_degrees, " are refused"));
+            " degrees; rotations beyond +-", options_.max_abs_rotation_degrees, " are refused"));
       }
-      values[count++] = value;
+      values_[count++] = value;
       p = next;
     }
-    if (p < end) ++p;  // the newline
-    if (count == 0) continue;
-    if (count != channels) {
-      return absl::InvalidArgumentError(absl::StrCat("line ", line, ": expected ", channels,
-                                                     " values, found ", count,
-                                                     p == end ? " (the file is truncated)" : ""));
-    }
-    if (rows == options.max_frames) {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("line ", line, ": more than ", options.max_frames, " frames"));
-    }
-    if (rows == capacity) {
-      capacity *= 2;
-      rotations.conservativeResize(capacity, Eigen::NoChange);
-      translations.conservativeResize(capacity, Eigen::NoChange);
-    }
-    layout.Apply(values.data(), rotations.row(rows).data(), translations.row(rows).data());
-    ++rows;
+    if (count != 0) MOTIONDB_RETURN_IF_ERROR(AddRow(count, unterminated));
+    ++line_;
+    return absl::OkStatus();
   }
-  if (rows == 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "line ", line, ": expected frame rows after 'Frame Time:', found end of file"));
-  }
-  rotations.conservativeResize(rows, Eigen::NoChange);
-  translations.conservativeResize(rows, Eigen::NoChange);
 
-  std::vector<std::string> warnings;
-  if (rows != header_frames) {
-    warnings.push_back(absl::StrCat("line ", frames_line, ": header says Frames: ", header_frames,
-                                    " but the file holds ", rows, " frame rows; using ", rows));
+  absl::StatusOr<BvhReadResult> Finish() {
+    if (rows_ == 0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "line ", line_, ": expected frame rows after 'Frame Time:', found end of file"));
+    }
+    rotations_.conservativeResize(rows_, Eigen::NoChange);
+    positions_.conservativeResize(rows_, Eigen::NoChange);
+    std::vector<std::string> warnings;
+    if (rows_ != header_.frames) {
+      warnings.push_back(absl::StrCat("line ", header_.frames_line,
+                                      ": header says Frames: ", header_.frames,
+                                      " but the file holds ", rows_, " frame rows; using ", rows_));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(
+        Clip clip, Clip::Create(std::move(skeleton_), header_.frame_time, std::move(rotations_),
+                                std::move(positions_)));
+    return BvhReadResult{std::move(clip), std::move(warnings)};
   }
-  MOTIONDB_ASSIGN_OR_RETURN(Clip clip, Clip::Create(std::move(skeleton), *frame_time,
-                                                    std::move(rotations), std::move(translations)));
-  return BvhReadResult{std::move(clip), std::move(warnings)};
+
+ private:
+  absl::Status AddRow(int count, bool unterminated) {
+    if (count != static_cast<int>(values_.size())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("line ", line_, ": expected ", values_.size(), " values, found ", count,
+                       unterminated ? " (the file is truncated)" : ""));
+    }
+    if (rows_ == options_.max_frames) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("line ", line_, ": more than ", options_.max_frames, " frames"));
+    }
+    if (rows_ == capacity_) {
+      // realloc: large blocks are mapped, so growing them moves pages rather than copying.
+      capacity_ = rows_ < header_.frames ? std::min<Eigen::Index>(2 * capacity_, header_.frames)
+                                         : 2 * capacity_;
+      rotations_.conservativeResize(capacity_, Eigen::NoChange);
+      positions_.conservativeResize(capacity_, Eigen::NoChange);
+    }
+    layout_.Apply(values_.data(), rotations_.row(rows_).data(), positions_.row(rows_).data());
+    ++rows_;
+    return absl::OkStatus();
+  }
+
+  std::shared_ptr<const Skeleton> skeleton_;
+  MotionHeader header_;
+  BvhReadOptions options_;
+  RowLayout layout_;
+  std::vector<double> values_;  // one row's, in file order
+  int line_;                    // of the next line
+  Eigen::Index rows_ = 0;
+  Eigen::Index capacity_ = 0;
+  RowMatrixXd rotations_;
+  RowMatrixXd positions_;
+};
+
+BvhStreamReader::BvhStreamReader(const BvhReadOptions& options) : options_(options) {}
+BvhStreamReader::~BvhStreamReader() = default;
+BvhStreamReader::BvhStreamReader(BvhStreamReader&&) noexcept = default;
+BvhStreamReader& BvhStreamReader::operator=(BvhStreamReader&&) noexcept = default;
+
+absl::Status BvhStreamReader::Append(absl::string_view piece) {
+  MOTIONDB_RETURN_IF_ERROR(status_);
+  bytes_ += static_cast<int64_t>(piece.size());
+  if (bytes_ > options_.max_bytes) {
+    status_ = absl::ResourceExhaustedError(absl::StrCat(
+        "input is ", bytes_, " bytes or more, over the limit of ", options_.max_bytes));
+  } else {
+    status_ = motion_ ? AppendToMotion(piece) : AppendToHeader(piece);
+  }
+  return status_;
 }
 
-}  // namespace
+absl::StatusOr<BvhReadResult> BvhStreamReader::Finish() {
+  MOTIONDB_RETURN_IF_ERROR(status_);
+  if (!motion_) {
+    const std::string text = std::move(pending_);
+    pending_.clear();
+    status_ = ParseHeader(text, /*final=*/true);
+  }
+  if (status_.ok() && !pending_.empty()) {
+    status_ = motion_->ParseLine(pending_, /*unterminated=*/true);
+  }
+  MOTIONDB_RETURN_IF_ERROR(status_);
+  status_ = absl::FailedPreconditionError("BvhStreamReader::Finish was called already");
+  return motion_->Finish();
+}
+
+absl::Status BvhStreamReader::AppendToHeader(absl::string_view piece) {
+  // Parsed in place when nothing is pending: a whole file is not copied.
+  if (pending_.empty()) {
+    MOTIONDB_RETURN_IF_ERROR(ParseHeader(piece, /*final=*/false));
+    if (!motion_) pending_.assign(piece.data(), piece.size());
+  } else {
+    pending_.append(piece.data(), piece.size());
+    if (pending_.size() < next_header_attempt_) return absl::OkStatus();
+    const std::string text = std::move(pending_);
+    pending_.clear();
+    MOTIONDB_RETURN_IF_ERROR(ParseHeader(text, /*final=*/false));
+    if (!motion_) pending_ = std::move(text);
+  }
+  if (!motion_) next_header_attempt_ = 2 * pending_.size();
+  return absl::OkStatus();
+}
+
+absl::Status BvhStreamReader::ParseHeader(absl::string_view text, bool final) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+  Scanner scanner(text);
+  // An error or a header that ran into the end of the text may be a piece's cut: wait for more.
+  auto wait_for_more = [&] { return !final && scanner.reached_end(); };
+  absl::StatusOr<std::vector<Joint>> joints = ParseHierarchy(scanner, options_);
+  if (wait_for_more()) return absl::OkStatus();
+  MOTIONDB_RETURN_IF_ERROR(joints.status());
+  MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(*std::move(joints)));
+  const absl::StatusOr<MotionHeader> header = ParseMotionHeader(scanner, options_);
+  if (wait_for_more()) return absl::OkStatus();
+  MOTIONDB_RETURN_IF_ERROR(header.status());
+  if (skeleton.channel_count() == 0) {
+    return absl::InvalidArgumentError("the hierarchy has no channels");
+  }
+  const absl::string_view rows = text.substr(scanner.pos());
+  motion_ = std::make_unique<Motion>(std::make_shared<const Skeleton>(std::move(skeleton)), *header,
+                                     scanner.line(), rows.size(), options_);
+  return AppendToMotion(rows);
+}
+
+absl::Status BvhStreamReader::AppendToMotion(absl::string_view piece) {
+  if (!pending_.empty()) {
+    const size_t newline = piece.find('\n');
+    if (newline == absl::string_view::npos) {
+      pending_.append(piece.data(), piece.size());
+      return absl::OkStatus();
+    }
+    pending_.append(piece.data(), newline);
+    MOTIONDB_RETURN_IF_ERROR(motion_->ParseLine(pending_, /*unterminated=*/false));
+    pending_.clear();
+    piece.remove_prefix(newline + 1);
+  }
+  const size_t last_newline = piece.rfind('\n');
+  if (last_newline != absl::string_view::npos) {
+    MOTIONDB_RETURN_IF_ERROR(motion_->ParseLines(piece.substr(0, last_newline + 1)));
+    piece.remove_prefix(last_newline + 1);
+  }
+  pending_.assign(piece.data(), piece.size());
+  return absl::OkStatus();
+}
 
 absl::StatusOr<BvhReadResult> ReadBvh(absl::string_view text, const BvhReadOptions& options) {
   if (static_cast<int64_t>(text.size()) > options.max_bytes) {
     return absl::ResourceExhaustedError(
         absl::StrCat("input is ", text.size(), " bytes, over the limit of ", options.max_bytes));
   }
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
-  Scanner scanner(text);
-  MOTIONDB_ASSIGN_OR_RETURN(std::vector<Joint> joints, ParseHierarchy(scanner, options));
-  MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(std::move(joints)));
-  return ParseMotion(text, scanner, std::make_shared<const Skeleton>(std::move(skeleton)), options);
+  BvhStreamReader reader(options);
+  MOTIONDB_RETURN_IF_ERROR(reader.Append(text));
+  return reader.Finish();
 }
 
 absl::StatusOr<BvhReadResult> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {

@@ -6,11 +6,12 @@
 #define MOTIONDB_CORE_BVH_BVH_READER_H_
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
-#include "absl/strings/string_view.h"
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "core/motion/clip.h"
 
 namespace motiondb {
@@ -32,6 +33,42 @@ struct BvhReadResult {
   Clip clip;
   // Non-fatal oddities, e.g. a `Frames:` header that disagrees with the rows present.
   std::vector<std::string> warnings;
+};
+
+// Parses BVH text that arrives in pieces (a streamed upload) as it arrives, holding the clip
+// being built and the unparsed tail of the last piece rather than the whole text. Whatever the
+// pieces, the result and the errors are ReadBvh's for their concatenation; an error is reported
+// by the Append() that completes the line it is on, so a client learns of it before it has sent
+// the rest. Not thread-safe.
+class BvhStreamReader {
+ public:
+  explicit BvhStreamReader(const BvhReadOptions& options = {});
+  ~BvhStreamReader();
+  BvhStreamReader(BvhStreamReader&&) noexcept;
+  BvhStreamReader& operator=(BvhStreamReader&&) noexcept;
+
+  // Parses what `piece` completes. An error is final: every later call returns it.
+  absl::Status Append(absl::string_view piece);
+  // The text has ended: parses its unfinished last line and returns the clip. Call once.
+  absl::StatusOr<BvhReadResult> Finish();
+
+ private:
+  class Motion;
+  absl::Status AppendToHeader(absl::string_view piece);
+  absl::Status AppendToMotion(absl::string_view piece);
+  // Parses the header from `text` (the whole text so far); leaves motion_ unset when the text
+  // may end inside the header and more is to come (`final` false).
+  absl::Status ParseHeader(absl::string_view text, bool final);
+
+  BvhReadOptions options_;
+  absl::Status status_;
+  int64_t bytes_ = 0;
+  // The header's text while it is incomplete, then the motion's unfinished last line.
+  std::string pending_;
+  // The header is parsed again once pending_ reaches this size: doubling it keeps the work of
+  // a header that arrives in tiny pieces linear.
+  size_t next_header_attempt_ = 0;
+  std::unique_ptr<Motion> motion_;  // once the header is parsed
 };
 
 // Parses BVH text. Errors are INVALID_ARGUMENT ("line N: expected ..., found ...") or

@@ -44,18 +44,19 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
   MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
   absl::StatusOr<ReceivedUpload> received;
   {
-    // Only while reading: the parse that follows may take long without a byte arriving.
+    // Only while reading: the ingest that follows may take long without a byte arriving.
     StreamWatchdog::Watch watch = watchdog_.Start(context);
     received = ReceiveUpload(*reader, watch, limits_, ticket);
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const ReceivedUpload upload, std::move(received));
+  MOTIONDB_ASSIGN_OR_RETURN(ReceivedUpload upload, std::move(received));
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
   const std::function<bool()> should_stop = StopWhenCallEnds(context);
   if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
+  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, upload.bvh.Finish());
   MOTIONDB_ASSIGN_OR_RETURN(
       const IngestOutcome outcome,
-      IngestUpload(catalog_, upload.request, upload.bvh, limits_, should_stop));
+      IngestParsedUpload(catalog_, upload.request, std::move(read), should_stop));
   metrics_.CountIngest(outcome);
   ToProto(outcome, response);
   return absl::OkStatus();

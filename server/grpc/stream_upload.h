@@ -1,6 +1,7 @@
-// The messages of an IngestClipStream assembled into the upload they carry: the first names the
+// The messages of an IngestClipStream read into the upload they carry: the first names the
 // file (checked before more is read), and every message may carry a chunk, counted against the
-// file's limit and the budget of all uploads as it arrives.
+// file's limit and the budget of all uploads and parsed as it arrives (StreamedUpload), so a
+// malformed file is refused at the chunk that shows it.
 //
 // `Reader`: anything with bool Read(v1::IngestClipStreamRequest*) (grpc::ServerReader, or a
 // fuzzer's messages). `Activity`: Touch() as each message arrives and Status() once reading
@@ -10,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
@@ -23,7 +25,7 @@ namespace motiondb::server {
 
 struct ReceivedUpload {
   IngestRequest request;
-  std::string bvh;
+  StreamedUpload bvh;  // every chunk appended, not finished: the caller checks the call first
 };
 
 template <typename Reader, typename Activity>
@@ -35,16 +37,15 @@ absl::StatusOr<ReceivedUpload> ReceiveUpload(Reader& reader, Activity& activity,
     MOTIONDB_RETURN_IF_ERROR(activity.Status());
     return absl::InvalidArgumentError("the stream is empty: the first message needs file_name");
   }
-  ReceivedUpload upload;
-  MOTIONDB_ASSIGN_OR_RETURN(upload.request, FromProto(message));
+  MOTIONDB_ASSIGN_OR_RETURN(IngestRequest request, FromProto(message));
   // Refused before the upload is read: a stream without a file name would be read in vain.
-  MOTIONDB_RETURN_IF_ERROR(ClipName(upload.request).status());
+  MOTIONDB_RETURN_IF_ERROR(ClipName(request).status());
+  StreamedUpload bvh(request.file_name, limits);
+  ReceivedUpload upload{std::move(request), std::move(bvh)};
   do {
     activity.Touch();
-    MOTIONDB_RETURN_IF_ERROR(
-        CheckUploadSize(static_cast<int64_t>(upload.bvh.size() + message.chunk().size()), limits));
     MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(message.chunk().size())));
-    upload.bvh += message.chunk();
+    MOTIONDB_RETURN_IF_ERROR(upload.bvh.Append(message.chunk()));
   } while (reader.Read(&message));
   MOTIONDB_RETURN_IF_ERROR(activity.Status());
   return upload;

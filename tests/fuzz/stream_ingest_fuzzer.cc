@@ -1,8 +1,9 @@
-// libFuzzer target: IngestClipStream's assembly of an upload from its messages
-// (server/grpc/stream_upload.h) and the parse of what it assembled: the input is split into
+// libFuzzer target: IngestClipStream's reading of an upload from its messages
+// (server/grpc/stream_upload.h), parsed chunk by chunk as they arrive: the input is split into
 // serialised messages (the first may lack a file name or be missing altogether), chunks split
 // anywhere, under small file and buffer limits. Nothing may crash, trip a sanitizer, or
-// answer INTERNAL, and no chunk may be counted past the limits.
+// answer INTERNAL, no chunk may be counted past the limits, and the chunks parsed as they
+// arrive must give exactly what the concatenated file gives parsed whole (ReadUpload).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstddef>
@@ -59,7 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   absl::StatusOr<server::UploadBudget::Ticket> ticket = budget.Admit();
   if (!ticket.ok()) std::abort();
   NoWatch watch;
-  const absl::StatusOr<server::ReceivedUpload> upload =
+  absl::StatusOr<server::ReceivedUpload> upload =
       server::ReceiveUpload(messages, watch, limits, *ticket);
   if (budget.buffered_bytes() > limits.max_buffered_bytes) {
     std::fprintf(stderr, "the budget counted %lld bytes over its limit %lld\n",
@@ -71,8 +72,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::CheckNotInternal(upload.status(), "ReceiveUpload");
     return 0;
   }
-  if (static_cast<int64_t>(upload->bvh.size()) > limits.max_bvh_bytes) std::abort();
-  fuzz::CheckNotInternal(
-      server::ReadUpload(upload->bvh, upload->request.file_name, limits).status(), "ReadUpload");
+  std::string whole;
+  for (const IngestClipStreamRequest& message : messages.list) whole += message.chunk();
+  if (static_cast<int64_t>(whole.size()) > limits.max_bvh_bytes) std::abort();
+  const absl::StatusOr<BvhReadResult> streamed = upload->bvh.Finish();
+  const absl::StatusOr<BvhReadResult> read =
+      server::ReadUpload(whole, upload->request.file_name, limits);
+  fuzz::CheckNotInternal(read.status(), "ReadUpload");
+  const bool same = streamed.status() == read.status() &&
+                    (!read.ok() || (streamed->clip.rotations() == read->clip.rotations() &&
+                                    streamed->clip.positions() == read->clip.positions() &&
+                                    streamed->warnings == read->warnings));
+  if (!same) {
+    std::fprintf(stderr, "streamed: %s\nwhole: %s\n", streamed.status().ToString().c_str(),
+                 read.status().ToString().c_str());
+    std::abort();
+  }
   return 0;
 }
