@@ -5,7 +5,6 @@
 #define MOTIONDB_SERVER_UPLOAD_H_
 
 #include <cstdint>
-#include <string>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -20,10 +19,10 @@ struct UploadLimits {
   // Ingests (unary or streamed) in progress at once (--max-uploads); one more is refused with
   // RESOURCE_EXHAUSTED before it is read.
   int max_uploads = 32;
-  // Bytes the ingests in progress may hold together (--max-upload-buffer-mb); a message or
-  // chunk beyond fails its upload with RESOURCE_EXHAUSTED. A streamed upload holds its clip
-  // parsed as it arrives (about its size, measured in bench/RESULTS.md), a unary one its text
-  // and then the clip, so this is what bounds the server's memory under many large uploads.
+  // Bytes of text the ingests in progress may hold together (--max-upload-buffer-mb); a message
+  // or chunk beyond fails its upload with RESOURCE_EXHAUSTED. An upload peaks at 1.9-4.2x its
+  // text (the parsed clip and its stored copy; bench/RESULTS.md), and no one upload's clip may
+  // take more than this either, so this is what bounds the server's memory under many uploads.
   int64_t max_buffered_bytes = int64_t{2} << 30;
 };
 
@@ -35,24 +34,8 @@ absl::Status CheckUploadSize(int64_t bytes, const UploadLimits& limits);
 absl::StatusOr<BvhReadResult> ReadUpload(absl::string_view bvh, absl::string_view name,
                                          const UploadLimits& limits);
 
-// A file that arrives in chunks (IngestClipStream), parsed as they arrive (BvhStreamReader) so
-// that the server holds the clip being built rather than the text. Errors, the size check's
-// too, begin with `name`, as ReadUpload's do. Not thread-safe.
-class StreamedUpload {
- public:
-  StreamedUpload(std::string name, const UploadLimits& limits);
-
-  // Checks the size so far against the limit, then parses what `chunk` completes.
-  absl::Status Append(absl::string_view chunk);
-  // The file has ended: the parsed clip. Call once.
-  absl::StatusOr<BvhReadResult> Finish();
-
- private:
-  std::string name_;
-  UploadLimits limits_;
-  int64_t bytes_ = 0;
-  BvhStreamReader reader_;
-};
+// How the server reads an upload: its size limit, and its clip at most the budget of all.
+BvhReadOptions UploadReadOptions(const UploadLimits& limits);
 
 }  // namespace motiondb::server
 

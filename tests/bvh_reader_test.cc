@@ -16,6 +16,7 @@ namespace motiondb {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
@@ -203,6 +204,10 @@ std::vector<MalformedCase> MalformedCases() {
        Truncated(last_row + 12),
        absl::StatusCode::kInvalidArgument,
        {"line 20", "expected 9 values, found 3", "truncated"}},
+      {"ShortLastRowEndingInANewline",
+       Replace(minimal, "1.5 91.0 -2.0 11.0 21.0 31.0 -41.0 51.0 61.0", "1.5 91.0 -2.0"),
+       absl::StatusCode::kInvalidArgument,
+       {"line 20", "expected 9 values, found 3 (the file is truncated)"}},
       {"TooFewValuesOnARow",
        Replace(minimal, "10.0 20.0 30.0 ", ""),
        absl::StatusCode::kInvalidArgument,
@@ -539,6 +544,36 @@ TEST(BvhStreamReader, EveryDialectParsesTheSameInAnyPieces) {
 
 TEST_P(BvhReaderMalformed, IsRejectedTheSameWhenStreamedInAnyPieces) {
   ExpectSameInEveryPieces(GetParam().text);
+}
+
+// "Truncated" is said of the text's last line only, however the text arrives.
+TEST(BvhReaderMalformedRows, AShortRowFollowedByABlankLineIsNotCalledTruncated) {
+  const std::string text =
+      Replace(kMinimal, "1.5 91.0 -2.0 11.0 21.0 31.0 -41.0 51.0 61.0\n", "1.5 91.0 -2.0\n\n");
+  const absl::StatusOr<BvhReadResult> result = Read(text);
+  EXPECT_THAT(std::string(result.status().message()), HasSubstr("line 20: expected 9 values"));
+  EXPECT_THAT(std::string(result.status().message()), Not(HasSubstr("truncated")));
+  ExpectSameInEveryPieces(text);
+}
+
+TEST(BvhReaderLimits, TheHeaderRowAndClipLimitsAreRefusedInAnyPieces) {
+  struct Case {
+    BvhReadOptions options;
+    std::string message;
+  };
+  std::vector<Case> cases(3);
+  cases[0].options.max_header_bytes = 100;
+  cases[0].message = "the header (HIERARCHY to the frame time) is over the limit of 100 bytes";
+  cases[1].options.max_row_bytes = 20;
+  cases[1].message = "line 19: a frame row longer than the limit of 20 bytes";
+  cases[2].options.max_clip_bytes = 100;  // a frame takes 8 x (4 x 2 joints + 3) = 88 bytes
+  cases[2].message = "line 20: the clip would take more than 100 bytes of memory";
+  for (const Case& c : cases) {
+    const absl::StatusOr<BvhReadResult> result = Read(kMinimal, c.options);
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted) << result.status();
+    EXPECT_THAT(std::string(result.status().message()), HasSubstr(c.message));
+    ExpectSameInEveryPieces(kMinimal, c.options);
+  }
 }
 
 TEST(BvhStreamReader, LimitsHoldInAnyPieces) {

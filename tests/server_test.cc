@@ -1528,6 +1528,21 @@ TEST_F(ServerTest, UploadsInProgressAreBounded) {
   const grpc::Status over = big_writer->Finish();
   EXPECT_EQ(over.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(over.error_message(), HasSubstr("(--max-upload-buffer-mb)"));
+
+  // 42 KB of text whose clip would take 1.3 MB (1000 joints, 40 frames, 32 bytes a joint a
+  // frame whether it has channels or not): over the budget too, though its text is not.
+  std::string wide =
+      "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n";
+  for (int j = 1; j < 1000; ++j) {
+    wide += "JOINT j" + std::to_string(j) + "\n{\nOFFSET 0 1 0\nCHANNELS 0\n}\n";
+  }
+  wide += "}\nMOTION\nFrames: 40\nFrame Time: 0.01\n";
+  for (int frame = 0; frame < 40; ++frame) wide += "0 0 0\n";
+  v1::IngestClipResponse wide_response;
+  const grpc::Status too_wide = client.Ingest("wide.bvh", wide, &wide_response);
+  EXPECT_EQ(too_wide.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED)
+      << too_wide.error_message();
+  EXPECT_THAT(too_wide.error_message(), HasSubstr("bytes of memory"));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -369,12 +369,14 @@ class BvhStreamReader::Motion {
         options_(options),
         layout_(*skeleton_),
         values_(skeleton_->channel_count()),
-        line_(first_line) {
+        line_(first_line),
+        row_bytes_(static_cast<int64_t>(sizeof(double)) *
+                   (4 * skeleton_->joint_count() + 3 * skeleton_->position_joint_count())) {
     // Each value takes at least two bytes, which bounds the rows the text can hold; beyond the
     // hint the matrices grow by doubling, up to what the header says and then past it.
     capacity_ = static_cast<Eigen::Index>(std::min<size_t>(static_cast<size_t>(header.frames),
                                                            bytes_hint / (2 * values_.size()) + 1));
-    capacity_ = std::max<Eigen::Index>(capacity_, 1);
+    capacity_ = std::clamp<Eigen::Index>(capacity_, 1, options.max_clip_bytes / row_bytes_ + 1);
     rotations_.resize(capacity_, 4 * skeleton_->joint_count());
     positions_.resize(capacity_, 3 * skeleton_->position_joint_count());
   }
@@ -387,12 +389,14 @@ class BvhStreamReader::Motion {
       const char* newline = static_cast<const char*>(std::memchr(p, '\n', end - p));
       MOTIONDB_RETURN_IF_ERROR(ParseLine(absl::string_view(p, newline - p), false));
       p = newline + 1;
+      if (short_row_) return TextGoesOn(p < end);
     }
     return absl::OkStatus();
   }
 
   // One line without its newline; `unterminated`: the text ended inside it.
   absl::Status ParseLine(absl::string_view text, bool unterminated) {
+    MOTIONDB_RETURN_IF_ERROR(CheckRowLength(text.size()));
     const int channels = static_cast<int>(values_.size());
     const char* p = text.data();
     const char* const end = p + text.size();
@@ -435,7 +439,23 @@ class BvhStreamReader::Motion {
     return absl::OkStatus();
   }
 
+  // RESOURCE_EXHAUSTED when the line being read is over the options' limit.
+  absl::Status CheckRowLength(size_t bytes) const {
+    if (static_cast<int64_t>(bytes) <= options_.max_row_bytes) return absl::OkStatus();
+    return absl::ResourceExhaustedError(absl::StrCat("line ", line_,
+                                                     ": a frame row longer than the limit of ",
+                                                     options_.max_row_bytes, " bytes"));
+  }
+
+  // After a row short of values whose line ended where the text so far ends: whether more text
+  // follows decides its error (ReadBvh says "truncated" only of the text's last line).
+  bool has_short_row() const { return short_row_.has_value(); }
+  absl::Status TextGoesOn(bool goes_on) const {
+    return goes_on ? ShortRowError(/*truncated=*/false) : absl::OkStatus();
+  }
+
   absl::StatusOr<BvhReadResult> Finish() {
+    if (short_row_) return ShortRowError(/*truncated=*/true);
     if (rows_ == 0) {
       return absl::InvalidArgumentError(absl::StrCat(
           "line ", line_, ": expected frame rows after 'Frame Time:', found end of file"));
@@ -455,15 +475,30 @@ class BvhStreamReader::Motion {
   }
 
  private:
+  struct ShortRow {
+    int line;
+    int count;
+  };
+
+  absl::Status ShortRowError(bool truncated) const {
+    return absl::InvalidArgumentError(
+        absl::StrCat("line ", short_row_->line, ": expected ", values_.size(), " values, found ",
+                     short_row_->count, truncated ? " (the file is truncated)" : ""));
+  }
+
   absl::Status AddRow(int count, bool unterminated) {
     if (count != static_cast<int>(values_.size())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("line ", line_, ": expected ", values_.size(), " values, found ", count,
-                       unterminated ? " (the file is truncated)" : ""));
+      short_row_ = ShortRow{line_, count};
+      return unterminated ? ShortRowError(/*truncated=*/true) : absl::OkStatus();
     }
     if (rows_ == options_.max_frames) {
       return absl::ResourceExhaustedError(
           absl::StrCat("line ", line_, ": more than ", options_.max_frames, " frames"));
+    }
+    if ((rows_ + 1) * row_bytes_ > options_.max_clip_bytes) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "line ", line_, ": the clip would take more than ", options_.max_clip_bytes,
+          " bytes of memory (", row_bytes_, " a frame for ", skeleton_->joint_count(), " joints)"));
     }
     if (rows_ == capacity_) {
       // realloc: large blocks are mapped, so growing them moves pages rather than copying.
@@ -483,6 +518,8 @@ class BvhStreamReader::Motion {
   RowLayout layout_;
   std::vector<double> values_;  // one row's, in file order
   int line_;                    // of the next line
+  int64_t row_bytes_;           // a frame's in the matrices
+  std::optional<ShortRow> short_row_;
   Eigen::Index rows_ = 0;
   Eigen::Index capacity_ = 0;
   RowMatrixXd rotations_;
@@ -529,7 +566,7 @@ absl::Status BvhStreamReader::AppendToHeader(absl::string_view piece) {
   } else {
     pending_.append(piece.data(), piece.size());
     if (pending_.size() < next_header_attempt_) return absl::OkStatus();
-    const std::string text = std::move(pending_);
+    std::string text = std::move(pending_);
     pending_.clear();
     MOTIONDB_RETURN_IF_ERROR(ParseHeader(text, /*final=*/false));
     if (!motion_) pending_ = std::move(text);
@@ -542,13 +579,24 @@ absl::Status BvhStreamReader::ParseHeader(absl::string_view text, bool final) {
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   Scanner scanner(text);
   // An error or a header that ran into the end of the text may be a piece's cut: wait for more.
-  auto wait_for_more = [&] { return !final && scanner.reached_end(); };
+  // A parse that went past the header's limit is refused whether or not it ended there, so that
+  // the whole text and any pieces of it give the same error.
+  auto wait_for_more = [&]() -> absl::StatusOr<bool> {
+    if (static_cast<int64_t>(scanner.pos()) > options_.max_header_bytes) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("the header (HIERARCHY to the frame time) is over the limit of ",
+                       options_.max_header_bytes, " bytes"));
+    }
+    return !final && scanner.reached_end();
+  };
   absl::StatusOr<std::vector<Joint>> joints = ParseHierarchy(scanner, options_);
-  if (wait_for_more()) return absl::OkStatus();
+  MOTIONDB_ASSIGN_OR_RETURN(bool wait, wait_for_more());
+  if (wait) return absl::OkStatus();
   MOTIONDB_RETURN_IF_ERROR(joints.status());
   MOTIONDB_ASSIGN_OR_RETURN(Skeleton skeleton, Skeleton::Create(*std::move(joints)));
   const absl::StatusOr<MotionHeader> header = ParseMotionHeader(scanner, options_);
-  if (wait_for_more()) return absl::OkStatus();
+  MOTIONDB_ASSIGN_OR_RETURN(wait, wait_for_more());
+  if (wait) return absl::OkStatus();
   MOTIONDB_RETURN_IF_ERROR(header.status());
   if (skeleton.channel_count() == 0) {
     return absl::InvalidArgumentError("the hierarchy has no channels");
@@ -560,24 +608,27 @@ absl::Status BvhStreamReader::ParseHeader(absl::string_view text, bool final) {
 }
 
 absl::Status BvhStreamReader::AppendToMotion(absl::string_view piece) {
+  if (motion_->has_short_row()) return motion_->TextGoesOn(!piece.empty());
   if (!pending_.empty()) {
     const size_t newline = piece.find('\n');
     if (newline == absl::string_view::npos) {
       pending_.append(piece.data(), piece.size());
-      return absl::OkStatus();
+      return motion_->CheckRowLength(pending_.size());
     }
     pending_.append(piece.data(), newline);
     MOTIONDB_RETURN_IF_ERROR(motion_->ParseLine(pending_, /*unterminated=*/false));
     pending_.clear();
     piece.remove_prefix(newline + 1);
+    if (motion_->has_short_row()) return motion_->TextGoesOn(!piece.empty());
   }
   const size_t last_newline = piece.rfind('\n');
   if (last_newline != absl::string_view::npos) {
     MOTIONDB_RETURN_IF_ERROR(motion_->ParseLines(piece.substr(0, last_newline + 1)));
     piece.remove_prefix(last_newline + 1);
+    if (motion_->has_short_row()) return motion_->TextGoesOn(!piece.empty());
   }
   pending_.assign(piece.data(), piece.size());
-  return absl::OkStatus();
+  return motion_->CheckRowLength(pending_.size());
 }
 
 absl::StatusOr<BvhReadResult> ReadBvh(absl::string_view text, const BvhReadOptions& options) {

@@ -27,6 +27,16 @@ struct BvhReadOptions {
   // within a few turns, and an angle such as 1e308 keeps none of its digits through the sine
   // and cosine (it would be stored, and exported, as some other angle).
   double max_abs_rotation_degrees = 1e5;
+  // The header (HIERARCHY to the frame time's line) may be at most this long: 1000 joints take
+  // about 200 KB, and a stream waits for the whole header before it parses a row.
+  int64_t max_header_bytes = int64_t{4} << 20;
+  // A frame row may be at most this long (1000 joints of 6 values in 30 characters each take
+  // 180 KB): a stream holds a row until its newline arrives.
+  int64_t max_row_bytes = int64_t{1} << 20;
+  // The clip may take at most this much memory (every frame 32 bytes a joint, channels or not,
+  // and 24 a position joint), so that a small file of many joints and rows cannot make a huge
+  // clip; the server sets it to its upload budget.
+  int64_t max_clip_bytes = int64_t{16} << 30;
 };
 
 struct BvhReadResult {
@@ -37,9 +47,13 @@ struct BvhReadResult {
 
 // Parses BVH text that arrives in pieces (a streamed upload) as it arrives, holding the clip
 // being built and the unparsed tail of the last piece rather than the whole text. Whatever the
-// pieces, the result and the errors are ReadBvh's for their concatenation; an error is reported
-// by the Append() that completes the line it is on, so a client learns of it before it has sent
-// the rest. Not thread-safe.
+// pieces, the result and the errors are ReadBvh's for their concatenation, except that text over
+// `max_bytes` is refused when it arrives rather than before it is parsed. A row's error is
+// reported by the Append() that completes its line (a row short of values one byte later, when
+// it is known whether the text ends there: the error then says the file is truncated); a header
+// error once the text so far has doubled since the header was last tried, which keeps a header
+// sent in tiny pieces linear to parse. So a client learns of an error before it has sent the
+// rest. Not thread-safe.
 class BvhStreamReader {
  public:
   explicit BvhStreamReader(const BvhReadOptions& options = {});

@@ -17,6 +17,7 @@
 #include "motiondb/v1/clip_service.pb.h"
 #include "server/clip_ingest.h"
 #include "server/grpc/proto_conversion.h"
+#include "server/streamed_upload.h"
 #include "server/upload.h"
 #include "server/upload_budget.h"
 #include "util/status_macros.h"
@@ -44,8 +45,7 @@ absl::StatusOr<ReceivedUpload> ReceiveUpload(Reader& reader, Activity& activity,
   ReceivedUpload upload{std::move(request), std::move(bvh)};
   do {
     activity.Touch();
-    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(message.chunk().size())));
-    MOTIONDB_RETURN_IF_ERROR(upload.bvh.Append(message.chunk()));
+    MOTIONDB_RETURN_IF_ERROR(upload.bvh.Append(message.chunk(), ticket));
   } while (reader.Read(&message));
   MOTIONDB_RETURN_IF_ERROR(activity.Status());
   return upload;

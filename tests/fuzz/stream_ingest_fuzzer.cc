@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "server/grpc/stream_upload.h"
 #include "tests/fuzz/fuzz_library.h"
 
@@ -68,12 +69,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                  static_cast<long long>(limits.max_buffered_bytes));
     std::abort();
   }
-  if (!upload.ok()) {
-    fuzz::CheckNotInternal(upload.status(), "ReceiveUpload");
-    return 0;
-  }
   std::string whole;
   for (const IngestClipStreamRequest& message : messages.list) whole += message.chunk();
+  if (!upload.ok()) {
+    fuzz::CheckNotInternal(upload.status(), "ReceiveUpload");
+    // A parse error met while the chunks arrived must be the whole file's error.
+    const std::string name = messages.list.empty() ? "" : messages.list[0].file_name();
+    const bool parse_error = !name.empty() &&
+                             absl::StartsWith(upload.status().message(), name + ": ") &&
+                             static_cast<int64_t>(whole.size()) <= limits.max_bvh_bytes;
+    if (parse_error && server::ReadUpload(whole, name, limits).status() != upload.status()) {
+      std::fprintf(stderr, "streamed: %s\nwhole: %s\n", upload.status().ToString().c_str(),
+                   server::ReadUpload(whole, name, limits).status().ToString().c_str());
+      std::abort();
+    }
+    return 0;
+  }
   if (static_cast<int64_t>(whole.size()) > limits.max_bvh_bytes) std::abort();
   const absl::StatusOr<BvhReadResult> streamed = upload->bvh.Finish();
   const absl::StatusOr<BvhReadResult> read =
