@@ -11,9 +11,9 @@ StreamedUpload::StreamedUpload(std::string name, const UploadLimits& limits)
     : name_(std::move(name)), limits_(limits), reader_(UploadReadOptions(limits)) {}
 
 absl::Status StreamedUpload::Append(absl::string_view chunk, UploadBudget::Ticket& ticket) {
-  bytes_ += static_cast<int64_t>(chunk.size());
   // The file's own limit first: it is final, while the budget's refusal is worth a retry.
-  MOTIONDB_RETURN_IF_ERROR(Prefixed(name_, CheckUploadSize(bytes_, limits_)));
+  MOTIONDB_RETURN_IF_ERROR(Prefixed(
+      name_, CheckUploadSize(reader_.bytes() + static_cast<int64_t>(chunk.size()), limits_)));
   MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(chunk.size())));
   return Prefixed(name_, reader_.Append(chunk));
 }

@@ -1,4 +1,3 @@
-// A file that arrives in chunks (IngestClipStream), parsed as they arrive.
 #ifndef MOTIONDB_SERVER_STREAMED_UPLOAD_H_
 #define MOTIONDB_SERVER_STREAMED_UPLOAD_H_
 
@@ -29,7 +28,6 @@ class StreamedUpload {
  private:
   std::string name_;
   UploadLimits limits_;
-  int64_t bytes_ = 0;
   BvhStreamReader reader_;
 };
 

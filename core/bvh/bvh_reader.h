@@ -65,6 +65,8 @@ class BvhStreamReader {
   absl::Status Append(absl::string_view piece);
   // The text has ended: parses its unfinished last line and returns the clip. Call once.
   absl::StatusOr<BvhReadResult> Finish();
+  // Bytes appended so far.
+  int64_t bytes() const { return bytes_; }
 
  private:
   class Motion;
