@@ -685,6 +685,17 @@ TEST_F(HttpTest, ServesTheWebUiFilesWithTheirTypes) {
   EXPECT_EQ(error.code, 5);
   EXPECT_THAT(error.message, HasSubstr("not built"));
   EXPECT_THAT(error.message, HasSubstr("no-such-dist"));
+
+  // An empty web root (the image built where the npm registry was unreachable) is not built
+  // either: / says so rather than answering a bare 404.
+  std::filesystem::create_directory(dir_ / "empty-dist");
+  ServerProcess* empty = Start(
+      {"--web-root", (dir_ / "empty-dist").string(), "--db", (dir_ / "empty.sqlite").string()});
+  ASSERT_NE(empty, nullptr);
+  const ErrorAnswer empty_error = ErrorOf(HttpClient(*empty).Get("/"));
+  EXPECT_EQ(empty_error.status, 404);
+  EXPECT_THAT(empty_error.message, HasSubstr("not built"));
+  EXPECT_THAT(empty_error.message, HasSubstr("empty-dist"));
 }
 
 TEST_F(HttpTest, HealthAndReadiness) {

@@ -262,9 +262,15 @@ void AddOperationsRoutes(const ApiTranscoder& api, MotionDbServer& server, httpl
   });
 }
 
+// A web root counts as built when it holds the page: an image built without the npm registry
+// ships an empty one.
+bool WebRootIsBuilt(const std::string& root) {
+  return std::filesystem::is_regular_file(std::filesystem::path(root) / "index.html");
+}
+
 // The web UI's files from `root`, or, when it is not built, a 404 at / saying how to build it.
 void AddWebRoot(const std::string& root, httplib::Server& http) {
-  if (std::filesystem::is_directory(root) && http.set_mount_point("/", root)) {
+  if (WebRootIsBuilt(root) && http.set_mount_point("/", root)) {
     // Beyond httplib's own table: source maps and a charset for text.
     http.set_file_extension_and_mimetype_mapping("html", "text/html; charset=utf-8");
     http.set_file_extension_and_mimetype_mapping("js", "text/javascript; charset=utf-8");
@@ -276,7 +282,7 @@ void AddWebRoot(const std::string& root, httplib::Server& http) {
   http.Get("/", [root](const httplib::Request&, httplib::Response& response) {
     SendError(grpc::StatusCode::NOT_FOUND,
               absl::StrCat("the web UI is not built: ", root,
-                           " does not exist (scripts/start.sh builds it: npm ci and npm run "
+                           " holds no index.html (scripts/start.sh builds it: npm ci and npm run "
                            "build in web/; or pass --web-root DIR)"),
               response);
   });
@@ -350,8 +356,7 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
   }
   LogLine(absl::StrCat("HTTP on ", options.listen, " (http port ", bound, ")",
                        server.options().tls_cert_pem.empty() ? ", plain text" : ", HTTPS",
-                       "; web UI from ", web_root,
-                       std::filesystem::is_directory(web_root) ? "" : " (not built)"));
+                       "; web UI from ", web_root, WebRootIsBuilt(web_root) ? "" : " (not built)"));
   return std::unique_ptr<HttpServer>(new HttpServer(std::move(state)));
 }
 
