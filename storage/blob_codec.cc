@@ -1,5 +1,6 @@
 #include "storage/blob_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -35,7 +36,29 @@ absl::Status CheckFloat32Range(const RowMatrixXd& matrix, absl::string_view what
 }
 
 std::string Float32Blob(const RowMatrixXd& matrix) {
-  return Float32Blob(RowMatrixXf(matrix.cast<float>()));
+  std::string blob;
+  blob.reserve(matrix.size() * sizeof(float));
+  // The lambda cannot fail.
+  ForEachFloat32Piece(matrix, [&blob](absl::string_view piece) {
+    blob.append(piece.data(), piece.size());
+    return absl::OkStatus();
+  }).IgnoreError();
+  return blob;
+}
+
+absl::Status ForEachFloat32Piece(const RowMatrixXd& matrix,
+                                 absl::FunctionRef<absl::Status(absl::string_view)> consume) {
+  constexpr Eigen::Index kPieceValues = kFloat32PieceBytes / sizeof(float);
+  std::vector<float> values;
+  std::string piece;
+  for (Eigen::Index first = 0; first < matrix.size(); first += kPieceValues) {
+    const Eigen::Index count = std::min(kPieceValues, matrix.size() - first);
+    values.assign(matrix.data() + first, matrix.data() + first + count);
+    piece.clear();
+    AppendFloat32s(values.data(), values.size(), &piece);
+    MOTIONDB_RETURN_IF_ERROR(consume(piece));
+  }
+  return absl::OkStatus();
 }
 
 std::string Float32Blob(const RowMatrixXf& matrix) {

@@ -5,10 +5,12 @@
 #ifndef MOTIONDB_STORAGE_BLOB_CODEC_H_
 #define MOTIONDB_STORAGE_BLOB_CODEC_H_
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "absl/functional/function_ref.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -22,6 +24,12 @@ absl::Status CheckFloat32Range(const RowMatrixXd& matrix, absl::string_view what
 
 // Row-major little-endian float32; doubles are rounded to the nearest float.
 std::string Float32Blob(const RowMatrixXd& matrix);
+// Float32Blob(matrix)'s bytes in order, in pieces of at most kFloat32PieceBytes handed to
+// `consume` (its first error stops the loop and is returned): a blob written or hashed this way
+// is never whole in memory.
+inline constexpr size_t kFloat32PieceBytes = size_t{1} << 20;
+absl::Status ForEachFloat32Piece(const RowMatrixXd& matrix,
+                                 absl::FunctionRef<absl::Status(absl::string_view)> consume);
 std::string Float32Blob(const RowMatrixXf& matrix);
 // DATA_LOSS naming `what` when the blob is not rows x cols floats.
 absl::StatusOr<RowMatrixXf> ParseFloat32Blob(absl::string_view blob, int64_t rows, int64_t cols,

@@ -17,6 +17,7 @@
 #include "storage/internal/database_impl.h"
 #include "storage/internal/record_checks.h"
 #include "storage/internal/record_rows.h"
+#include "storage/sqlite_blob.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -92,6 +93,19 @@ absl::Status InsertTags(SqliteConnection& db, int64_t clip_id,
 
 // The records, tags included, of the rows `query` returns: bound, and selecting
 // kClipRecordColumns of clips as `c`.
+// The rotation blob of the clip row `clip_id`, inserted as a zero blob of its size, written
+// in pieces (the column is the row's last: storage/schema.cc, migration 5).
+absl::Status WriteRotations(SqliteConnection& db, int64_t clip_id, const RowMatrixXd& rotations) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob blob,
+                            SqliteBlob::OpenForWrite(db, "clips", "rotations", clip_id));
+  int64_t offset = 0;
+  return ForEachFloat32Piece(rotations, [&](absl::string_view piece) {
+    MOTIONDB_RETURN_IF_ERROR(blob.Write(piece, offset));
+    offset += static_cast<int64_t>(piece.size());
+    return absl::OkStatus();
+  });
+}
+
 absl::StatusOr<std::vector<ClipRecord>> ReadClipRecords(SqliteConnection& db,
                                                         SqliteStatement& query) {
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
@@ -215,10 +229,9 @@ absl::StatusOr<int64_t> Database::InsertClip(
   // Encoded before the write lock, which other writers wait for.
   const std::string key = TopologyKey(clip.skeleton());
   const std::string layout = SkeletonLayoutBlob(clip.skeleton());
-  const std::string rotations = Float32Blob(clip.rotations());
   const std::string positions = Float32Blob(clip.positions());
-  MOTIONDB_ASSIGN_OR_RETURN(const std::string content_hash,
-                            ContentHashOfBlobs(clip.frame_time(), layout, rotations, positions));
+  // The rotations, the largest blob, are hashed and written in pieces, never encoded whole.
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string content_hash, ContentHash(clip));
   const int64_t now = CreationTime(record.created_unix_ms);
 
   int64_t clip_id = 0;
@@ -245,13 +258,14 @@ absl::StatusOr<int64_t> Database::InsertClip(
                                  .BindInt64(6, clip.skeleton().joint_count())
                                  .BindInt64(7, clip.skeleton().position_joint_count())
                                  .BindBlob(8, layout)
-                                 .BindBlob(9, rotations)
+                                 .BindZeroBlob(9, clip.rotations().size() * sizeof(float))
                                  .BindBlob(10, positions)
                                  .BindInt64(11, now)
                                  .BindText(12, content_hash)
                                  .BindText(13, record.provenance)
                                  .Run());
     clip_id = db.last_insert_rowid();
+    MOTIONDB_RETURN_IF_ERROR(WriteRotations(db, clip_id, clip.rotations()));
     MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, tags));
     return InsertProjectionsOfClip(db, clip_id, skeleton_id, projections);
   }));

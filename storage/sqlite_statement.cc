@@ -58,6 +58,10 @@ SqliteStatement& SqliteStatement::BindBlob(int index, absl::string_view bytes) {
   return Check(sqlite3_bind_blob64(stmt_, index, bytes.data(), bytes.size(), SQLITE_STATIC), index);
 }
 
+SqliteStatement& SqliteStatement::BindZeroBlob(int index, int64_t bytes) {
+  return Check(sqlite3_bind_zeroblob64(stmt_, index, static_cast<sqlite3_uint64>(bytes)), index);
+}
+
 absl::StatusOr<bool> SqliteStatement::Step() {
   if (!bind_status_.ok()) return bind_status_;
   const int rc = sqlite3_step(stmt_);

@@ -35,6 +35,9 @@ class SqliteStatement {
   SqliteStatement& BindDouble(int index, double value);
   SqliteStatement& BindText(int index, absl::string_view text);
   SqliteStatement& BindBlob(int index, absl::string_view bytes);
+  // A blob of `bytes` zeros, which SQLite keeps as a count when it is the row's last column;
+  // SqliteBlob writes its bytes afterwards.
+  SqliteStatement& BindZeroBlob(int index, int64_t bytes);
 
   // Advances to the next row: true on a row, false when the statement is done.
   absl::StatusOr<bool> Step();

@@ -26,6 +26,7 @@
 
 #include "absl/strings/escaping.h"
 #include "core/space/space_serialization.h"
+#include "storage/blob_codec.h"
 #include "storage/content_hash.h"
 #include "storage/schema.h"
 #include "storage/sqlite_connection.h"
@@ -152,9 +153,31 @@ class StorageTest : public ::testing::Test {
     EXPECT_TRUE(counts.ok()) << counts.status();
     return counts.value_or(Counts{});
   }
+  // Stores `walk` as "walk" (tagged x), then "session1/run" of `run_frames` frames: the two
+  // records by id, for the tests of older schemas.
+  std::map<int64_t, ClipRecord> StoreWalkAndRun(const Clip& walk, int run_frames) {
+    const int64_t a = Insert(Named("walk", {"x"}), walk);
+    const int64_t b =
+        Insert(Named("session1/run"), Motion(testing::ChainSkeleton(), run_frames, 2));
+    std::map<int64_t, ClipRecord> records;
+    for (const int64_t id : {a, b}) records[id] = *Db().GetClipRecord(id);
+    return records;
+  }
+  // Expects the clip `id` readable, with `expected`'s name, tags, content hash and frames.
+  void ExpectKept(int64_t id, const ClipRecord& expected) {
+    const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->name, expected.name);
+    EXPECT_EQ(record->tags, expected.tags);
+    EXPECT_EQ(record->content_hash, expected.content_hash);
+    EXPECT_EQ(record->frame_count, expected.frame_count);
+    const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
+    EXPECT_TRUE(stored.ok()) << stored.status();
+  }
   // Closes the database and copies its skeletons, clips and tags into a new file at schema
   // `version`, made by its own migrations, whose clips table has `clip_columns`; path_ then names
-  // that file. Checks the copy has the version and lacks `missing_column` of clips.
+  // that file. Checks the copy has the version and lacks `missing_column` of clips (unless
+  // empty).
   void CopyToOldSchema(int version, const std::string& clip_columns,
                        const std::string& missing_column) {
     Close();
@@ -170,10 +193,12 @@ class StorageTest : public ::testing::Test {
         "INSERT INTO clip_tags SELECT * FROM current.clip_tags;", "DETACH DATABASE current"));
     ASSERT_TRUE(copied.ok()) << copied;
     EXPECT_EQ(*(*old)->QueryInt64("PRAGMA user_version"), version);
-    EXPECT_EQ(
-        *(*old)->QueryInt64(absl::StrCat(
-            "SELECT count(*) FROM pragma_table_info('clips') WHERE name = '", missing_column, "'")),
-        0);
+    if (!missing_column.empty()) {
+      EXPECT_EQ(*(*old)->QueryInt64(
+                    absl::StrCat("SELECT count(*) FROM pragma_table_info('clips') WHERE name = '",
+                                 missing_column, "'")),
+                0);
+    }
     path_ = old_path;
   }
   // A raw connection, to look at and damage what the Database wrote.
@@ -1019,16 +1044,95 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   EXPECT_GT(Insert(Named("new"), walk), c);
 }
 
+// The rotation blob, written in pieces after a zero blob (storage/sqlite_blob.h), holds exactly
+// the bytes of the clip's rotations in float32, and the stored hash is that of the stored
+// columns. 20000 frames of 19 joints are 5.8 MiB of rotations: six pieces, the last a part one.
+TEST_F(StorageTest, RotationsWrittenInPiecesAreTheWholeBlob) {
+  const std::shared_ptr<const Skeleton> skeleton = testing::HumanoidSkeleton(/*still_root=*/false);
+  const Clip clip = Motion(skeleton, 20000, 4);
+  ASSERT_GT(clip.rotations().size() * sizeof(float), 5 * kFloat32PieceBytes);
+  ASSERT_NE(clip.rotations().size() * sizeof(float) % kFloat32PieceBytes, 0u);
+  const int64_t id = Insert(Named("long"), clip);
+  const std::string hash = Db().GetClipRecord(id)->content_hash;
+  Close();
+  {
+    std::unique_ptr<SqliteConnection> raw = Raw();
+    absl::StatusOr<SqliteStatement> row = raw->Prepare(
+        "SELECT frame_time, layout, rotations, positions FROM clips WHERE clip_id = ?");
+    ASSERT_TRUE(row.ok()) << row.status();
+    ASSERT_TRUE(*row->BindInt64(1, id).Step());
+    EXPECT_TRUE(row->ColumnBlob(2) == Float32Blob(clip.rotations()));
+    EXPECT_EQ(*ContentHashOfBlobs(row->ColumnDouble(0), row->ColumnBlob(1), row->ColumnBlob(2),
+                                  row->ColumnBlob(3)),
+              hash);
+  }
+  EXPECT_EQ(*ContentHash(clip), hash);
+  const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  EXPECT_TRUE(stored->clip.rotations().isApprox(clip.rotations(), 1e-6));
+}
+
+// A file of schema version 4 keeps its clips, bit for bit, when version 5 moves the rotation
+// blob to the end of the row (so that an insert can write it in pieces), and a NULL rotation
+// blob is refused as before, by a trigger now.
+TEST_F(StorageTest, SchemaFourFileKeepsItsClipsWithTheRotationsLast) {
+  const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
+  // A run long enough that the rewrites leave most of the file free.
+  std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 8000);
+  const int64_t a = expected.begin()->first;
+  const int64_t b = expected.rbegin()->first;
+  const std::string columns =
+      "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+      "position_joint_count, layout, rotations, positions, created_unix_ms, content_hash, "
+      "provenance";
+  CopyToOldSchema(4, columns, "");
+  const std::string last_column =
+      "SELECT name FROM pragma_table_info('clips') ORDER BY cid DESC LIMIT 1";
+  EXPECT_EQ(*Raw()->QueryText(last_column), "provenance");
+  std::map<int64_t, std::string> old_rotations;
+  for (const int64_t id : {a, b}) {
+    old_rotations[id] =
+        *Raw()->QueryText(absl::StrCat("SELECT hex(rotations) FROM clips WHERE clip_id = ", id));
+  }
+
+  for (const int64_t id : {a, b}) ExpectKept(id, expected[id]);
+  EXPECT_TRUE(Db().GetClip(a)->clip.rotations().isApprox(walk.rotations(), 1e-6));
+  const int64_t c = Insert(Named("new"), walk);
+  EXPECT_EQ(Db().GetClipRecord(c)->content_hash, expected[a].content_hash);
+  Close();
+  std::unique_ptr<SqliteConnection> raw = Raw();
+  EXPECT_EQ(*raw->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  EXPECT_EQ(*raw->QueryText(last_column), "rotations");
+  // The pages the rewrites freed were given back (VACUUM): the file did not double.
+  EXPECT_LE(4 * *raw->QueryInt64("PRAGMA freelist_count"), *raw->QueryInt64("PRAGMA page_count"));
+  for (const int64_t id : {a, b}) {
+    EXPECT_EQ(
+        *raw->QueryText(absl::StrCat("SELECT hex(rotations) FROM clips WHERE clip_id = ", id)),
+        old_rotations[id]);
+  }
+  const absl::Status null_update =
+      raw->Execute(absl::StrCat("UPDATE clips SET rotations = NULL WHERE clip_id = ", a));
+  EXPECT_THAT(null_update.message(), HasSubstr("NOT NULL constraint failed: clips.rotations"));
+  const absl::Status null_insert = raw->Execute(
+      "INSERT INTO clips (name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+      "position_joint_count, layout, positions, created_unix_ms) SELECT 'null', '', skeleton_id, "
+      "frame_time, frame_count, joint_count, position_joint_count, layout, positions, 0 "
+      "FROM clips WHERE clip_id = " +
+      std::to_string(a));
+  EXPECT_THAT(null_insert.message(), HasSubstr("NOT NULL constraint failed: clips.rotations"));
+  const absl::Status short_blob =
+      raw->Execute(absl::StrCat("UPDATE clips SET rotations = x'00' WHERE clip_id = ", a));
+  EXPECT_THAT(short_blob.message(), HasSubstr("CHECK constraint failed"));
+}
+
 // A file of schema version 3, as builds before the operators (issue 16) wrote it, keeps its
 // clips when opened and gains what version 4 adds: each clip's provenance (none for an ingested
 // clip) and the pose models' table.
 TEST_F(StorageTest, SchemaThreeFileKeepsItsClipsAndGainsProvenanceAndPoseModels) {
   const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
-  const int64_t a = Insert(Named("walk", {"x"}), walk);
-  const int64_t b = Insert(Named("session1/run"), Motion(testing::ChainSkeleton(), 30, 2));
-  std::map<int64_t, ClipRecord> expected;
-  for (const int64_t id : {a, b}) expected[id] = *Db().GetClipRecord(id);
-  Close();
+  std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 30);
+  const int64_t a = expected.begin()->first;
+  const int64_t b = expected.rbegin()->first;
 
   CopyToOldSchema(3,
                   "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
@@ -1038,15 +1142,8 @@ TEST_F(StorageTest, SchemaThreeFileKeepsItsClipsAndGainsProvenanceAndPoseModels)
   EXPECT_EQ(*Raw()->QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'pose_models'"), 0);
 
   for (const int64_t id : {a, b}) {
-    const absl::StatusOr<ClipRecord> record = Db().GetClipRecord(id);
-    ASSERT_TRUE(record.ok()) << record.status();
-    EXPECT_EQ(record->name, expected[id].name);
-    EXPECT_EQ(record->tags, expected[id].tags);
-    EXPECT_EQ(record->content_hash, expected[id].content_hash);
-    EXPECT_EQ(record->frame_count, expected[id].frame_count);
-    EXPECT_EQ(record->provenance, "");
-    const absl::StatusOr<StoredClip> stored = Db().GetClip(id);
-    ASSERT_TRUE(stored.ok()) << stored.status();
+    ExpectKept(id, expected[id]);
+    EXPECT_EQ(Db().GetClipRecord(id)->provenance, "");
   }
   EXPECT_EQ(Db().GetClip(a)->clip.frame_count(), 20);
   const absl::StatusOr<std::vector<PoseModelRecord>> models = Db().ListPoseModels();
