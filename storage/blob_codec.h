@@ -24,13 +24,13 @@ absl::Status CheckFloat32Range(const RowMatrixXd& matrix, absl::string_view what
 
 // Row-major little-endian float32; doubles are rounded to the nearest float.
 std::string Float32Blob(const RowMatrixXd& matrix);
+std::string Float32Blob(const RowMatrixXf& matrix);
 // Float32Blob(matrix)'s bytes in order, in pieces of at most kFloat32PieceBytes handed to
 // `consume` (its first error stops the loop and is returned): a blob written or hashed this way
 // is never whole in memory.
 inline constexpr size_t kFloat32PieceBytes = size_t{1} << 20;
 absl::Status ForEachFloat32Piece(const RowMatrixXd& matrix,
                                  absl::FunctionRef<absl::Status(absl::string_view)> consume);
-std::string Float32Blob(const RowMatrixXf& matrix);
 // DATA_LOSS naming `what` when the blob is not rows x cols floats.
 absl::StatusOr<RowMatrixXf> ParseFloat32Blob(absl::string_view blob, int64_t rows, int64_t cols,
                                              absl::string_view what);

@@ -91,21 +91,26 @@ absl::Status InsertTags(SqliteConnection& db, int64_t clip_id,
   return absl::OkStatus();
 }
 
-// The records, tags included, of the rows `query` returns: bound, and selecting
-// kClipRecordColumns of clips as `c`.
 // The rotation blob of the clip row `clip_id`, inserted as a zero blob of its size, written
 // in pieces (the column is the row's last: storage/schema.cc, migration 5).
 absl::Status WriteRotations(SqliteConnection& db, int64_t clip_id, const RowMatrixXd& rotations) {
-  MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob blob,
-                            SqliteBlob::OpenForWrite(db, "clips", "rotations", clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob blob, SqliteBlob::Open(db, "clips", "rotations", clip_id,
+                                                              SqliteBlob::Mode::kWrite));
   int64_t offset = 0;
-  return ForEachFloat32Piece(rotations, [&](absl::string_view piece) {
+  MOTIONDB_RETURN_IF_ERROR(ForEachFloat32Piece(rotations, [&](absl::string_view piece) {
     MOTIONDB_RETURN_IF_ERROR(blob.Write(piece, offset));
     offset += static_cast<int64_t>(piece.size());
     return absl::OkStatus();
-  });
+  }));
+  if (offset != blob.size()) {
+    return absl::InternalError(absl::StrCat("wrote ", offset, " bytes of clip ", clip_id,
+                                            "'s rotation blob of ", blob.size()));
+  }
+  return absl::OkStatus();
 }
 
+// The records, tags included, of the rows `query` returns: bound, and selecting
+// kClipRecordColumns of clips as `c`.
 absl::StatusOr<std::vector<ClipRecord>> ReadClipRecords(SqliteConnection& db,
                                                         SqliteStatement& query) {
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
@@ -226,11 +231,12 @@ absl::StatusOr<int64_t> Database::InsertClip(
     MOTIONDB_RETURN_IF_ERROR(CheckProjection(projection.coordinates, std::nullopt,
                                              absl::StrCat("projection into space ", space_id)));
   }
-  // Encoded before the write lock, which other writers wait for.
+  // Encoded before the write lock, which other writers wait for; the rotations, the largest
+  // blob, are never encoded whole: hashed in pieces here, converted again piece by piece under
+  // the lock as they are written (a conversion costs far less than holding a second copy).
   const std::string key = TopologyKey(clip.skeleton());
   const std::string layout = SkeletonLayoutBlob(clip.skeleton());
   const std::string positions = Float32Blob(clip.positions());
-  // The rotations, the largest blob, are hashed and written in pieces, never encoded whole.
   MOTIONDB_ASSIGN_OR_RETURN(const std::string content_hash, ContentHash(clip));
   const int64_t now = CreationTime(record.created_unix_ms);
 

@@ -1,10 +1,15 @@
 #include "storage/schema.h"
 
+#include <algorithm>
 #include <array>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "storage/blob_codec.h"
 #include "storage/content_hash.h"
+#include "storage/sqlite_blob.h"
 #include "storage/sqlite_transaction.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -153,16 +158,19 @@ CREATE INDEX pose_models_by_space ON pose_models (space_id);
 )sql";
 
 // Each clip's rotation blob, its largest by far, moved to the end of its row (issue 15): an
-// insert then gives it as a zero blob, which SQLite keeps as a count only when no column with
+// insert then binds it as a zero blob, which SQLite keeps as a count only when no column with
 // bytes follows it, and writes it in pieces (sqlite3_blob_write), so that storing a clip never
 // holds a second copy of it in memory (a blob elsewhere in the row is copied into the record
-// being built, a zero blob expanded). SQLite cannot move a column: a new one is added, filled,
-// the old dropped, the new renamed (each rewrites the table once). A column added to rows that
-// exist cannot be NOT NULL without a default, so triggers refuse NULL instead.
+// being built, a zero blob expanded). Any column added to clips later lands after it and must
+// hold no bytes for that to stay true (the schema tests check the last column). SQLite cannot
+// move a column: a new one is added, filled by CopyRotationsLast, the old dropped, the new
+// renamed. A column added to rows that exist cannot be NOT NULL without a default, so triggers
+// refuse NULL instead.
 constexpr const char* kMigration5 = R"sql(
 ALTER TABLE clips ADD COLUMN rotations_last BLOB
   CHECK (length(rotations_last) = 16 * frame_count * joint_count);
-UPDATE clips SET rotations_last = rotations;
+)sql";
+constexpr const char* kMigration5Finish = R"sql(
 ALTER TABLE clips DROP COLUMN rotations;
 ALTER TABLE clips RENAME COLUMN rotations_last TO rotations;
 CREATE TRIGGER clips_rotations_insert_not_null BEFORE INSERT ON clips
@@ -172,6 +180,42 @@ CREATE TRIGGER clips_rotations_update_not_null BEFORE UPDATE OF rotations ON cli
   WHEN NEW.rotations IS NULL
   BEGIN SELECT RAISE(ABORT, 'NOT NULL constraint failed: clips.rotations'); END;
 )sql";
+
+// Migration 5's copy, a row at a time and in 1 MiB pieces: one `UPDATE clips SET
+// rotations_last = rotations` held each blob several times over (measured: +1.4 GiB for one
+// 286 MiB blob) and a statement journal of the whole table on disk.
+absl::Status CopyRotationsLast(SqliteConnection& connection) {
+  std::vector<std::pair<int64_t, int64_t>> clips;  // id, rotation bytes
+  {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement sizes,
+        connection.Prepare("SELECT clip_id, length(rotations) FROM clips ORDER BY clip_id"));
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, sizes.Step());
+      if (!row) break;
+      clips.emplace_back(sizes.ColumnInt64(0), sizes.ColumnInt64(1));
+    }
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement make_room,
+      connection.Prepare("UPDATE clips SET rotations_last = ? WHERE clip_id = ?"));
+  std::string piece;
+  for (const auto& [clip_id, bytes] : clips) {
+    make_room.Reset();
+    MOTIONDB_RETURN_IF_ERROR(make_room.BindZeroBlob(1, bytes).BindInt64(2, clip_id).Run());
+    using Mode = SqliteBlob::Mode;
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteBlob from, SqliteBlob::Open(connection, "clips", "rotations", clip_id, Mode::kRead));
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob to, SqliteBlob::Open(connection, "clips", "rotations_last",
+                                                              clip_id, Mode::kWrite));
+    for (int64_t offset = 0; offset < bytes; offset += static_cast<int64_t>(piece.size())) {
+      const int64_t count = std::min<int64_t>(bytes - offset, kFloat32PieceBytes);
+      MOTIONDB_RETURN_IF_ERROR(from.Read(offset, count, piece));
+      MOTIONDB_RETURN_IF_ERROR(to.Write(piece, offset));
+    }
+  }
+  return absl::OkStatus();
+}
 
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
@@ -206,29 +250,38 @@ absl::Status BackfillContentHashes(SqliteConnection& connection) {
   return absl::OkStatus();
 }
 
-// A schema step: its SQL, then the C++ that fills what SQL cannot (or null).
+// A schema step: its SQL, then the C++ that fills what SQL cannot (or null), then SQL that
+// needs what the C++ filled (or null).
 struct Migration {
   const char* sql;
-  absl::Status (*backfill)(SqliteConnection& connection);
+  absl::Status (*backfill)(SqliteConnection& connection) = nullptr;
+  const char* finish_sql = nullptr;
 };
 
 // Append only: a file at version i has run exactly the first i entries.
+// clang-format off
 constexpr std::array kMigrations = {
-    Migration{kMigration1, nullptr}, Migration{kMigration2, BackfillContentHashes},
-    Migration{kMigration3, nullptr}, Migration{kMigration4, nullptr},
-    Migration{kMigration5, nullptr},
+    Migration{kMigration1},
+    Migration{kMigration2, BackfillContentHashes},
+    Migration{kMigration3},
+    Migration{kMigration4},
+    Migration{kMigration5, CopyRotationsLast, kMigration5Finish},
 };
+// clang-format on
 
 // A migration that rewrites a table (5 rewrites the clips twice) leaves its old pages free in
 // the file, which would keep up to twice its size until later writes reuse them: VACUUM when
-// more than a quarter of the file is free (measured: 4.7 s for a 714 MB file after migration 5,
-// which took 27 s). Best effort: the file is whole and migrated either way, and VACUUM fails
-// only for want of disk (it writes a copy) or while another process reads.
+// more than a quarter of the file is free (measured: 4.7 s for a 714 MB file after migration
+// 5), then empty the write-ahead log the rewrites filled. Best effort: the file is whole and
+// migrated either way. VACUUM fails for want of disk (it writes a copy of the file) or while
+// another process holds the write lock; the file then keeps its size, its free pages reused by
+// later writes (`sqlite3 FILE VACUUM` offline compacts it; server/README.md).
 void ReclaimFreedPages(SqliteConnection& connection) {
   const absl::StatusOr<int64_t> free_pages = connection.QueryInt64("PRAGMA freelist_count");
   const absl::StatusOr<int64_t> pages = connection.QueryInt64("PRAGMA page_count");
   if (free_pages.ok() && pages.ok() && 4 * *free_pages > *pages) {
     connection.Execute("VACUUM").IgnoreError();
+    connection.Execute("PRAGMA wal_checkpoint(TRUNCATE)").IgnoreError();
   }
 }
 
@@ -278,6 +331,9 @@ absl::Status MigrateSchema(SqliteConnection& connection, int target_version) {
     MOTIONDB_RETURN_IF_ERROR(Prefixed(step, connection.Execute(migration.sql)));
     if (migration.backfill != nullptr) {
       MOTIONDB_RETURN_IF_ERROR(Prefixed(step, migration.backfill(connection)));
+    }
+    if (migration.finish_sql != nullptr) {
+      MOTIONDB_RETURN_IF_ERROR(Prefixed(step, connection.Execute(migration.finish_sql)));
     }
   }
   // PRAGMAs take no parameters; both values are numbers of ours.

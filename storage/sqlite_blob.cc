@@ -7,12 +7,12 @@
 
 namespace motiondb::storage {
 
-absl::StatusOr<SqliteBlob> SqliteBlob::OpenForWrite(SqliteConnection& db, const char* table,
-                                                    const char* column, int64_t rowid) {
+absl::StatusOr<SqliteBlob> SqliteBlob::Open(SqliteConnection& db, const char* table,
+                                            const char* column, int64_t rowid, Mode mode) {
   sqlite3_blob* blob = nullptr;
-  const int rc = sqlite3_blob_open(db.handle(), "main", table, column, rowid, /*flags=*/1, &blob);
+  const int rc = sqlite3_blob_open(db.handle(), "main", table, column, rowid,
+                                   mode == Mode::kWrite ? 1 : 0, &blob);
   if (rc != SQLITE_OK) {
-    sqlite3_blob_close(blob);  // sqlite3_blob_open may leave a handle to close even on failure
     return SqliteStatus(db.handle(), rc,
                         absl::StrCat("opening ", table, ".", column, " of row ", rowid));
   }
@@ -33,17 +33,30 @@ SqliteBlob& SqliteBlob::operator=(SqliteBlob&& other) noexcept {
 
 SqliteBlob::~SqliteBlob() { sqlite3_blob_close(blob_); }
 
-absl::Status SqliteBlob::Write(absl::string_view bytes, int64_t offset) {
-  const int64_t size = sqlite3_blob_bytes(blob_);
-  if (offset < 0 || offset > size || static_cast<int64_t>(bytes.size()) > size - offset) {
+absl::Status SqliteBlob::CheckRange(int64_t offset, int64_t bytes) const {
+  if (offset < 0 || bytes < 0 || offset > size() || bytes > size() - offset) {
     return absl::OutOfRangeError(
-        absl::StrCat("writing ", bytes.size(), " bytes at ", offset, " into a blob of ", size));
+        absl::StrCat(bytes, " bytes at ", offset, " of a blob of ", size()));
   }
-  const int rc = sqlite3_blob_write(blob_, bytes.data(), static_cast<int>(bytes.size()),
-                                    static_cast<int>(offset));
-  if (rc != SQLITE_OK) {
-    return SqliteStatus(db_, rc, absl::StrCat("writing ", bytes.size(), " bytes of a blob"));
-  }
+  return absl::OkStatus();
+}
+
+absl::Status SqliteBlob::Read(int64_t offset, int64_t bytes, std::string& out) {
+  if (absl::Status range = CheckRange(offset, bytes); !range.ok()) return range;
+  out.resize(static_cast<size_t>(bytes));
+  // Blobs are at most SQLITE_MAX_LENGTH (1e9) bytes, so a checked range fits an int.
+  const int rc =
+      sqlite3_blob_read(blob_, out.data(), static_cast<int>(bytes), static_cast<int>(offset));
+  if (rc != SQLITE_OK) return SqliteStatus(db_, rc, absl::StrCat("reading a blob at ", offset));
+  return absl::OkStatus();
+}
+
+absl::Status SqliteBlob::Write(absl::string_view bytes, int64_t offset) {
+  const int64_t count = static_cast<int64_t>(bytes.size());
+  if (absl::Status range = CheckRange(offset, count); !range.ok()) return range;
+  const int rc =
+      sqlite3_blob_write(blob_, bytes.data(), static_cast<int>(count), static_cast<int>(offset));
+  if (rc != SQLITE_OK) return SqliteStatus(db_, rc, absl::StrCat("writing a blob at ", offset));
   return absl::OkStatus();
 }
 

@@ -185,6 +185,8 @@ class StorageTest : public ::testing::Test {
     absl::StatusOr<std::unique_ptr<SqliteConnection>> old =
         SqliteConnection::Open(old_path, SqliteConnection::Mode::kReadWriteCreate, 1000);
     ASSERT_TRUE(old.ok()) << old.status();
+    // In WAL mode, as every build's server leaves its file.
+    ASSERT_EQ(*(*old)->QueryText("PRAGMA journal_mode = WAL"), "wal");
     ASSERT_TRUE(MigrateSchema(**old, version).ok());
     const absl::Status copied = (*old)->Execute(absl::StrCat(
         "ATTACH DATABASE '", path_, "' AS current;",
@@ -1077,8 +1079,9 @@ TEST_F(StorageTest, RotationsWrittenInPiecesAreTheWholeBlob) {
 // blob is refused as before, by a trigger now.
 TEST_F(StorageTest, SchemaFourFileKeepsItsClipsWithTheRotationsLast) {
   const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
-  // A run long enough that the rewrites leave most of the file free.
-  std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 8000);
+  // A run long enough that the rewrites leave most of the file free, and whose rotations
+  // (25000 frames x 3 joints x 16 bytes, 1.14 MiB) are copied in two pieces.
+  std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 25000);
   const int64_t a = expected.begin()->first;
   const int64_t b = expected.rbegin()->first;
   const std::string columns =
@@ -1103,6 +1106,8 @@ TEST_F(StorageTest, SchemaFourFileKeepsItsClipsWithTheRotationsLast) {
   std::unique_ptr<SqliteConnection> raw = Raw();
   EXPECT_EQ(*raw->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
   EXPECT_EQ(*raw->QueryText(last_column), "rotations");
+  // Migrated under a rollback journal, the file is back in WAL mode.
+  EXPECT_EQ(*raw->QueryText("PRAGMA journal_mode"), "wal");
   // The pages the rewrites freed were given back (VACUUM): the file did not double.
   EXPECT_LE(4 * *raw->QueryInt64("PRAGMA freelist_count"), *raw->QueryInt64("PRAGMA page_count"));
   for (const int64_t id : {a, b}) {

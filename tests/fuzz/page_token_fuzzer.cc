@@ -15,13 +15,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace motiondb;
   fuzz::FuzzLibrary& library = fuzz::TheFuzzLibrary();
   FuzzedDataProvider input(data, size);
-  server::PageRequest page;
-  page.page_size = input.ConsumeIntegral<int>();
-  server::ClipListRequest filter;
-  filter.sort = input.ConsumeRandomLengthString(16);
-  filter.tag = input.ConsumeRandomLengthString(16);
-  filter.name_contains = input.ConsumeRandomLengthString(16);
-  page.page_token = input.ConsumeRandomLengthString(64);
+  server::ClipListRequest clips;
+  clips.page.page_size = input.ConsumeIntegral<int>();
+  clips.sort = input.ConsumeRandomLengthString(16);
+  clips.tag = input.ConsumeRandomLengthString(16);
+  clips.name_contains = input.ConsumeRandomLengthString(16);
+  clips.skeleton_id = input.ConsumeIntegral<int64_t>();
+  clips.descriptor = input.ConsumeRandomLengthString(16);
+  clips.page.page_token = input.ConsumeRandomLengthString(64);
+  server::PageRequest& page = clips.page;
   const bool spaces = input.ConsumeBool();
   for (int turn = 0; turn < 4; ++turn) {
     std::string next;
@@ -31,8 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!listed.ok()) break;
       next = listed->next_page_token;
     } else {
-      const absl::StatusOr<storage::ClipPage> listed =
-          server::ListClips(*library.database, page, filter);
+      const absl::StatusOr<storage::ClipPage> listed = server::ListClips(*library.database, clips);
       fuzz::CheckNotInternal(listed.status(), "ListClips");
       if (!listed.ok()) break;
       next = listed->next_page_token;
