@@ -10,8 +10,10 @@
 namespace motiondb {
 namespace {
 
-// Row `position` (fractional) of `samples` by linear interpolation, clamped to its ends.
-Eigen::RowVectorXd ReadAt(const RowMatrixXd& samples, double position) {
+// Row `position` (fractional) of `samples` by linear interpolation, clamped to its ends. A Ref,
+// so that the curve is not copied whole for every row read (a `const RowMatrixXd&` made a
+// temporary of the Ref'd curve at each call: 512 copies of the curve per smoothing).
+Eigen::RowVectorXd ReadAt(const Eigen::Ref<const RowMatrixXd>& samples, double position) {
   const double last = static_cast<double>(samples.rows() - 1);
   position = std::clamp(position, 0.0, last);
   const Eigen::Index low = static_cast<Eigen::Index>(std::floor(position));
