@@ -1046,6 +1046,12 @@ TEST_F(StorageTest, SchemaOneFileIsMigratedAndBackfilled) {
   EXPECT_GT(Insert(Named("new"), walk), c);
 }
 
+// The clips table's columns at schema version 4, for CopyToOldSchema.
+constexpr const char* kSchemaFourClipColumns =
+    "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
+    "position_joint_count, layout, rotations, positions, created_unix_ms, content_hash, "
+    "provenance";
+
 // The rotation blob, written in pieces after a zero blob (storage/sqlite_blob.h), holds exactly
 // the bytes of the clip's rotations in float32, and the stored hash is that of the stored
 // columns. 20000 frames of 19 joints are 5.8 MiB of rotations: six pieces, the last a part one.
@@ -1084,11 +1090,7 @@ TEST_F(StorageTest, SchemaFourFileKeepsItsClipsWithTheRotationsLast) {
   std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 25000);
   const int64_t a = expected.begin()->first;
   const int64_t b = expected.rbegin()->first;
-  const std::string columns =
-      "clip_id, name, source_file, skeleton_id, frame_time, frame_count, joint_count, "
-      "position_joint_count, layout, rotations, positions, created_unix_ms, content_hash, "
-      "provenance";
-  CopyToOldSchema(4, columns, "");
+  CopyToOldSchema(4, kSchemaFourClipColumns, "");
   const std::string last_column =
       "SELECT name FROM pragma_table_info('clips') ORDER BY cid DESC LIMIT 1";
   EXPECT_EQ(*Raw()->QueryText(last_column), "provenance");
@@ -1128,6 +1130,30 @@ TEST_F(StorageTest, SchemaFourFileKeepsItsClipsWithTheRotationsLast) {
   const absl::Status short_blob =
       raw->Execute(absl::StrCat("UPDATE clips SET rotations = x'00' WHERE clip_id = ", a));
   EXPECT_THAT(short_blob.message(), HasSubstr("CHECK constraint failed"));
+}
+
+// While another connection reads an older file, SQLite refuses to leave WAL mode, and the file
+// migrates in WAL mode instead, rather than the open failing.
+TEST_F(StorageTest, AnOlderFileMigratesWhileAnotherConnectionReadsIt) {
+  const Clip walk = Motion(testing::ChainSkeleton(), 20, 1);
+  std::map<int64_t, ClipRecord> expected = StoreWalkAndRun(walk, 30);
+  CopyToOldSchema(4, kSchemaFourClipColumns, "");
+  std::unique_ptr<SqliteConnection> reader = Raw();
+  ASSERT_TRUE(reader->Execute("BEGIN").ok());
+  ASSERT_EQ(*reader->QueryInt64("SELECT count(*) FROM clips"), 2);
+
+  DatabaseOptions options;
+  options.busy_timeout_ms = 100;
+  absl::StatusOr<std::unique_ptr<Database>> db = Database::Open(path_, options);
+  ASSERT_TRUE(db.ok()) << db.status();
+  for (const auto& [id, record] : expected) {
+    const absl::StatusOr<ClipRecord> migrated = (*db)->GetClipRecord(id);
+    ASSERT_TRUE(migrated.ok()) << migrated.status();
+    EXPECT_EQ(migrated->content_hash, record.content_hash);
+  }
+  ASSERT_TRUE(reader->Execute("COMMIT").ok());
+  EXPECT_EQ(*reader->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  EXPECT_EQ(*reader->QueryText("PRAGMA journal_mode"), "wal");
 }
 
 // A file of schema version 3, as builds before the operators (issue 16) wrote it, keeps its
