@@ -56,7 +56,8 @@ Samples JobSamples(storage::Database& database) {
 
 }  // namespace
 
-ServerMetrics::ServerMetrics(const IndexRegistry& indices, storage::Database& database)
+ServerMetrics::ServerMetrics(const IndexRegistry& indices, storage::Database& database,
+                             const UploadBudget& uploads)
     : calls_(registry_.AddCounter("motiondb_requests_total",
                                   "Calls of each API method, by face (grpc, http) and status code.",
                                   {"face", "method", "code"})),
@@ -83,6 +84,16 @@ ServerMetrics::ServerMetrics(const IndexRegistry& indices, storage::Database& da
                      [&indices] { return SpaceSamples(indices, /*frames=*/true); });
   registry_.AddGauge("motiondb_jobs", "Background jobs in each state.", {"state"},
                      [&database] { return JobSamples(database); });
+  registry_.AddGauge("motiondb_uploads_in_progress", "Ingests in progress (at most --max-uploads).",
+                     {}, [&uploads] {
+                       return Samples{{{}, static_cast<double>(uploads.uploads())}};
+                     });
+  registry_.AddGauge(
+      "motiondb_upload_buffered_bytes",
+      "Bytes the ingests in progress hold together (at most --max-upload-buffer-mb).", {},
+      [&uploads] {
+        return Samples{{{}, static_cast<double>(uploads.buffered_bytes())}};
+      });
   registry_.AddGauge("process_resident_memory_bytes", "Resident memory size in bytes.", {}, [] {
     return Samples{{{}, ResidentBytes()}};
   });

@@ -1,8 +1,9 @@
 // The server's metrics, as GET /metrics shows them: calls per method and status code on each
 // face with their latencies, HTTP exchanges per route, search stage times, frames ingested,
-// and, read when scraped, each space index's clips and frames, jobs per state and the process's
-// resident memory. Fed where calls are already timed (server/grpc/request_logger.h, the search
-// and clip services, the HTTP face); it knows no proto.
+// and, read when scraped, each space index's clips and frames, jobs per state, the uploads in
+// progress and the bytes they hold, and the process's resident memory. Fed where calls are already
+// timed (server/grpc/request_logger.h, the search and clip services, the HTTP face); it knows no
+// proto.
 //
 // Thread-safe.
 #ifndef MOTIONDB_SERVER_SERVER_METRICS_H_
@@ -15,14 +16,16 @@
 #include "server/index_registry.h"
 #include "server/metrics_registry.h"
 #include "server/search_runner.h"
+#include "server/upload_budget.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
 class ServerMetrics {
  public:
-  // `indices` and `database` are read at each Render() and must outlive this.
-  ServerMetrics(const IndexRegistry& indices, storage::Database& database);
+  // `indices`, `database` and `uploads` are read at each Render() and must outlive this.
+  ServerMetrics(const IndexRegistry& indices, storage::Database& database,
+                const UploadBudget& uploads);
   ServerMetrics(const ServerMetrics&) = delete;
   ServerMetrics& operator=(const ServerMetrics&) = delete;
 

@@ -816,6 +816,8 @@ TEST_F(HttpTest, MetricsCountBothFacesSearchesIndicesJobsAndMemory) {
   EXPECT_TRUE(has_line("motiondb_ingested_frames_total 960"));  // 4 takes of 240 frames
   EXPECT_TRUE(has_line(R"(motiondb_jobs{state="queued"} 0)"));
   EXPECT_TRUE(has_line(R"(motiondb_jobs{state="interrupted"} 0)"));
+  EXPECT_TRUE(has_line("motiondb_uploads_in_progress 0\n"));  // every ingest done
+  EXPECT_TRUE(has_line("motiondb_upload_buffered_bytes 0\n"));
   EXPECT_TRUE(has_line("process_resident_memory_bytes "));
   EXPECT_THAT(text, HasSubstr("# TYPE motiondb_request_duration_seconds histogram\n"));
 }

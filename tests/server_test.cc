@@ -42,6 +42,9 @@
 #include "tests/test_data.h"
 #include "util/byte_coding.h"
 
+// Last: it includes <resolv.h>, whose macro _res breaks Eigen's headers included after it.
+#include <httplib.h>
+
 namespace motiondb {
 namespace {
 
@@ -1497,14 +1500,19 @@ TEST_F(ServerTest, UploadsInProgressAreBounded) {
   first.set_file_name("streamed.bvh");
   first.set_chunk(bvh.substr(0, 100));
   ASSERT_TRUE(writer->Write(first));
-  // A second upload is refused once the first is under way (the first tries may come before the
-  // server has begun the stream).
-  grpc::Status refused;
-  for (int i = 0; i < 500 && refused.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED; ++i) {
-    v1::IngestClipResponse response;
-    refused = client.Ingest("unary.bvh", bvh, &response);
-    if (refused.ok()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // A second upload is refused once the server has taken the first in (seen on /metrics: the
+  // stream's call may reach the server after a unary one sent later).
+  httplib::Client http("127.0.0.1", server->http_port());
+  const auto uploads_in_progress = [&http] {
+    const httplib::Result metrics = http.Get("/metrics");
+    return metrics && metrics->body.find("\nmotiondb_uploads_in_progress 1\n") != std::string::npos;
+  };
+  for (int i = 0; i < 3000 && !uploads_in_progress(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+  ASSERT_TRUE(uploads_in_progress()) << server->Log();
+  v1::IngestClipResponse response;
+  const grpc::Status refused = client.Ingest("unary.bvh", bvh, &response);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(refused.error_message(), HasSubstr("(--max-uploads)"));
   v1::IngestClipStreamRequest rest;

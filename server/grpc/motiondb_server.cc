@@ -36,10 +36,10 @@ struct MotionDbServer::State {
   std::unique_ptr<Catalog> catalog;
   std::unique_ptr<SearchRunner> runner;
   std::unique_ptr<JobRunner> jobs;  // its worker uses the runner, the registry and the database
+  std::unique_ptr<UploadBudget> uploads;
   std::unique_ptr<ServerMetrics> metrics;
   std::unique_ptr<RequestLog> request_log;
   std::unique_ptr<CallGate> gate;
-  std::unique_ptr<UploadBudget> uploads;
   std::unique_ptr<StreamWatchdog> watchdog;
   std::unique_ptr<ClipServiceImpl> clips;
   std::unique_ptr<SpaceServiceImpl> spaces;
@@ -89,10 +89,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
       *s.database, s.registry, *s.runner,
       JobRunnerOptions{.threads = options.job_threads,
                        .test_pause_after = options.test_job_pause_after});
-  s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database);
+  s.uploads = std::make_unique<UploadBudget>(options.uploads);
+  s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database, *s.uploads);
   s.request_log = std::make_unique<RequestLog>(options.log_requests, *s.metrics);
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
-  s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.watchdog =
       std::make_unique<StreamWatchdog>(std::chrono::seconds(options.stream_idle_timeout_s));
   s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.uploads,
