@@ -518,6 +518,27 @@ std::vector<SearchResult> ExhaustiveReference(const LibraryIndex& library, const
   return RankResults(std::move(candidates), 0.5, k);
 }
 
+// `result.path` is a warp of `query` within the slope limit `s`, from its first frame to its
+// last, whose mean distance over `dims` dimensions is its score.
+void ExpectPathOfItsScore(const LibraryIndex& library, CoordinateView query,
+                          const SearchResult& result, int s, int dims) {
+  ASSERT_EQ(static_cast<int64_t>(result.path.size()), query.rows);
+  EXPECT_EQ(result.path.front(), result.first_frame);
+  EXPECT_EQ(result.path.back(), result.last_frame);
+  const CoordinateView clip = library.clip_coordinates(result.clip_index);
+  double total = Distance(query.row(0), clip.row(result.path[0]), dims);
+  int pauses = 0;
+  for (size_t i = 1; i < result.path.size(); ++i) {
+    const int64_t step = result.path[i] - result.path[i - 1];
+    EXPECT_GE(step, 0);
+    EXPECT_LE(step, s);
+    pauses = step == 0 ? pauses + 1 : 0;
+    EXPECT_LE(pauses, s - 1);
+    total += Distance(query.row(i), clip.row(result.path[i]), dims);
+  }
+  EXPECT_NEAR(total / query.rows, result.score, 1e-5 * (1 + result.score));
+}
+
 TEST(ExactSearch, MatchesAnExhaustiveReferenceOnSmallLibraries) {
   for (int trial = 0; trial < 6; ++trial) {
     const int s = 1 + trial % 3;
@@ -542,6 +563,19 @@ TEST(ExactSearch, MatchesAnExhaustiveReferenceOnSmallLibraries) {
     for (size_t i = 0; i < reference.size(); ++i) {
       EXPECT_NEAR(exact->results[i].score, reference[i].score, 1e-4)
           << "trial " << trial << " #" << i;
+      EXPECT_TRUE(exact->results[i].path.empty());
+    }
+    // With their paths when asked: the same results, each path scoring its result.
+    params.return_path = true;
+    absl::StatusOr<SearchResponse> with_paths =
+        ExactSearch(*library, CoordinateView::Of(q), params);
+    ASSERT_TRUE(with_paths.ok()) << with_paths.status();
+    ASSERT_EQ(with_paths->results.size(), reference.size());
+    for (size_t i = 0; i < reference.size(); ++i) {
+      SCOPED_TRACE(::testing::Message() << "trial " << trial << " #" << i);
+      EXPECT_EQ(with_paths->results[i].score, exact->results[i].score);
+      EXPECT_EQ(with_paths->results[i].last_frame, exact->results[i].last_frame);
+      ExpectPathOfItsScore(*library, CoordinateView::Of(q), with_paths->results[i], s, 4);
     }
   }
 }

@@ -697,6 +697,19 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
     EXPECT_GE(why.max_speed(), why.mean_speed() * (1 - 1e-9));
   }
   EXPECT_NEAR(explained.results(0).explanation().mean_speed(), 1.0, 0.05);  // itself
+  // The exact search explains its results too, and returns their paths (it answered INTERNAL
+  // and no path: found by the search_request fuzzer).
+  explained_query.set_exact(true);
+  explained_query.set_return_path(true);
+  status = client.Search(explained_query, &explained);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GT(explained.results_size(), 0);
+  for (const v1::SearchResult& r : explained.results()) {
+    EXPECT_TRUE(r.has_explanation());
+    ASSERT_GT(r.path_size(), 0);
+    EXPECT_EQ(r.path(0), r.start_frame());
+    EXPECT_EQ(r.path(r.path_size() - 1), r.end_frame());
+  }
 
   // The same range uploaded as BVH gives the same results.
   v1::SearchRequest uploaded = query;

@@ -7,9 +7,12 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
+#include <optional>
 
 #include "absl/functional/function_ref.h"
+#include "absl/strings/str_cat.h"
 #include "core/search/internal/search_query.h"
+#include "core/search/warp/time_warp.h"
 #include "util/parallel_for.h"
 #include "util/status_macros.h"
 
@@ -228,6 +231,28 @@ class FinishedClips {
   std::atomic<float> bound_{kInfinity};
 };
 
+// Gives each result its path. The scan keeps no back-pointers (a column of costs and starts
+// per clip frame); a result is the best warp ending at its last frame, which is what a warp
+// anchored at the query's last frame there computes again, with its path, for k results only.
+absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const SearchParams& params,
+                      std::vector<SearchResult>& results) {
+  WarpWorkspace workspace;
+  for (SearchResult& result : results) {
+    std::optional<Warp> warp = AnchoredWarp(
+        query, library.clip_coordinates(result.clip_index), static_cast<int>(query.rows - 1),
+        result.last_frame, {params.slope_limit, params.dtw_dims}, /*with_path=*/true, workspace);
+    if (!warp) {
+      return absl::InternalError(absl::StrCat("no warp ends at frame ", result.last_frame,
+                                              " of clip ", result.clip_index,
+                                              ", where the exact search found one"));
+    }
+    // Among equal warps the scan and the anchored warp may keep different starts.
+    result.first_frame = warp->first;
+    result.path = std::move(warp->path);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
@@ -255,7 +280,9 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
     response.stats.pruned_blocks += thread_stats.pruned_blocks;
   }
   response.stats.warps_ms = MillisecondsSince(warps);
-  response.results = FinishResults(library, finished.Take(), params);
+  std::vector<SearchResult> best = finished.Take();
+  if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, best));
+  response.results = FinishResults(library, std::move(best), params);
   response.stats.total_ms = MillisecondsSince(start);
   return response;
 }

@@ -21,9 +21,9 @@
 
 namespace motiondb {
 
-// Uses dtw_dims, slope_limit, max_results, max_overlap, exact_threads, the filters and
-// should_stop (called from every scanning thread) of `params`; the seed parameters do not
-// apply. Thread-safe like Search().
+// Uses dtw_dims, slope_limit, max_results, max_overlap, return_path, exact_threads, the
+// filters and should_stop (called from every scanning thread) of `params`; the seed parameters
+// do not apply. Thread-safe like Search().
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
                                            const SearchParams& params);
 
