@@ -516,6 +516,10 @@ TEST_F(HttpTest, ErrorsAreMappedAsGrpcGatewayMapsThemWithCodeAndMessage) {
   // services' side refuses such a request as a whole (found by the http_route fuzzer).
   expect_error(http.Get("/v1/jobs/%D0%FE"), 400, 3, "not UTF-8");
   expect_error(http.Get("/v1/clips?tag=%FF"), 400, 3, "tag");
+  // A message that quotes such bytes (a parameter's name, a number's text) had them raw in the
+  // body, which was then no JSON (found by the http_route fuzzer): they are U+FFFD now.
+  expect_error(http.Get("/v1/clips?%FF%FEx=1"), 400, 3, "parameter '\uFFFD\uFFFDx'");
+  expect_error(http.Get("/v1/clips/%C1%FF7"), 400, 3, "'\uFFFD\uFFFD7' is not a valid int64");
   expect_error(http.Get(absl::StrCat("/v1/clips/", ids_[0], "/poses?to=100000").c_str()), 400, 3,
                "clip.last_frame");
   expect_error(http.Get(absl::StrCat("/v1/clips/", ids_[0], "/poses?max_rate=-1").c_str()), 400, 3,

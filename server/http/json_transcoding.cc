@@ -1,9 +1,9 @@
 #include "server/http/json_transcoding.h"
 
-#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/stubs/common.h>
 #include <google/protobuf/util/json_util.h>
 
+#include <nlohmann/json.hpp>
 #include "absl/strings/ascii.h"
 #include "absl/strings/escaping.h"
 #include "absl/strings/numbers.h"
@@ -181,13 +181,10 @@ std::string ToJson(const Message& message) {
 }
 
 std::string ErrorJson(grpc::StatusCode code, absl::string_view message) {
-  google::protobuf::Struct error;
-  (*error.mutable_fields())["code"].set_number_value(static_cast<int>(code));
-  (*error.mutable_fields())["message"].set_string_value(std::string(message));
-  google::protobuf::util::JsonPrintOptions options;
-  std::string json;
-  (void)google::protobuf::util::MessageToJsonString(error, &json, options);
-  return json;
+  const nlohmann::json error = {{"code", static_cast<int>(code)}, {"message", message}};
+  // A message may quote what a client sent (a parameter's name, a value, a path), which need
+  // not be UTF-8: such bytes become U+FFFD, so that the body stays JSON.
+  return error.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace motiondb::server
