@@ -402,6 +402,16 @@ TEST_F(SearchTest, OneFrameIsAPoseQuery) {
                             }))
         << "clip " << p.clip << " at " << p.first;
   }
+  // Paths only when asked, then each the one frame (it had none, so that explaining a pose
+  // query answered INTERNAL: found by the search_request fuzzer).
+  for (const SearchResult& r : results) EXPECT_TRUE(r.path.empty());
+  params.return_path = true;
+  found = Search(*library_, CoordinateView::Of(pose), params);
+  ASSERT_TRUE(found.ok()) << found.status();
+  ASSERT_EQ(found->results.size(), results.size());
+  for (const SearchResult& r : found->results)
+    EXPECT_EQ(r.path, std::vector<int64_t>{r.seed_frame});
+  params.return_path = false;
   // A library frame finds itself at distance 0; the filters hold.
   const RowMatrixXf own = Eigen::Map<const RowMatrixXf>(FrameRow(*library_, 1200 + 77), 1, kDims);
   params.clip_ids = {101};

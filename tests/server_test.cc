@@ -669,6 +669,15 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   EXPECT_LT(poses.results(0).score(), 1e-3);
   for (const v1::SearchResult& r : poses.results()) EXPECT_EQ(r.start_frame(), r.end_frame());
   EXPECT_EQ(poses.counts().warps(), 0);
+  v1::SearchRequest explained_pose = ClipQuery("body", raise_clip, peak, peak);
+  explained_pose.set_explain(true);
+  status = client.Search(explained_pose, &poses);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(poses.results_size(), 4);
+  for (const v1::SearchResult& r : poses.results()) {
+    EXPECT_TRUE(r.has_explanation());
+    EXPECT_EQ(r.path_size(), 0);
+  }
 
   // explain: each result says which joints its distance lies in and how fast it plays; the
   // path it needs is returned only when asked for.

@@ -75,6 +75,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   for (SearchResult& result : response.results) {
     result.first_frame = result.last_frame = result.seed_frame;
     result.start_s = result.end_s = result.seed_frame / library.rate();
+    if (params.return_path) result.path = {result.seed_frame};
   }
   stats.total_ms = MillisecondsSince(start);
   return response;

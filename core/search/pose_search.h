@@ -17,8 +17,8 @@ inline constexpr double kPoseSeparationS = 0.5;
 // `pose`: one row, the library's dimensions. Each result is one frame (first = last =
 // seed_frame) scored by its pose distance over `dtw_dims` (what a warp of one frame scores);
 // of one clip, no two lie closer than kPoseSeparationS (or the cluster gap, if longer). The
-// filters, max_results, ann_dims and epsilon apply as in Search(); the warp's parameters are
-// unused. Thread-safe, as Search().
+// filters, max_results, ann_dims, epsilon and return_path (the one frame) apply as in Search();
+// the warp's parameters are unused. Thread-safe, as Search().
 absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, CoordinateView pose,
                                           const SearchParams& params);
 
