@@ -56,6 +56,7 @@ for target in "${targets[@]}"; do
     # LeakSanitizer still checks the whole run at its end.
     options+=(-detect_leaks=0)
   fi
+  export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan_suppressions.txt"
   log="$build/$target.log"
   echo "fuzz: $target for ${seconds}s, corpus $corpus"
   status=0
