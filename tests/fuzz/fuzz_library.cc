@@ -28,7 +28,17 @@ std::string FreshFolder() {
   return pattern;
 }
 
-FuzzLibrary* Make() {
+// The three actions of the libraries, each `repeats` times, at 30 frames a second.
+SyntheticCorpusOptions ThreeActions(int repeats) {
+  SyntheticCorpusOptions options;
+  options.fps = 30;
+  options.script = {{SyntheticAction::kRightArmRaise, repeats},
+                    {SyntheticAction::kLeftArmRaise, repeats},
+                    {SyntheticAction::kShrug, repeats}};
+  return options;
+}
+
+FuzzLibrary* Make(const SyntheticCorpusOptions& options) {
   // Random bytes make protobuf log every string field that is not UTF-8: noise, and slow.
   google::protobuf::SetLogHandler(nullptr);
   auto library = new FuzzLibrary;
@@ -38,12 +48,6 @@ FuzzLibrary* Make() {
   if (!database.ok()) Die(database.status());
   library->database = *std::move(database);
   library->catalog = std::make_unique<server::Catalog>(*library->database, library->registry);
-  SyntheticCorpusOptions options;
-  options.fps = 30;
-  options.script = {{SyntheticAction::kRightArmRaise, 2},
-                    {SyntheticAction::kLeftArmRaise, 2},
-                    {SyntheticAction::kShrug, 2}};
-  options.max_clip_duration_s = 8;
   absl::StatusOr<SyntheticCorpus> corpus = GenerateSyntheticCorpus(options);
   if (!corpus.ok()) Die(corpus.status());
   for (size_t c = 0; c < corpus->clips.size(); ++c) {
@@ -67,7 +71,23 @@ FuzzLibrary* Make() {
 }  // namespace
 
 FuzzLibrary& TheFuzzLibrary() {
-  static FuzzLibrary* const library = Make();
+  static FuzzLibrary* const library = [] {
+    SyntheticCorpusOptions options = ThreeActions(2);
+    options.max_clip_duration_s = 8;
+    return Make(options);
+  }();
+  return *library;
+}
+
+FuzzLibrary& TheSmallFuzzLibrary() {
+  static FuzzLibrary* const library = [] {
+    // Short rests and no stretched actions, so that a clip of 4 s holds any action.
+    SyntheticCorpusOptions options = ThreeActions(1);
+    options.rest_max_s = options.rest_min_s;
+    options.timing_scale_max = 1.0;
+    options.max_clip_duration_s = 4;
+    return Make(options);
+  }();
   return *library;
 }
 

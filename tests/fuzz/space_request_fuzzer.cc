@@ -1,8 +1,8 @@
 // libFuzzer target: SpaceService.CreateSpace's request handling. The input is a serialised
 // motiondb.v1.CreateSpaceRequest (names, skeleton, training ranges, weights JSON, presets,
 // rates, dimensions); it is converted as the gRPC face converts it and, when that succeeds, the
-// space is built from a small real library (server::BuildSpace writes nothing). Nothing may
-// crash, trip a sanitizer, or answer INTERNAL.
+// space is built from a small real library (TheSmallFuzzLibrary) (server::BuildSpace writes
+// nothing). Nothing may crash, trip a sanitizer, or answer INTERNAL.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -14,7 +14,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace motiondb;
-  fuzz::FuzzLibrary& library = fuzz::TheFuzzLibrary();
+  fuzz::FuzzLibrary& library = fuzz::TheSmallFuzzLibrary();
   v1::CreateSpaceRequest request;
   if (!request.ParseFromArray(data, static_cast<int>(size))) return 0;
   const absl::StatusOr<server::SpaceRequest> space = server::FromProto(request);
