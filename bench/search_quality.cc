@@ -7,7 +7,7 @@
 // folder), the fast search's recall@10 against the exact search, latency and stage times.
 //
 // usage: search_quality [--folder DIR]... [--split one|style|dataset] [--metric unit|eigen]
-//          [--weights mass|uniform]
+//          [--weights mass|uniform] [--weight-floor F] [--weight JOINT=W]...
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
 //          [--no-refine] [--points K]
@@ -17,7 +17,10 @@
 #include <tuple>
 #include <vector>
 
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "bench/measure.h"
 #include "testing/labelled_index.h"
 #include "testing/retrieval_evaluation.h"
@@ -36,6 +39,7 @@ struct QualityFlags {
   std::string neutral = "mean";
   bool keep_heading = false, no_refine = false;
   int places = 0;
+  std::vector<std::string> weight_overrides;  // JOINT=W
   double root_velocity = SpaceOptions().root_velocity_weight;
   SpaceOptions space;
   RetrievalOptions retrieval;
@@ -53,6 +57,15 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
   cli::OneOf(app.add_option("--weights", flags->weights, "the joint-weight preset"),
              {"mass", "uniform"})
       ->capture_default_str();
+  app.add_option("--weight-floor", flags->space.weights.floor,
+                 "mass weights: the smallest as a fraction of the largest")
+      ->type_name("F")
+      ->capture_default_str()
+      ->check(cli::NumberAbove(0));
+  app.add_option("--weight", flags->weight_overrides,
+                 "a joint's final weight, replacing the preset's (repeat for several)")
+      ->type_name("JOINT=W")
+      ->delimiter(',');
   app.add_option("--rate", flags->space.sample_rate, "the space's sample rate")
       ->type_name("HZ")
       ->capture_default_str()
@@ -113,6 +126,14 @@ absl::Status Run(QualityFlags& flags) {
   const std::string& metric = flags.metric;
   space_options.metric = metric == "eigen" ? SpaceMetric::kEigenvalueScaled : SpaceMetric::kUnit;
   MOTIONDB_ASSIGN_OR_RETURN(space_options.weights.preset, ParseWeightPreset(flags.weights));
+  for (const std::string& entry : flags.weight_overrides) {
+    const std::vector<std::string> parts = absl::StrSplit(entry, '=');
+    double weight = 0;
+    if (parts.size() != 2 || !absl::SimpleAtod(parts[1], &weight)) {
+      return absl::InvalidArgumentError(absl::StrCat("--weight ", entry, ": expected JOINT=W"));
+    }
+    space_options.weights.overrides[parts[0]] = weight;
+  }
   space_options.pose.remove_heading = !flags.keep_heading;
   space_options.pose.root_velocity = flags.root_velocity > 0;
   if (flags.root_velocity > 0) space_options.root_velocity_weight = flags.root_velocity;
@@ -150,6 +171,12 @@ absl::Status Run(QualityFlags& flags) {
       params.slope_limit, neutral.c_str(),
       space_options.pose.remove_heading ? "" : ", heading kept",
       params.refine ? "" : ", no refinement");
+  std::printf("joint weights:");
+  const Eigen::VectorXd& joint_weights = library.space->data().joint_weights;
+  for (int j = 0; j < joint_weights.size(); ++j) {
+    std::printf(" %s %.3g", library.space->skeleton().joint(j).name.c_str(), joint_weights[j]);
+  }
+  std::printf("\n");
   std::printf(
       "fast:  precision@%d %.3f over %d queries (split %s, %d left out), latency p50 %.2f ms p99 "
       "%.2f ms\n",
