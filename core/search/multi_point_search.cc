@@ -23,20 +23,86 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kPartMatchesPerResult = 10;
 constexpr int kMinPartMatches = 200;
 
-// Query rows [first, first + rows), anchored at its own row `anchor`.
+// A pose held between two actions is cut out of the parts: each part is warped through its own
+// point with the search's slope limit, which cannot fit a hold of 5 s in the query onto one of
+// 0.3 s in the clip (or the reverse), so a hold split between two parts made both match badly.
+// The hold's rows are matched to the clip frame where the parts' matches join instead, at the
+// pose distance from it. A row is held when the pose moved less than kStillShare of the query's
+// mean movement a row since the previous one; a run of held rows is a hold from kMinHoldS.
+constexpr double kStillShare = 0.2;
+constexpr double kMinHoldS = 0.5;
+// Each part keeps this much of the hold's edge, so that its warp sees the pose settle.
+constexpr double kHoldEdgeS = 0.5;
+
+// Query rows [first, first + rows), anchored at its own row `anchor`. Rows between one part's
+// end and the next one's first are a hold.
 struct Part {
   int first = 0;
   int rows = 0;
   int anchor = 0;
 };
 
-// The query cut halfway between adjacent anchors.
-std::vector<Part> QueryParts(int64_t rows, const std::vector<int>& anchors) {
+// Per query row from 1, whether the pose moved less than kStillShare of the mean movement.
+std::vector<bool> HeldRows(CoordinateView query, int dims) {
+  std::vector<float> moved(query.rows, 0.0f);
+  double total = 0;
+  for (int64_t r = 1; r < query.rows; ++r) {
+    moved[r] = Distance(query.row(r), query.row(r - 1), dims);
+    total += moved[r];
+  }
+  const double still = kStillShare * total / std::max<int64_t>(1, query.rows - 1);
+  std::vector<bool> held(query.rows, false);
+  for (int64_t r = 1; r < query.rows; ++r) held[r] = moved[r] < still;
+  return held;
+}
+
+// Of the runs of held rows strictly between rows `from` and `to` that last `min_rows`, the one
+// nearest the middle between them, as [first, end); empty (first == end) when there is none. The
+// middle, not the longest: an action's own extreme is often held too, and cutting there would
+// leave the held pose between the actions inside a part.
+std::pair<int, int> MiddleHold(const std::vector<bool>& held, int from, int to, int min_rows) {
+  std::pair<int, int> best{from, from};
+  const double middle = 0.5 * (from + to);
+  double best_distance = kInfinity;
+  for (int r = from + 1; r < to;) {
+    if (!held[r]) {
+      ++r;
+      continue;
+    }
+    const int first = r;
+    while (r < to && held[r]) ++r;
+    if (r - first < min_rows) continue;
+    const double distance = first > middle ? first - middle : (r <= middle ? middle - r : 0.0);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = {first, r};
+    }
+  }
+  return best;
+}
+
+// The query cut between adjacent anchors: around the hold between them nearest their middle
+// (MiddleHold), keeping kHoldEdgeS of it in each part; halfway when there is none.
+std::vector<Part> QueryParts(CoordinateView query, const std::vector<int>& anchors, int dims,
+                             double rate) {
+  const std::vector<bool> held = HeldRows(query, dims);
+  const int min_hold = std::max(1, static_cast<int>(std::lround(kMinHoldS * rate)));
+  const int edge = static_cast<int>(std::lround(kHoldEdgeS * rate));
+  std::vector<std::pair<int, int>> cuts;  // [end of part k, first of part k + 1)
+  for (size_t k = 0; k + 1 < anchors.size(); ++k) {
+    const auto [first, end] = MiddleHold(held, anchors[k], anchors[k + 1], min_hold);
+    if (end > first) {
+      const int part_end = std::min(first + edge, anchors[k + 1]);
+      cuts.push_back({part_end, std::max(end - edge, part_end)});
+    } else {
+      const int middle = (anchors[k] + anchors[k + 1]) / 2 + 1;
+      cuts.push_back({middle, middle});
+    }
+  }
   std::vector<Part> parts;
   for (size_t k = 0; k < anchors.size(); ++k) {
-    const int first = k == 0 ? 0 : (anchors[k - 1] + anchors[k]) / 2 + 1;
-    const int end =
-        k + 1 == anchors.size() ? static_cast<int>(rows) : (anchors[k] + anchors[k + 1]) / 2 + 1;
+    const int first = k == 0 ? 0 : cuts[k - 1].second;
+    const int end = k + 1 == anchors.size() ? static_cast<int>(query.rows) : cuts[k].first;
     parts.push_back({first, end - first, anchors[k] - first});
   }
   return parts;
@@ -50,6 +116,8 @@ struct Link {
   // the earlier one's rows matched past it and the later one's rows matched before it are moved
   // to (a pause at the junction); -1 when they do not overlap (the path jumps forward there).
   int64_t meet = -1;
+  // The clip frame the hold between parts k - 1 and k is matched to (unused without a hold).
+  int64_t hold_frame = -1;
 };
 
 // What the links need to price a junction: the query, the library, the warp's dimensions.
@@ -76,26 +144,65 @@ double ClampCost(const Chaining& chaining, const SearchResult& match, int first,
   return change;
 }
 
-// Where adjacent parts' matches join, and the change in cost: nothing when the later one
-// starts after the earlier one ends, at most max_gap later (a pause held longer in the clip than
-// in the query is skipped); when they overlap, a frame between their anchors where the path
-// pauses instead (held longer in the query): the cheapest of the later one's start, the earlier
-// one's end and the middle between the anchors, of those that lie between them. nullopt: no
-// join (a gap beyond max_gap, or the anchors out of order).
-std::optional<std::pair<int64_t, double>> Join(const Chaining& chaining,
-                                               const SearchResult& previous, int previous_first,
-                                               const SearchResult& next, int next_first) {
+// The pose distance of query rows [first, end) (a hold) from clip frame `frame`.
+double HoldCost(const Chaining& chaining, int clip_index, int first, int end, int64_t frame) {
+  const CoordinateView clip = chaining.library.clip_coordinates(clip_index);
+  double cost = 0;
+  for (int r = first; r < end; ++r) {
+    cost += Distance(chaining.query.row(r), clip.row(frame), chaining.dims);
+  }
+  return cost;
+}
+
+struct Junction {
+  int64_t meet = -1;        // as Link::meet
+  int64_t hold_frame = -1;  // as Link::hold_frame
+  double change = 0;        // what the junction adds to the chain's cost
+};
+
+// Where adjacent parts' matches join, and the change in cost: when the later one starts after
+// the earlier one ends, at most max_gap later than the hold between the parts lasts (a pause held
+// longer in the clip than in the query is skipped), the hold's rows at the clip frame between
+// them nearest the hold's middle row; when they overlap, a frame between their anchors where the
+// path pauses instead (held longer in the query), the hold's rows there too: the cheapest of the
+// later one's start, the earlier one's end and the middle between the anchors, of those that lie
+// between them. nullopt: no join (a gap beyond max_gap, or the anchors out of order).
+std::optional<Junction> Join(const Chaining& chaining, const SearchResult& previous,
+                             const Part& previous_part, const SearchResult& next,
+                             const Part& next_part) {
+  const int hold_first = previous_part.first + previous_part.rows;
+  const int hold_end = next_part.first;
+  // gap - 1 frames skipped: a pause in the clip up to max_gap longer than the query's hold.
   const int64_t gap = next.first_frame - previous.last_frame;
-  if (gap - 1 > chaining.max_gap) return std::nullopt;  // gap - 1 frames skipped
-  if (gap >= 0) return std::pair<int64_t, double>{-1, 0.0};
+  if (gap - 1 > chaining.max_gap + (hold_end - hold_first)) return std::nullopt;
+  const auto hold_cost = [&](int64_t frame) {
+    return HoldCost(chaining, next.clip_index, hold_first, hold_end, frame);
+  };
+  if (gap >= 0) {
+    if (hold_first == hold_end) return Junction{};
+    // The clip frame between the matches nearest the hold's middle row: the clip's own hold,
+    // when it has one.
+    const CoordinateView clip = chaining.library.clip_coordinates(next.clip_index);
+    const float* middle = chaining.query.row((hold_first + hold_end) / 2);
+    int64_t frame = previous.last_frame;
+    float nearest = std::numeric_limits<float>::infinity();
+    for (int64_t f = previous.last_frame; f <= next.first_frame; ++f) {
+      const float distance = Distance(middle, clip.row(f), chaining.dims);
+      if (distance < nearest) {
+        nearest = distance;
+        frame = f;
+      }
+    }
+    return Junction{-1, frame, hold_cost(frame)};
+  }
   if (previous.seed_frame > next.seed_frame) return std::nullopt;
-  std::optional<std::pair<int64_t, double>> best;
+  std::optional<Junction> best;
   for (const int64_t meet :
        {next.first_frame, previous.last_frame, (previous.seed_frame + next.seed_frame) / 2}) {
     if (meet < previous.seed_frame || meet > next.seed_frame) continue;
-    const double change = ClampCost(chaining, previous, previous_first, false, meet) +
-                          ClampCost(chaining, next, next_first, true, meet);
-    if (!best || change < best->second) best = {meet, change};
+    const double change = ClampCost(chaining, previous, previous_part.first, false, meet) +
+                          ClampCost(chaining, next, next_part.first, true, meet) + hold_cost(meet);
+    if (!best || change < best->change) best = Junction{meet, meet, change};
   }
   return best;
 }
@@ -117,10 +224,10 @@ std::vector<Link> LinkPart(const Chaining& chaining, const Part& previous_part,
     const double own = match.score * part.rows;
     for (const int j : clip->second) {
       // No pruning on the previous chain's cost alone: a pause at the junction can lower it.
-      const auto join = Join(chaining, previous[j], previous_part.first, match, part.first);
+      const std::optional<Junction> join = Join(chaining, previous[j], previous_part, match, part);
       if (!join) continue;
-      const double cost = previous_links[j].cost + own + join->second;
-      if (cost < links[i].cost) links[i] = {cost, j, join->first};
+      const double cost = previous_links[j].cost + own + join->change;
+      if (cost < links[i].cost) links[i] = {cost, j, join->meet, join->hold_frame};
     }
   }
   return links;
@@ -148,6 +255,10 @@ SearchResult ChainResult(const std::vector<std::vector<SearchResult>>& matches,
   result.path.reserve(query_rows);
   for (size_t k = 0; k < parts.size(); ++k) {
     const SearchResult& match = matches[k][chain[k]];
+    if (k > 0) {
+      const int hold_rows = parts[k].first - (parts[k - 1].first + parts[k - 1].rows);
+      result.path.insert(result.path.end(), hold_rows, links[k][chain[k]].hold_frame);
+    }
     const size_t from = result.path.size();
     result.path.insert(result.path.end(), match.path.begin(), match.path.end());
     if (k == 0) continue;
@@ -179,7 +290,7 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
                                                 const std::vector<int>& anchors,
                                                 const SearchParams& params) {
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<Part> parts = QueryParts(query.rows, anchors);
+  const std::vector<Part> parts = QueryParts(query, anchors, params.dtw_dims, library.rate());
   SearchParams part_params = params;
   part_params.characteristic_frames.clear();
   part_params.characteristic_points = 1;

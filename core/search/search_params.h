@@ -71,8 +71,9 @@ struct SearchParams {
   // point; 0 takes one per action of the query (characteristic_points.h, FindActionFrames).
   int characteristic_points = 1;
   // Several points: the most seconds of clip a result may skip between the end of one part's
-  // match and the start of the next's (a held pose longer than the query's is absorbed there,
-  // where one slope-limited warp cannot absorb it).
+  // match and the start of the next's beyond the query's own held pose between the parts (a
+  // held pose longer than the query's is absorbed there, where one slope-limited warp cannot
+  // absorb it).
   double max_point_gap_s = 10.0;
   // Seeds of one clip closer than this in time join one cluster.
   double cluster_gap_s = 0.1;
