@@ -17,10 +17,7 @@
 #include <tuple>
 #include <vector>
 
-#include "absl/strings/numbers.h"
-#include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "absl/strings/str_split.h"
 #include "bench/measure.h"
 #include "testing/labelled_index.h"
 #include "testing/retrieval_evaluation.h"
@@ -127,12 +124,8 @@ absl::Status Run(QualityFlags& flags) {
   space_options.metric = metric == "eigen" ? SpaceMetric::kEigenvalueScaled : SpaceMetric::kUnit;
   MOTIONDB_ASSIGN_OR_RETURN(space_options.weights.preset, ParseWeightPreset(flags.weights));
   for (const std::string& entry : flags.weight_overrides) {
-    const std::vector<std::string> parts = absl::StrSplit(entry, '=');
-    double weight = 0;
-    if (parts.size() != 2 || !absl::SimpleAtod(parts[1], &weight)) {
-      return absl::InvalidArgumentError(absl::StrCat("--weight ", entry, ": expected JOINT=W"));
-    }
-    space_options.weights.overrides[parts[0]] = weight;
+    MOTIONDB_ASSIGN_OR_RETURN(const auto joint_weight, cli::ParseJointValue(entry, "--weight"));
+    space_options.weights.overrides[joint_weight.first] = joint_weight.second;
   }
   space_options.pose.remove_heading = !flags.keep_heading;
   space_options.pose.root_velocity = flags.root_velocity > 0;

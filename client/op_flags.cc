@@ -17,19 +17,6 @@
 namespace motiondb::cli {
 namespace {
 
-// "JOINT=VALUE".
-absl::StatusOr<std::pair<std::string, double>> ParseJointValue(const std::string& text,
-                                                               const std::string& flag) {
-  const size_t equals = text.rfind('=');
-  double value = 0;
-  if (equals == std::string::npos || equals == 0 ||
-      !absl::SimpleAtod(text.substr(equals + 1), &value)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(flag, ": expected JOINT=NUMBER, got '", text, "'"));
-  }
-  return std::make_pair(text.substr(0, equals), value);
-}
-
 absl::Status AddJointValues(const std::vector<std::string>& texts, const std::string& flag,
                             google::protobuf::Map<std::string, double>* values) {
   for (const std::string& text : texts) {

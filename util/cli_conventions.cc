@@ -115,4 +115,16 @@ std::optional<int> ParseCommandLine(CLI::App& app, int argc, const char* const* 
   return std::nullopt;
 }
 
+absl::StatusOr<std::pair<std::string, double>> ParseJointValue(const std::string& text,
+                                                               const std::string& flag) {
+  const size_t equals = text.rfind('=');
+  double value = 0;
+  if (equals == std::string::npos || equals == 0 ||
+      !absl::SimpleAtod(text.substr(equals + 1), &value)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(flag, ": expected JOINT=NUMBER, got '", text, "'"));
+  }
+  return std::make_pair(text.substr(0, equals), value);
+}
+
 }  // namespace motiondb::cli

@@ -9,9 +9,12 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "absl/status/statusor.h"
 
 namespace motiondb::cli {
 
@@ -28,6 +31,10 @@ CLI::Validator WholeAtLeast(int64_t min);
 CLI::Validator ExistingFile();
 // Makes `option` take one of `choices`, named "a|b|c" in the help; returns it.
 CLI::Option* OneOf(CLI::Option* option, const std::vector<std::string>& choices);
+
+// "JOINT=VALUE" given to `flag` as a joint name and a number; the error names the flag.
+absl::StatusOr<std::pair<std::string, double>> ParseJointValue(const std::string& text,
+                                                               const std::string& flag);
 
 // Parses `argv` into `app` and its subcommands. Returns nullopt when the program should go on
 // (`ChosenCommand(app)` is then the command to run), or the exit code when it must stop: 0
