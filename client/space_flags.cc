@@ -10,7 +10,10 @@ namespace motiondb::cli {
 
 void AddSpaceFlags(CLI::App* command, SpaceFlags* flags) {
   const SpaceOptions defaults;
-  command->add_option("--rate", flags->rate, "sample rate of the clips in the space, in Hz")
+  command
+      ->add_option(
+          "--rate", flags->rate,
+          absl::StrCat("sample rate of the clips in the space, in Hz, at most ", kMaxSpaceRate))
       ->type_name("R")
       ->default_str(absl::StrCat(defaults.sample_rate))
       ->check(NumberAbove(0));

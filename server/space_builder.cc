@@ -130,7 +130,8 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
     used.push_back({ranges[i].clip_id, frames});
   }
 
-  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built, MotionSpace::Build(training, request.options));
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built,
+                            MotionSpace::Build(training, request.options, should_stop));
   // Counted once Build has checked the sample rate (a rate of 1e295 overflowed the count).
   int64_t training_frames = 0;
   for (const TrainingClip& clip : training) {
@@ -139,7 +140,7 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   }
   auto space = std::make_shared<const MotionSpace>(std::move(built));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
-                            space->RepresentationalError(training));
+                            space->RepresentationalError(training, kErrorReportDims, should_stop));
   training.clear();
 
   BuiltSpace result;

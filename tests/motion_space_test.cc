@@ -292,7 +292,7 @@ TEST_F(MotionSpaceTest, RejectsBadTrainingAndOptions) {
     EXPECT_THAT(space.status().message(), HasSubstr(message));
   };
   fails({}, {}, "needs training clips");
-  for (const double rate : {0.0, -30.0, nan, 1e6}) {
+  for (const double rate : {0.0, -30.0, nan, 1e6, kMaxSpaceRate + 1}) {
     fails(training_, {.sample_rate = rate}, "sample rate");
   }
   for (const double weight : {0.0, -0.5, nan}) {
@@ -346,8 +346,28 @@ TEST_F(MotionSpaceTest, RejectsBadBlocksAndClips) {
               HasSubstr("clip0: skeleton differs"));
 }
 
+TEST_F(MotionSpaceTest, BuildAndErrorReportStopWhenAsked) {
+  int asked = 0;
+  const auto stop_at_second = [&asked] { return ++asked == 2; };
+  const absl::StatusOr<MotionSpace> space = MotionSpace::Build(training_, {}, stop_at_second);
+  EXPECT_EQ(space.status().code(), absl::StatusCode::kCancelled) << space.status();
+  asked = 0;
+  EXPECT_EQ(
+      space_.RepresentationalError(training_, kErrorReportDims, stop_at_second).status().code(),
+      absl::StatusCode::kCancelled);
+  const auto never = [] { return false; };
+  EXPECT_TRUE(MotionSpace::Build(training_, {}, never).ok());
+  EXPECT_TRUE(space_.RepresentationalError(training_, kErrorReportDims, never).ok());
+}
+
 TEST_F(MotionSpaceTest, FromDataChecksConsistency) {
   EXPECT_TRUE(MotionSpace::FromData(space_.data()).ok());
+  {
+    // Spaces stored when new ones could sample faster than kMaxSpaceRate still load.
+    SpaceData fast = space_.data();
+    fast.sample_rate = 4 * kMaxSpaceRate;
+    EXPECT_TRUE(MotionSpace::FromData(std::move(fast)).ok());
+  }
   const auto fails = [&](const std::function<void(SpaceData&)>& damage, const std::string& what) {
     SpaceData data = space_.data();
     damage(data);

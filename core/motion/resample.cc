@@ -24,9 +24,9 @@ int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fp
 }
 
 absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
-  if (!std::isfinite(target_fps) || target_fps <= 0.0 || target_fps > 10000.0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("target rate must be in (0, 10000] frames per second, got ", target_fps));
+  if (!std::isfinite(target_fps) || target_fps <= 0.0 || target_fps > kMaxResampleRate) {
+    return absl::InvalidArgumentError(absl::StrCat("target rate must be in (0, ", kMaxResampleRate,
+                                                   "] frames per second, got ", target_fps));
   }
   const int n = clip.frame_count();
   const double samples = SampleCount(n, clip.frame_time(), target_fps);

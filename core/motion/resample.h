@@ -9,14 +9,17 @@
 
 namespace motiondb {
 
+// The fastest rate Resample() makes, frames per second.
+inline constexpr double kMaxResampleRate = 10000.0;
+
 // Samples `clip` at t = k / target_fps for every k with t within the clip's span
 // [0, (frame_count - 1) * frame_time], allowing 1% of an output frame past the end (taken as
 // the last frame) so that rounded frame times such as 0.0333333 keep every frame. `target_fps` must
-// be finite and in (0, 10000].
+// be finite and in (0, kMaxResampleRate].
 absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps);
 
 // The number of frames Resample() makes of `frame_count` frames `frame_time` apart (without its
-// limit on the output's size). `target_fps` must be in Resample's range, (0, 10000].
+// limit on the output's size). `target_fps` must be in Resample's range.
 int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fps);
 
 }  // namespace motiondb

@@ -31,11 +31,16 @@ absl::StatusOr<Clip> SampleRange(const TrainingClip& range, double rate) {
   return sampled;
 }
 
-absl::Status CheckSampleRate(double rate) {
-  if (!std::isfinite(rate) || rate <= 0.0 || rate > 10000.0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("space sample rate must be in (0, 10000] frames per second, got ", rate));
+absl::Status CheckSampleRate(double rate, double max_rate) {
+  if (!std::isfinite(rate) || rate <= 0.0 || rate > max_rate) {
+    return absl::InvalidArgumentError(absl::StrCat("space sample rate must be in (0, ", max_rate,
+                                                   "] frames per second, got ", rate));
   }
+  return absl::OkStatus();
+}
+
+absl::Status CheckStop(const std::function<bool()>& should_stop) {
+  if (should_stop && should_stop()) return absl::CancelledError("space build cancelled");
   return absl::OkStatus();
 }
 
@@ -66,7 +71,7 @@ absl::Status CheckShape(absl::string_view what, Eigen::Index rows, Eigen::Index 
 
 absl::Status CheckData(const SpaceData& data) {
   if (data.skeleton == nullptr) return absl::InvalidArgumentError("space has no skeleton");
-  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(data.sample_rate));
+  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(data.sample_rate, kMaxResampleRate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(data.pose));
   MOTIONDB_RETURN_IF_ERROR(
       CheckExtraWeights(data.pose, data.yaw_rate_weight, data.root_velocity_weight));
@@ -149,9 +154,10 @@ Eigen::VectorXd MetricScales(SpaceMetric metric, const Eigen::VectorXd& eigenval
 }
 
 absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& training,
-                                               const SpaceOptions& options) {
+                                               const SpaceOptions& options,
+                                               const std::function<bool()>& should_stop) {
   if (training.empty()) return absl::InvalidArgumentError("a space needs training clips");
-  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate));
+  MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate, kMaxSpaceRate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(options.pose));
   MOTIONDB_RETURN_IF_ERROR(
       CheckExtraWeights(options.pose, options.yaw_rate_weight, options.root_velocity_weight));
@@ -169,6 +175,7 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& 
   std::vector<PoseRotations> poses;
   Eigen::Index frames = 0;
   for (const TrainingClip& range : training) {
+    MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
     if (!range.clip.skeleton().SameTopology(*data.skeleton)) {
       return absl::InvalidArgumentError(
           absl::StrCat(range.source, ": skeleton differs from the first training clip's (",
@@ -286,7 +293,8 @@ absl::StatusOr<double> MotionSpace::Distance(const Eigen::Ref<const Eigen::RowVe
 }
 
 absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
-    const std::vector<TrainingClip>& clips, const std::vector<int>& dims) const {
+    const std::vector<TrainingClip>& clips, absl::Span<const int> dims,
+    const std::function<bool()>& should_stop) const {
   std::vector<int> levels;
   for (const int n : dims) {
     if (n < 1) {
@@ -304,6 +312,7 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
   double angles = 0.0;
   const int joints = skeleton().joint_count();
   for (const TrainingClip& range : clips) {
+    MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
     if (!range.clip.skeleton().SameTopology(skeleton())) {
       return absl::InvalidArgumentError(
           absl::StrCat(range.source, ": skeleton differs from the space's"));

@@ -12,6 +12,7 @@
 #ifndef MOTIONDB_CORE_SPACE_MOTION_SPACE_H_
 #define MOTIONDB_CORE_SPACE_MOTION_SPACE_H_
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,7 @@
 #include <Eigen/Core>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
 #include "core/space/joint_weights.h"
@@ -33,8 +35,20 @@ enum class SpaceMetric {
   kEigenvalueScaled,  // s_i = eigenvalue i, as the thesis writes it
 };
 
+// The fastest rate a new space may sample at, frames per second. Capture for animation runs at
+// 30-480 Hz and a space sampled faster than its clips holds only interpolated frames, while
+// every frame costs memory and time: at the earlier bound, 10000 Hz, a request resampled 30 Hz
+// clips 333 times over (a 10 h library to 360M frames) and a space over the request fuzzer's
+// three short clips took 10-14 s to build, uncancellable. Spaces stored before keep loading up to
+// kMaxResampleRate.
+inline constexpr double kMaxSpaceRate = 1000.0;
+
+// The dimension counts a space's build report gives its reconstruction error at.
+inline constexpr int kErrorReportDims[] = {3, 5, 10, 20};
+
 struct SpaceOptions {
-  // Frames per second at which training clips, and every clip projected later, are sampled.
+  // Frames per second at which training clips, and every clip projected later, are sampled; in
+  // (0, kMaxSpaceRate].
   double sample_rate = 30.0;
   // Facing removal and yaw-rate smoothing.
   PoseOptions pose = {};
@@ -102,9 +116,11 @@ class MotionSpace {
   // Builds a space from training clips or ranges, which must share one skeleton topology. Each
   // is cut to its range, resampled to options.sample_rate, freed of its facing (unless
   // options.pose.remove_heading is false) and linearised about the per-joint mean orientation
-  // of all training frames (thesis Algorithm 2).
+  // of all training frames (thesis Algorithm 2). `should_stop`, when set, is asked between
+  // training clips: CANCELLED when it says so.
   static absl::StatusOr<MotionSpace> Build(const std::vector<TrainingClip>& training,
-                                           const SpaceOptions& options = {});
+                                           const SpaceOptions& options = {},
+                                           const std::function<bool()>& should_stop = {});
   // Checks that the parts are consistent (shapes, finite values, positive weights, orthonormal
   // basis), e.g. after reading them from storage.
   static absl::StatusOr<MotionSpace> FromData(SpaceData data);
@@ -139,9 +155,11 @@ class MotionSpace {
                                   const Eigen::Ref<const Eigen::RowVectorXd>& q) const;
 
   // Thesis 3.3.4: the joint-angle error when the clips' poses are reconstructed from each of
-  // `dims` (sorted, capped at dims(); all dimensions are always reported last).
+  // `dims` (sorted, capped at dims(); all dimensions are always reported last). `should_stop`
+  // as for Build.
   absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
-      const std::vector<TrainingClip>& clips, const std::vector<int>& dims = {3, 5, 10, 20}) const;
+      const std::vector<TrainingClip>& clips, absl::Span<const int> dims = kErrorReportDims,
+      const std::function<bool()>& should_stop = {}) const;
 
  private:
   explicit MotionSpace(SpaceData data);
