@@ -1,7 +1,6 @@
 #include "server/space_builder.h"
 
 #include <chrono>
-#include <map>
 
 #include "absl/strings/str_cat.h"
 #include "core/motion/resample.h"
@@ -107,54 +106,45 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
     return absl::NotFoundError(absl::StrCat("skeleton ", skeleton_id, " has no clips"));
   }
 
-  // Training clips are kept loaded: they are trained on, measured, and projected.
+  // The training clips are read from the database as each pass needs them (two to train, one to
+  // measure), so that a space over a large library holds one clip at a time.
   std::vector<ClipSelection> ranges = request.training;
   if (ranges.empty()) {
     for (const int64_t id : clip_ids) ranges.push_back({id, std::nullopt, std::nullopt});
   }
-  std::map<int64_t, storage::StoredClip> loaded;
-  std::vector<TrainingClip> training;
   std::vector<TrainingReport> used;
+  std::vector<storage::ClipRecord> records;
   for (size_t i = 0; i < ranges.size(); ++i) {
-    MOTIONDB_RETURN_IF_ERROR(check_stop());
-    auto it = loaded.find(ranges[i].clip_id);
-    if (it == loaded.end()) {
-      MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(ranges[i].clip_id));
-      it = loaded.emplace(ranges[i].clip_id, std::move(stored)).first;
-    }
-    const Clip& clip = it->second.clip;
-    MOTIONDB_ASSIGN_OR_RETURN(
-        const FrameRange frames,
-        ResolveFrameRange(ranges[i], clip.frame_count(), absl::StrCat("training[", i, "]")));
-    training.push_back({it->second.record.name, clip, frames});
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record,
+                              TrainingRecord(database, i, ranges[i].clip_id));
+    MOTIONDB_ASSIGN_OR_RETURN(const FrameRange frames,
+                              ResolveFrameRange(ranges[i], static_cast<int>(record.frame_count),
+                                                absl::StrCat("training[", i, "]")));
     used.push_back({ranges[i].clip_id, frames});
+    records.push_back(record);
   }
+  const TrainingSet training{
+      ranges.size(), [&](size_t i) -> absl::StatusOr<TrainingClip> {
+        MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(ranges[i].clip_id));
+        return TrainingClip{stored.record.name, std::move(stored.clip), used[i].frames};
+      }};
 
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built,
                             MotionSpace::Build(training, request.options, should_stop));
   // Counted once Build has checked the sample rate (a rate of 1e295 overflowed the count).
   int64_t training_frames = 0;
-  for (const TrainingClip& clip : training) {
+  for (size_t i = 0; i < used.size(); ++i) {
     training_frames +=
-        ResampledFrameCount(clip.frames->size(), clip.clip.frame_time(), built.sample_rate());
+        ResampledFrameCount(used[i].frames.size(), records[i].frame_time, built.sample_rate());
   }
   auto space = std::make_shared<const MotionSpace>(std::move(built));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
                             space->RepresentationalError(training, kErrorReportDims, should_stop));
-  training.clear();
 
   BuiltSpace result;
   for (const int64_t id : clip_ids) {
     MOTIONDB_RETURN_IF_ERROR(check_stop());
-    // A training clip is projected from memory and then released; others are loaded now.
-    absl::StatusOr<storage::StoredClip> loaded_clip = absl::NotFoundError("");
-    if (auto it = loaded.find(id); it != loaded.end()) {
-      loaded_clip = std::move(it->second);
-      loaded.erase(it);
-    } else {
-      loaded_clip = database.GetClip(id);
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, std::move(loaded_clip));
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, database.GetClip(id));
     MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space, stored.clip));
     result.clips.push_back({{id, stored.record.name, stored.record.tags, std::move(coordinates)},
                             ClipTiming::Of(stored.record)});

@@ -21,6 +21,7 @@
 namespace motiondb {
 namespace {
 
+using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
 constexpr double kPi = std::numbers::pi;
@@ -291,7 +292,7 @@ TEST_F(MotionSpaceTest, RejectsBadTrainingAndOptions) {
     EXPECT_EQ(space.status().code(), absl::StatusCode::kInvalidArgument) << space.status();
     EXPECT_THAT(space.status().message(), HasSubstr(message));
   };
-  fails({}, {}, "needs training clips");
+  fails(std::vector<TrainingClip>{}, {}, "needs training clips");
   for (const double rate : {0.0, -30.0, nan, 1e6, kMaxSpaceRate + 1}) {
     fails(training_, {.sample_rate = rate}, "sample rate");
   }
@@ -339,11 +340,51 @@ TEST_F(MotionSpaceTest, RejectsBadBlocksAndClips) {
   EXPECT_FALSE(space_.MetricScales(space_.dims() + 1).ok());
   EXPECT_FALSE(space_.Distance(Eigen::RowVectorXd::Zero(3), Eigen::RowVectorXd::Zero(4)).ok());
   EXPECT_FALSE(space_.RepresentationalError(training_, {0}).ok());
-  EXPECT_FALSE(space_.RepresentationalError({}).ok());
+  EXPECT_FALSE(space_.RepresentationalError(std::vector<TrainingClip>{}).ok());
   const Clip other = testing::SyntheticClip(testing::HumanoidSkeleton(false));
   EXPECT_THAT(space_.ProjectClip(other).status().message(), HasSubstr("skeleton differs"));
   EXPECT_THAT(space_.RepresentationalError(Whole({other})).status().message(),
               HasSubstr("clip0: skeleton differs"));
+}
+
+TEST_F(MotionSpaceTest, AFetchedSetIsReadAClipAtATimeAPassAtATime) {
+  std::vector<size_t> fetched;
+  const TrainingSet set{training_.size(), [&](size_t i) -> absl::StatusOr<TrainingClip> {
+                          fetched.push_back(i);
+                          return training_[i];
+                        }};
+  const MotionSpace space = *MotionSpace::Build(set);
+  // Two passes, in order: the mean orientations, then the basis.
+  EXPECT_THAT(fetched, ElementsAre(0, 0, 1, 0, 1));  // the first fetch finds the skeleton
+  EXPECT_EQ(space.data().training.size(), training_.size());
+  EXPECT_TRUE(space.data().mean.isApprox(space_.data().mean, 1e-12));
+  EXPECT_TRUE(space.data().eigenvalues.isApprox(space_.data().eigenvalues, 1e-12));
+
+  // The moments match the textbook covariance of all the weighted poses at once.
+  RowMatrixXd weighted(0, space.dims());
+  for (const TrainingClip& clip : training_) {
+    const RowMatrixXd poses = *space.EncodeClip(clip.clip);
+    weighted.conservativeResize(weighted.rows() + poses.rows(), Eigen::NoChange);
+    weighted.bottomRows(poses.rows()) = poses * space.pose_weights().asDiagonal();
+  }
+  const Eigen::RowVectorXd mean = weighted.colwise().mean();
+  EXPECT_LT((mean.transpose() - space.data().mean).cwiseAbs().maxCoeff(), 1e-12);
+  const RowMatrixXd centred = weighted.rowwise() - mean;
+  const Eigen::MatrixXd covariance =
+      centred.transpose() * centred / static_cast<double>(weighted.rows());
+  const Eigen::MatrixXd rebuilt =
+      space.data().basis * space.data().eigenvalues.asDiagonal() * space.data().basis.transpose();
+  EXPECT_LT((rebuilt - covariance).cwiseAbs().maxCoeff(), 1e-10);
+
+  fetched.clear();
+  ASSERT_TRUE(space.RepresentationalError(set).ok());
+  EXPECT_THAT(fetched, ElementsAre(0, 1));
+
+  const TrainingSet failing{2, [&](size_t i) -> absl::StatusOr<TrainingClip> {
+                              if (i == 1) return absl::UnavailableError("disk gone");
+                              return training_[i];
+                            }};
+  EXPECT_EQ(MotionSpace::Build(failing).status().code(), absl::StatusCode::kUnavailable);
 }
 
 TEST_F(MotionSpaceTest, BuildAndErrorReportStopWhenAsked) {

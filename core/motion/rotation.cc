@@ -154,7 +154,10 @@ absl::StatusOr<Quat> MeanQuaternion(const Eigen::Ref<const RowMatrixXd>& wxyz) {
     return absl::InvalidArgumentError("MeanQuaternion: expected 4 columns (w, x, y, z)");
   }
   if (wxyz.rows() == 0) return absl::InvalidArgumentError("MeanQuaternion: no samples");
-  const Eigen::Matrix4d scatter = wxyz.transpose() * wxyz;
+  return MeanQuaternionOfScatter(wxyz.transpose() * wxyz);
+}
+
+absl::StatusOr<Quat> MeanQuaternionOfScatter(const Eigen::Matrix4d& scatter) {
   if (!scatter.allFinite()) {
     return absl::InvalidArgumentError("MeanQuaternion: samples are not finite");
   }

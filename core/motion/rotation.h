@@ -66,6 +66,8 @@ double AngleBetween(const Quat& a, const Quat& b);
 // largest eigenvalue of sum q q^T, returned with w >= 0. Invariant to the sign of every sample.
 // `wxyz` holds one quaternion per row as w, x, y, z. Fails on an empty set.
 absl::StatusOr<Quat> MeanQuaternion(const Eigen::Ref<const RowMatrixXd>& wxyz);
+// The same mean from the samples' scatter sum q q^T, which can be summed a batch at a time.
+absl::StatusOr<Quat> MeanQuaternionOfScatter(const Eigen::Matrix4d& scatter);
 
 }  // namespace motiondb
 

@@ -113,9 +113,63 @@ absl::Status CheckData(const SpaceData& data) {
 
 // The eigen-decomposition of the weighted covariance, by decreasing eigenvalue. Each column's
 // sign makes its largest entry positive, so that rebuilding a space gives the same axes.
-void SolveBasis(const RowMatrixXd& centred, SpaceData* data) {
-  const Eigen::MatrixXd covariance =
-      (centred.transpose() * centred) / static_cast<double>(centred.rows());
+// The poses of a set of training clips, a clip at a time: each is fetched, checked against the
+// skeleton, cut to its range, sampled at the rate and turned into pose rotations.
+struct TrainingPoses {
+  const TrainingSet& training;
+  const Skeleton& skeleton;
+  std::string skeleton_owner;  // whose skeleton the clips must match, for the error
+  double rate;
+  const PoseOptions& pose;
+  const std::function<bool()>& should_stop;
+
+  absl::Status ForEach(
+      const std::function<absl::Status(const TrainingClip&, const PoseRotations&)>& use) const {
+    for (size_t i = 0; i < training.count; ++i) {
+      MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
+      MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip range, training.fetch(i));
+      if (!range.clip.skeleton().SameTopology(skeleton)) {
+        return absl::InvalidArgumentError(absl::StrCat(range.source, ": skeleton differs from ",
+                                                       skeleton_owner,
+                                                       ": joint names or parents do not match"));
+      }
+      MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
+      MOTIONDB_RETURN_IF_ERROR(use(range, ComputePoseRotations(sampled, pose)));
+    }
+    return absl::OkStatus();
+  }
+};
+
+// The mean and covariance of rows added a batch at a time. The sums are taken about the first
+// row rather than about zero, so that the covariance of poses far from the origin does not
+// come from the difference of two large numbers.
+class PoseMoments {
+ public:
+  explicit PoseMoments(Eigen::Index dims)
+      : sum_(Eigen::VectorXd::Zero(dims)), scatter_(Eigen::MatrixXd::Zero(dims, dims)) {}
+
+  void Add(RowMatrixXd rows) {
+    if (rows.rows() == 0) return;
+    if (count_ == 0) shift_ = rows.row(0).transpose();
+    rows.rowwise() -= shift_.transpose();
+    sum_ += rows.colwise().sum().transpose();
+    scatter_.noalias() += rows.transpose() * rows;
+    count_ += rows.rows();
+  }
+  Eigen::VectorXd Mean() const { return shift_ + sum_ / static_cast<double>(count_); }
+  Eigen::MatrixXd Covariance() const {
+    const Eigen::VectorXd offset = sum_ / static_cast<double>(count_);
+    return scatter_ / static_cast<double>(count_) - offset * offset.transpose();
+  }
+
+ private:
+  Eigen::Index count_ = 0;
+  Eigen::VectorXd shift_;
+  Eigen::VectorXd sum_;
+  Eigen::MatrixXd scatter_;
+};
+
+void SolveBasis(const Eigen::MatrixXd& covariance, SpaceData* data) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
   const Eigen::Index dims = covariance.rows();
   data->basis.resize(dims, dims);
@@ -153,16 +207,27 @@ Eigen::VectorXd MetricScales(SpaceMetric metric, const Eigen::VectorXd& eigenval
   return Eigen::VectorXd::Ones(dims);
 }
 
+TrainingSet TrainingSet::Of(const std::vector<TrainingClip>& clips) {
+  return {clips.size(), [&clips](size_t i) -> absl::StatusOr<TrainingClip> { return clips[i]; }};
+}
+
 absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& training,
                                                const SpaceOptions& options,
                                                const std::function<bool()>& should_stop) {
-  if (training.empty()) return absl::InvalidArgumentError("a space needs training clips");
+  return Build(TrainingSet::Of(training), options, should_stop);
+}
+
+absl::StatusOr<MotionSpace> MotionSpace::Build(const TrainingSet& training,
+                                               const SpaceOptions& options,
+                                               const std::function<bool()>& should_stop) {
+  if (training.count == 0) return absl::InvalidArgumentError("a space needs training clips");
   MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(options.sample_rate, kMaxSpaceRate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(options.pose));
   MOTIONDB_RETURN_IF_ERROR(
       CheckExtraWeights(options.pose, options.yaw_rate_weight, options.root_velocity_weight));
+  MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip first, training.fetch(0));
   SpaceData data;
-  data.skeleton = training.front().clip.shared_skeleton();
+  data.skeleton = first.clip.shared_skeleton();
   data.sample_rate = options.sample_rate;
   data.pose = options.pose;
   data.pose.root_velocity = options.pose.remove_heading && options.pose.root_velocity;
@@ -171,47 +236,40 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const std::vector<TrainingClip>& 
   data.metric = options.metric;
   MOTIONDB_ASSIGN_OR_RETURN(data.joint_weights,
                             ComputeJointWeights(*data.skeleton, options.weights));
+  const TrainingPoses poses{training,
+                            *data.skeleton,
+                            absl::StrCat("the first training clip's (", first.source, ")"),
+                            data.sample_rate,
+                            data.pose,
+                            should_stop};
 
-  std::vector<PoseRotations> poses;
-  Eigen::Index frames = 0;
-  for (const TrainingClip& range : training) {
-    MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
-    if (!range.clip.skeleton().SameTopology(*data.skeleton)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(range.source, ": skeleton differs from the first training clip's (",
-                       training.front().source, "): joint names or parents do not match"));
+  // Two passes, each holding one clip's poses at a time: the mean orientations, then the mean
+  // and covariance of the poses linearised about them.
+  const int joints = data.skeleton->joint_count();
+  std::vector<Eigen::Matrix4d> scatter(joints, Eigen::Matrix4d::Zero());
+  MOTIONDB_RETURN_IF_ERROR(poses.ForEach([&](const TrainingClip& range, const PoseRotations& pose) {
+    for (int j = 0; j < joints; ++j) {
+      const auto wxyz = pose.rotations.middleCols(4 * j, 4);
+      scatter[j] += wxyz.transpose() * wxyz;
     }
-    MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, options.sample_rate));
-    poses.push_back(ComputePoseRotations(sampled, options.pose));
-    frames += sampled.frame_count();
     const FrameRange all{0, range.clip.frame_count() - 1};
     data.training.push_back({range.source, range.frames.value_or(all)});
-  }
-
-  const int joints = data.skeleton->joint_count();
-  RowMatrixXd rotations(frames, 4 * joints);
-  Eigen::Index row = 0;
-  for (const PoseRotations& pose : poses) {
-    rotations.middleRows(row, pose.rotations.rows()) = pose.rotations;
-    row += pose.rotations.rows();
-  }
+    return absl::OkStatus();
+  }));
   data.references.resize(joints, 4);
   for (int j = 0; j < joints; ++j) {
-    MOTIONDB_ASSIGN_OR_RETURN(const Quat mean, MeanQuaternion(rotations.middleCols(4 * j, 4)));
+    MOTIONDB_ASSIGN_OR_RETURN(const Quat mean, MeanQuaternionOfScatter(scatter[j]));
     data.references.row(j) << mean.w(), mean.x(), mean.y(), mean.z();
   }
 
   const Eigen::VectorXd pose_weights = PoseWeights(data);
-  RowMatrixXd weighted(frames, pose_weights.size());
-  row = 0;
-  for (const PoseRotations& pose : poses) {
-    weighted.middleRows(row, pose.rotations.rows()) =
-        EncodePoses(pose, data.references) * pose_weights.asDiagonal();
-    row += pose.rotations.rows();
-  }
-  data.mean = weighted.colwise().mean().transpose();
-  weighted.rowwise() -= data.mean.transpose();
-  SolveBasis(weighted, &data);
+  PoseMoments moments(pose_weights.size());
+  MOTIONDB_RETURN_IF_ERROR(poses.ForEach([&](const TrainingClip&, const PoseRotations& pose) {
+    moments.Add(EncodePoses(pose, data.references) * pose_weights.asDiagonal());
+    return absl::OkStatus();
+  }));
+  data.mean = moments.Mean();
+  SolveBasis(moments.Covariance(), &data);
   if (data.eigenvalues.sum() <= 0.0) {
     return absl::InvalidArgumentError(
         "the training poses do not vary: a space needs at least two different poses");
@@ -295,6 +353,12 @@ absl::StatusOr<double> MotionSpace::Distance(const Eigen::Ref<const Eigen::RowVe
 absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
     const std::vector<TrainingClip>& clips, absl::Span<const int> dims,
     const std::function<bool()>& should_stop) const {
+  return RepresentationalError(TrainingSet::Of(clips), dims, should_stop);
+}
+
+absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
+    const TrainingSet& clips, absl::Span<const int> dims,
+    const std::function<bool()>& should_stop) const {
   std::vector<int> levels;
   for (const int n : dims) {
     if (n < 1) {
@@ -311,32 +375,29 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
   for (const int n : levels) report.push_back({n, 0.0, 0.0});
   double angles = 0.0;
   const int joints = skeleton().joint_count();
-  for (const TrainingClip& range : clips) {
-    MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
-    if (!range.clip.skeleton().SameTopology(skeleton())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(range.source, ": skeleton differs from the space's"));
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, data_.sample_rate));
-    const PoseRotations pose = ComputePoseRotations(sampled, data_.pose);
-    MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates,
-                              Project(EncodePoses(pose, data_.references)));
-    for (ReconstructionError& level : report) {
-      MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
-                                Reconstruct(coordinates.leftCols(level.dims)));
-      for (Eigen::Index f = 0; f < rebuilt.rows(); ++f) {
-        for (int j = 0; j < joints; ++j) {
-          const auto a = pose.rotations.block<1, 4>(f, 4 * j);
-          const auto b = rebuilt.block<1, 4>(f, 4 * j);
-          const double angle =
-              AngleBetween(Quat(a[0], a[1], a[2], a[3]), Quat(b[0], b[1], b[2], b[3]));
-          level.mean_rad += angle;
-          level.max_rad = std::max(level.max_rad, angle);
+  const TrainingPoses poses{clips,      skeleton(), "the space's", data_.sample_rate,
+                            data_.pose, should_stop};
+  MOTIONDB_RETURN_IF_ERROR(
+      poses.ForEach([&](const TrainingClip&, const PoseRotations& pose) -> absl::Status {
+        MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates,
+                                  Project(EncodePoses(pose, data_.references)));
+        for (ReconstructionError& level : report) {
+          MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
+                                    Reconstruct(coordinates.leftCols(level.dims)));
+          for (Eigen::Index f = 0; f < rebuilt.rows(); ++f) {
+            for (int j = 0; j < joints; ++j) {
+              const auto a = pose.rotations.block<1, 4>(f, 4 * j);
+              const auto b = rebuilt.block<1, 4>(f, 4 * j);
+              const double angle =
+                  AngleBetween(Quat(a[0], a[1], a[2], a[3]), Quat(b[0], b[1], b[2], b[3]));
+              level.mean_rad += angle;
+              level.max_rad = std::max(level.max_rad, angle);
+            }
+          }
         }
-      }
-    }
-    angles += static_cast<double>(pose.rotations.rows()) * joints;
-  }
+        angles += static_cast<double>(pose.rotations.rows()) * joints;
+        return absl::OkStatus();
+      }));
   if (angles == 0.0) return absl::InvalidArgumentError("no clips to reconstruct");
   for (ReconstructionError& level : report) level.mean_rad /= angles;
   return report;

@@ -76,6 +76,18 @@ struct TrainingClip {
   std::optional<FrameRange> frames;  // at the clip's own rate; nullopt for the whole clip
 };
 
+// Training clips fetched one at a time. Build and RepresentationalError fetch each clip once
+// a pass and keep none, so that a space over a large library holds one clip at a time (Build
+// makes two passes: the mean orientations, then the basis).
+struct TrainingSet {
+  size_t count = 0;
+  // The i-th clip, i < count.
+  std::function<absl::StatusOr<TrainingClip>(size_t i)> fetch;
+
+  // The clips of `clips`, which must outlive the set; each fetch copies one.
+  static TrainingSet Of(const std::vector<TrainingClip>& clips);
+};
+
 // Where a space's training frames came from.
 struct TrainingSource {
   std::string source;
@@ -121,6 +133,9 @@ class MotionSpace {
   static absl::StatusOr<MotionSpace> Build(const std::vector<TrainingClip>& training,
                                            const SpaceOptions& options = {},
                                            const std::function<bool()>& should_stop = {});
+  static absl::StatusOr<MotionSpace> Build(const TrainingSet& training,
+                                           const SpaceOptions& options = {},
+                                           const std::function<bool()>& should_stop = {});
   // Checks that the parts are consistent (shapes, finite values, positive weights, orthonormal
   // basis), e.g. after reading them from storage.
   static absl::StatusOr<MotionSpace> FromData(SpaceData data);
@@ -159,6 +174,9 @@ class MotionSpace {
   // as for Build.
   absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
       const std::vector<TrainingClip>& clips, absl::Span<const int> dims = kErrorReportDims,
+      const std::function<bool()>& should_stop = {}) const;
+  absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
+      const TrainingSet& clips, absl::Span<const int> dims = kErrorReportDims,
       const std::function<bool()>& should_stop = {}) const;
 
  private:
