@@ -111,8 +111,6 @@ absl::Status CheckData(const SpaceData& data) {
   return absl::OkStatus();
 }
 
-// The eigen-decomposition of the weighted covariance, by decreasing eigenvalue. Each column's
-// sign makes its largest entry positive, so that rebuilding a space gives the same axes.
 // The poses of a set of training clips, a clip at a time: each is fetched, checked against the
 // skeleton, cut to its range, sampled at the rate and turned into pose rotations.
 struct TrainingPoses {
@@ -169,6 +167,8 @@ class PoseMoments {
   Eigen::MatrixXd scatter_;
 };
 
+// The eigen-decomposition of the weighted covariance, by decreasing eigenvalue. Each column's
+// sign makes its largest entry positive, so that rebuilding a space gives the same axes.
 void SolveBasis(const Eigen::MatrixXd& covariance, SpaceData* data) {
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
   const Eigen::Index dims = covariance.rows();
