@@ -96,7 +96,9 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
                                       const std::function<bool()>& should_stop) {
   const auto start = std::chrono::steady_clock::now();
   auto check_stop = [&]() -> absl::Status {
-    if (should_stop && should_stop()) return absl::CancelledError("space build cancelled");
+    if (should_stop && should_stop()) {
+      return absl::CancelledError("stopped by its caller while projecting the library");
+    }
     return absl::OkStatus();
   };
   MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, ResolveSkeleton(database, request));
@@ -123,11 +125,17 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
     used.push_back({ranges[i].clip_id, frames});
     records.push_back(record);
   }
-  const TrainingSet training{
-      ranges.size(), [&](size_t i) -> absl::StatusOr<TrainingClip> {
-        MOTIONDB_ASSIGN_OR_RETURN(storage::StoredClip stored, database.GetClip(ranges[i].clip_id));
-        return TrainingClip{stored.record.name, std::move(stored.clip), used[i].frames};
-      }};
+  // The last clip read is kept, so that several ranges of one long take, given one after
+  // another, read it once a pass.
+  std::optional<storage::StoredClip> last;
+  const TrainingSet training{ranges.size(), [&](size_t i) -> absl::StatusOr<TrainingClip> {
+                               if (!last || last->record.clip_id != ranges[i].clip_id) {
+                                 last.reset();
+                                 MOTIONDB_ASSIGN_OR_RETURN(last,
+                                                           database.GetClip(ranges[i].clip_id));
+                               }
+                               return TrainingClip{last->record.name, last->clip, used[i].frames};
+                             }};
 
   MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built,
                             MotionSpace::Build(training, request.options, should_stop));
@@ -140,6 +148,7 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   auto space = std::make_shared<const MotionSpace>(std::move(built));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
                             space->RepresentationalError(training, kErrorReportDims, should_stop));
+  last.reset();
 
   BuiltSpace result;
   for (const int64_t id : clip_ids) {

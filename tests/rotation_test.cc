@@ -213,6 +213,8 @@ TEST(MeanQuaternion, RejectsBadInput) {
   RowMatrixXd nan = RowMatrixXd::Ones(2, 4);
   nan(1, 2) = NAN;
   EXPECT_EQ(MeanQuaternion(nan).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(MeanQuaternionOfScatter(Eigen::Matrix4d::Zero()).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(AngleBetween, IsSignInvariantAndExact) {

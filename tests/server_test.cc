@@ -14,6 +14,7 @@
 #include <regex>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include <gmock/gmock.h>
 #include <google/protobuf/descriptor.pb.h>
@@ -898,6 +899,26 @@ TEST_F(ServerTest, RealClipsSearchAndSkeletonMismatch) {
   EXPECT_EQ(space.report().training(0).last_frame(), 1999);
   EXPECT_EQ(space.report().joint_weights(0).joint(), "Hips");
   EXPECT_DOUBLE_EQ(space.report().joint_weights(0).weight(), 2.0);
+
+  // Ranges of one clip, apart and side by side: the training reads its clips as it goes.
+  v1::CreateSpaceRequest ranges;
+  ranges.set_name("cmu-ranges");
+  for (const auto& [clip, first, last] :
+       {std::tuple{walk, 0, 999}, std::tuple{other, 0, 99}, std::tuple{walk, 1000, 1999},
+        std::tuple{walk, 100, 199}}) {
+    v1::ClipRange* range = ranges.add_training();
+    range->set_clip_id(clip);
+    range->set_first_frame(first);
+    range->set_last_frame(last);
+  }
+  v1::Space ranged;
+  status = client.CreateSpace(ranges, &ranged);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(ranged.report().training_size(), 4);
+  EXPECT_EQ(ranged.report().training(1).clip_id(), other);
+  EXPECT_EQ(ranged.report().training(2).first_frame(), 1000);
+  EXPECT_EQ(ranged.report().training(3).last_frame(), 199);
+  EXPECT_EQ(ranged.report().training_frames(), (1000 + 100 + 1000 + 100) / 4);  // 120 -> 30 Hz
 
   v1::SearchResponse found;
   status = client.Search(ClipQuery("cmu", walk, 1000, 1240), &found);

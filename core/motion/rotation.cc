@@ -158,6 +158,8 @@ absl::StatusOr<Quat> MeanQuaternion(const Eigen::Ref<const RowMatrixXd>& wxyz) {
 }
 
 absl::StatusOr<Quat> MeanQuaternionOfScatter(const Eigen::Matrix4d& scatter) {
+  // The trace is the samples' summed squared norm: zero only without samples.
+  if (scatter.trace() <= 0.0) return absl::InvalidArgumentError("MeanQuaternion: no samples");
   if (!scatter.allFinite()) {
     return absl::InvalidArgumentError("MeanQuaternion: samples are not finite");
   }

@@ -67,6 +67,7 @@ double AngleBetween(const Quat& a, const Quat& b);
 // `wxyz` holds one quaternion per row as w, x, y, z. Fails on an empty set.
 absl::StatusOr<Quat> MeanQuaternion(const Eigen::Ref<const RowMatrixXd>& wxyz);
 // The same mean from the samples' scatter sum q q^T, which can be summed a batch at a time.
+// Fails on a zero scatter (no samples).
 absl::StatusOr<Quat> MeanQuaternionOfScatter(const Eigen::Matrix4d& scatter);
 
 }  // namespace motiondb

@@ -40,7 +40,9 @@ absl::Status CheckSampleRate(double rate, double max_rate) {
 }
 
 absl::Status CheckStop(const std::function<bool()>& should_stop) {
-  if (should_stop && should_stop()) return absl::CancelledError("space build cancelled");
+  if (should_stop && should_stop()) {
+    return absl::CancelledError("stopped by its caller between training clips");
+  }
   return absl::OkStatus();
 }
 
@@ -154,6 +156,8 @@ class PoseMoments {
     scatter_.noalias() += rows.transpose() * rows;
     count_ += rows.rows();
   }
+  // Mean and Covariance need a row added: Build adds every training clip's, and SampleRange
+  // refuses a clip without frames.
   Eigen::VectorXd Mean() const { return shift_ + sum_ / static_cast<double>(count_); }
   Eigen::MatrixXd Covariance() const {
     const Eigen::VectorXd offset = sum_ / static_cast<double>(count_);
@@ -225,9 +229,13 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const TrainingSet& training,
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(options.pose));
   MOTIONDB_RETURN_IF_ERROR(
       CheckExtraWeights(options.pose, options.yaw_rate_weight, options.root_velocity_weight));
-  MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip first, training.fetch(0));
   SpaceData data;
-  data.skeleton = first.clip.shared_skeleton();
+  std::string first_source;
+  {  // Not kept: the passes below hold one clip at a time.
+    MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip first, training.fetch(0));
+    data.skeleton = first.clip.shared_skeleton();
+    first_source = first.source;
+  }
   data.sample_rate = options.sample_rate;
   data.pose = options.pose;
   data.pose.root_velocity = options.pose.remove_heading && options.pose.root_velocity;
@@ -238,7 +246,7 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const TrainingSet& training,
                             ComputeJointWeights(*data.skeleton, options.weights));
   const TrainingPoses poses{training,
                             *data.skeleton,
-                            absl::StrCat("the first training clip's (", first.source, ")"),
+                            absl::StrCat("the first training clip's (", first_source, ")"),
                             data.sample_rate,
                             data.pose,
                             should_stop};

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include "absl/base/attributes.h"
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/motion/clip.h"
@@ -78,14 +79,16 @@ struct TrainingClip {
 
 // Training clips fetched one at a time. Build and RepresentationalError fetch each clip once
 // a pass and keep none, so that a space over a large library holds one clip at a time (Build
-// makes two passes: the mean orientations, then the basis).
+// fetches the first once more for its skeleton, then makes two passes: the mean orientations,
+// then the basis). A braced `{}` argument is ambiguous between this and a vector: spell out
+// the type.
 struct TrainingSet {
   size_t count = 0;
   // The i-th clip, i < count.
   std::function<absl::StatusOr<TrainingClip>(size_t i)> fetch;
 
   // The clips of `clips`, which must outlive the set; each fetch copies one.
-  static TrainingSet Of(const std::vector<TrainingClip>& clips);
+  static TrainingSet Of(const std::vector<TrainingClip>& clips ABSL_ATTRIBUTE_LIFETIME_BOUND);
 };
 
 // Where a space's training frames came from.
