@@ -140,6 +140,21 @@ struct TrainingPoses {
   }
 };
 
+// Adds the angle between each joint's original and rebuilt rotation (frames x 4 * joints, w, x,
+// y, z) to the level's sum (mean_rad until divided) and maximum.
+void AddAngleErrors(const RowMatrixXd& original, const RowMatrixXd& rebuilt,
+                    ReconstructionError* level) {
+  for (Eigen::Index f = 0; f < rebuilt.rows(); ++f) {
+    for (Eigen::Index c = 0; c < rebuilt.cols(); c += 4) {
+      const auto a = original.block<1, 4>(f, c);
+      const auto b = rebuilt.block<1, 4>(f, c);
+      const double angle = AngleBetween(Quat(a[0], a[1], a[2], a[3]), Quat(b[0], b[1], b[2], b[3]));
+      level->mean_rad += angle;
+      level->max_rad = std::max(level->max_rad, angle);
+    }
+  }
+}
+
 // The mean and covariance of rows added a batch at a time. The sums are taken about the first
 // row rather than about zero, so that the covariance of poses far from the origin does not
 // come from the difference of two large numbers.
@@ -392,16 +407,7 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
         for (ReconstructionError& level : report) {
           MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
                                     Reconstruct(coordinates.leftCols(level.dims)));
-          for (Eigen::Index f = 0; f < rebuilt.rows(); ++f) {
-            for (int j = 0; j < joints; ++j) {
-              const auto a = pose.rotations.block<1, 4>(f, 4 * j);
-              const auto b = rebuilt.block<1, 4>(f, 4 * j);
-              const double angle =
-                  AngleBetween(Quat(a[0], a[1], a[2], a[3]), Quat(b[0], b[1], b[2], b[3]));
-              level.mean_rad += angle;
-              level.max_rad = std::max(level.max_rad, angle);
-            }
-          }
+          AddAngleErrors(pose.rotations, rebuilt, &level);
         }
         angles += static_cast<double>(pose.rotations.rows()) * joints;
         return absl::OkStatus();
