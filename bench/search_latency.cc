@@ -5,7 +5,8 @@
 // anchored at the action's peak (the thesis's manual characteristic point).
 //
 // usage: search_latency [--scenario 70s120|1h30|10h30|10h120|100h30|sweeps|all] [--queries N]
-//          [--exact-queries N] [--places N ...] [--neighbours N ...]
+//          [--exact-queries N] [--places N ...] [--neighbours N ...] [--points K ...]
+//          [--second-anchor S ...]
 // real10h30: real capture from ../shared/mocap grown to 10 h by perturbed copies, real queries.
 #include <sys/resource.h>
 #include <unistd.h>
@@ -212,12 +213,13 @@ double RecallAtTen(const Run& fast, const Run& exact) {
 struct VariantFlags {
   std::vector<int> places;
   std::vector<int> neighbours;
-  std::vector<int> points;  // characteristic points (0: by the query's length)
+  std::vector<int> points;            // characteristic points (0: by the query's length)
+  std::vector<double> second_anchor;  // SearchParams::second_anchor_scatter values
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
-// refinement, with the --neighbours values, with the --points values, and with distinct places
-// as seeds: 128 of them and the --places values.
+// refinement, with the --neighbours values, with the --points values, with the --second-anchor
+// values, and with distinct places as seeds: 128 of them and the --places values.
 std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& flags) {
   SearchParams unrefined;
   unrefined.refine = false;
@@ -232,6 +234,11 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     SearchParams params;
     params.characteristic_points = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " characteristic points"), params);
+  }
+  for (double scatter : flags.second_anchor) {
+    SearchParams params;
+    params.second_anchor_scatter = scatter;
+    variants.emplace_back(absl::StrCat("fast, second_anchor_scatter ", scatter), params);
   }
   std::vector<int> places = {SearchParams().places};
   places.insert(places.end(), flags.places.begin(), flags.places.end());
@@ -392,6 +399,11 @@ int main(int argc, char** argv) {
                  "one per action of the query)")
       ->type_name("K ...")
       ->check(motiondb::cli::WholeAtLeast(0));
+  app.add_option("--second-anchor", variants.second_anchor,
+                 "also measure the fast search with these second_anchor_scatter values (a second "
+                 "anchor when the seeds fall in more clusters than this share of them; 0: never)")
+      ->type_name("S ...")
+      ->check(CLI::Range(0.0, 1.0));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }

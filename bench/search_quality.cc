@@ -10,7 +10,7 @@
 //          [--weights mass|uniform] [--weight-floor F] [--weight JOINT=W]...
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
-//          [--no-refine] [--points K]
+//          [--no-refine] [--points K] [--second-anchor S]
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -97,6 +97,12 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
              {"mean", "boundary", "origin"})
       ->capture_default_str();
   app.add_flag("--no-refine", flags->no_refine, "the thesis's search as is");
+  app.add_option("--second-anchor", params.second_anchor_scatter,
+                 "a second anchor when the seeds scatter over more clusters than this share of "
+                 "them (0: never)")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 // Groups and queries of `split` (see the file comment).

@@ -27,7 +27,7 @@ struct SearchFlags {
   std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, exact_threads;
   std::optional<int> points;
   std::vector<int> char_frames;
-  std::optional<double> max_point_gap;
+  std::optional<double> max_point_gap, second_anchor;
   std::string seeds = "frames";
   std::optional<double> epsilon;
   std::string neutral = "mean";
@@ -82,7 +82,8 @@ FlagNames SearchFlagNames(const SearchFlags& flags) {
                      {"neutral", "--neutral"},
                      {"exact_threads", "--threads"},
                      {"characteristic_frames", "--char-frames"},
-                     {"max_point_gap_s", "--max-point-gap"}};
+                     {"max_point_gap_s", "--max-point-gap"},
+                     {"second_anchor_scatter", "--second-anchor"}};
   for (const Parameter& parameter : kParameters) names.push_back({parameter.field, parameter.flag});
   return names;
 }
@@ -107,6 +108,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   if (flags.char_frame) request.set_characteristic_frame(*flags.char_frame);
   for (const int frame : flags.char_frames) request.add_characteristic_frames(frame);
   if (flags.max_point_gap) request.set_max_point_gap_s(*flags.max_point_gap);
+  if (flags.second_anchor) request.set_second_anchor_scatter(*flags.second_anchor);
   if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
   request.set_seed_selection(flags.seeds == "places" ? v1::SEED_SELECTION_DISTINCT_PLACES
                                                      : v1::SEED_SELECTION_NEAREST_FRAMES);
@@ -163,6 +165,7 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
           {"characteristic_frame", response.characteristic_frame()},
           {"characteristic_frames", std::vector<int>(response.characteristic_frames().begin(),
                                                      response.characteristic_frames().end())},
+          {"second_anchor_frame", response.second_anchor_frame()},
           {"timings",
            {{"characteristic_ms", t.characteristic_ms()},
             {"seeds_ms", t.seeds_ms()},
@@ -259,6 +262,13 @@ void AddSearch(Commands& commands) {
                    "several points: the most seconds a result may skip between two parts")
       ->type_name("S")
       ->default_str("10")
+      ->check(NumberAtLeast(0));
+  search
+      ->add_option("--second-anchor", flags->second_anchor,
+                   "one point: a second anchor takes half the seeds when they fall in more "
+                   "clusters than this share of them (a pose common to many takes); 0: never")
+      ->type_name("S")
+      ->default_str("0.5")
       ->check(NumberAtLeast(0));
   OneOf(search->add_option("--neutral", flags->neutral,
                            "auto --char-frame: the pose farthest from this"),

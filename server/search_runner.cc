@@ -232,6 +232,10 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
     for (const int row : outcome.stats.characteristic_frames) {
       outcome.characteristic_frames.push_back(query.frames.ToOriginal(query.first_row + row));
     }
+    if (outcome.stats.second_anchor >= 0) {
+      outcome.second_anchor_frame =
+          query.frames.ToOriginal(query.first_row + outcome.stats.second_anchor);
+    }
   }
   outcome.request_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

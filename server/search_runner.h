@@ -73,6 +73,7 @@ struct SearchOutcome {
   SearchStats stats;                       // zero when the space holds no clips
   int characteristic_frame = -1;           // at the query clip's rate; -1 when none was used
   std::vector<int> characteristic_frames;  // every one used, as characteristic_frame
+  int second_anchor_frame = -1;            // as characteristic_frame; -1 when none was used
   int64_t query_frames = 0;                // at the space rate
   int64_t library_frames = 0;
   double request_ms = 0;  // the whole request, query projection included

@@ -187,6 +187,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--char-frames F,F,...",
                              "--points K=1",
                              "--max-point-gap S=10",
+                             "--second-anchor S=0.5",
                              "--neutral mean|boundary|origin=mean",
                              "--exact",
                              "--no-refine",
@@ -393,7 +394,8 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
         {"--seeds", "frames", "--neighbours", "200"},
         {"--exact", "--threads", "2"},
         {"--char-frames", "15,35"},
-        {"--points", "2", "--max-point-gap", "1"}}) {
+        {"--points", "2", "--max-point-gap", "1"},
+        {"--second-anchor", "0"}}) {
     std::vector<std::string> args = {"search", "--space",         "body",  "--clip",
                                      clip_id_, "--from",          "10",    "--to",
                                      "40",     "--include-query", "--json"};
@@ -412,6 +414,10 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
       Remote({"search", "--space", "body", "--clip", clip_id_, "--exact", "--threads", "5000"});
   EXPECT_EQ(threads.exit_code, 1);
   EXPECT_THAT(threads.err, HasSubstr("--threads 5000 is out of range"));
+  const testing::CommandResult scatter =
+      Remote({"search", "--space", "body", "--clip", clip_id_, "--second-anchor", "2"});
+  EXPECT_EQ(scatter.exit_code, 1);
+  EXPECT_THAT(scatter.err, HasSubstr("--second-anchor 2 is out of range; expected 0..1"));
   const testing::CommandResult frames =
       Remote({"search", "--space", "body", "--clip", clip_id_, "--char-frames", "30,20", "--json"});
   EXPECT_EQ(frames.exit_code, 1);

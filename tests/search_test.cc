@@ -233,6 +233,22 @@ TEST_F(SearchTest, CharacteristicFrameIsTheFarthestFromTheNeutralPose) {
   EXPECT_EQ(FindCharacteristicFrame(CoordinateView::Of(ramp), 2, NeutralPose::kOrigin), 4);
 }
 
+// The second anchor: the farthest frame from the anchor's pose, at least a quarter of the query
+// (and 2 frames) away, on either side; none in a query too short for one.
+TEST(SecondAnchor, IsTheFarthestFrameAQuarterOfTheQueryAway) {
+  RowMatrixXf line(12, 2);
+  for (int f = 0; f < 12; ++f) line.row(f) << static_cast<float>(f == 5 ? 100 : f), 0;
+  const CoordinateView q = CoordinateView::Of(line);
+  EXPECT_EQ(FindSecondAnchor(q, 11, 2), 5);  // frame 5 is farthest from frame 11's pose
+  EXPECT_EQ(FindSecondAnchor(q, 5, 2), 0);   // from frame 5's (100), frame 0 beats frame 8
+  EXPECT_EQ(FindSecondAnchor(q, 3, 2), 11);  // frames 1..5 lie within 3 frames of frame 3
+  EXPECT_EQ(FindSecondAnchor(q, 0, 1), 5);
+  RowMatrixXf three(3, 2);
+  three.setZero();
+  EXPECT_EQ(FindSecondAnchor(CoordinateView::Of(three), 1, 2), -1);
+  EXPECT_EQ(FindSecondAnchor(CoordinateView::Of(three), 0, 2), 2);
+}
+
 TEST_F(SearchTest, FastSearchFindsEveryPlantedCopyFirst) {
   SearchParams params;
   params.neighbours = 200;
@@ -340,6 +356,69 @@ TEST_F(SearchTest, RefinementOnlyImprovesAndKeepsPathsTrue) {
   }
 }
 
+// A query of two actions, A then its mirror image -A, whose first action's pose is common: 60
+// clips hold A exactly, then noise; one clip holds a weaker A (0.8 A) then -A, and matches best.
+// The nearest frames to A's peak all lie in the 60, each a cluster of its own, so one anchor
+// never reaches the true clip; a second anchor at -A's peak does, and the result passes the
+// characteristic frame where its seed_frame says, with or without refinement.
+TEST(SearchSecondAnchor, ReachesWhatACommonPoseHides) {
+  const RowMatrixXf a = testing::Pattern(20, kDims);
+  RowMatrixXf query(40, kDims);
+  query << a, -a;
+  std::vector<LibraryClip> clips;
+  for (int c = 0; c <= 60; ++c) {
+    RowMatrixXf curve = testing::SmoothNoise(200, kDims, 50 + c);
+    if (c == 60) {
+      RowMatrixXf weak(40, kDims);
+      weak << 0.8f * a, -a;
+      testing::Plant(curve, weak, 100);
+    } else {
+      testing::Plant(curve, a, 60 + c);
+    }
+    clips.push_back({c, "clip" + std::to_string(c), {}, std::move(curve)});
+  }
+  const std::unique_ptr<LibraryIndex> library = *LibraryIndex::Build(std::move(clips), 30.0, {});
+  const CoordinateView q = CoordinateView::Of(query);
+  SearchParams params;
+  params.characteristic_frame = 10;
+  params.neighbours = 40;
+  params.max_results = 5;
+  const SearchResponse exact = *ExactSearch(*library, q, params);
+  ASSERT_FALSE(exact.results.empty());
+  ASSERT_EQ(exact.results[0].clip_id, 60);
+
+  params.second_anchor_scatter = 0;
+  const SearchResponse one = *Search(*library, q, params);
+  EXPECT_EQ(one.stats.second_anchor, -1);
+  for (const SearchResult& r : one.results) EXPECT_NE(r.clip_id, 60);
+
+  params.second_anchor_scatter = SearchParams().second_anchor_scatter;
+  params.return_path = true;
+  for (const bool refine : {true, false}) {
+    params.refine = refine;
+    const SearchResponse two = *Search(*library, q, params);
+    EXPECT_THAT(two.stats.second_anchor, ::testing::AllOf(::testing::Ge(25), ::testing::Le(34)))
+        << refine;  // -A's peak
+    EXPECT_GT(two.stats.clusters, params.second_anchor_scatter * two.stats.seeds) << refine;
+    ASSERT_FALSE(two.results.empty());
+    EXPECT_EQ(two.results[0].clip_id, 60) << refine;
+    if (refine) {
+      EXPECT_NEAR(two.results[0].score, exact.results[0].score, 1e-5);
+    }
+    for (const SearchResult& r : two.results) {
+      ASSERT_EQ(r.path.size(), 40u);
+      EXPECT_EQ(r.path[10], r.seed_frame) << refine;
+    }
+  }
+  // Below the share, or with several points, there is no second anchor.
+  params.second_anchor_scatter = 1;
+  EXPECT_EQ(Search(*library, q, params)->stats.second_anchor, -1);
+  params.second_anchor_scatter = 0.5;
+  params.characteristic_frame = -1;
+  params.characteristic_frames = {10, 30};
+  EXPECT_EQ(Search(*library, q, params)->stats.second_anchor, -1);
+}
+
 TEST_F(SearchTest, FiltersByClipIdAndTag) {
   SearchParams params;
   params.clip_ids = {101};
@@ -443,6 +522,9 @@ TEST_F(SearchTest, RejectsBadParametersAndQueries) {
   EXPECT_EQ(code([](SearchParams& p) { p.characteristic_frame = 40; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.cluster_gap_s = -1; }), bad);
   EXPECT_EQ(code([](SearchParams& p) { p.max_overlap = 2; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.second_anchor_scatter = -0.1; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.second_anchor_scatter = 1.5; }), bad);
+  EXPECT_EQ(code([](SearchParams& p) { p.second_anchor_scatter = NAN; }), bad);
   RowMatrixXf nan = query_;
   nan(3, 2) = NAN;
   EXPECT_EQ(Search(*library_, CoordinateView::Of(nan), {}).status().code(), bad);

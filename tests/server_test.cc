@@ -775,6 +775,17 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   ASSERT_GE(found.results_size(), 1);
   for (const v1::SearchResult& r : found.results()) EXPECT_EQ(r.clip_id(), raise_clip);
   EXPECT_NEAR(found.characteristic_frame(), filtered.characteristic_frame(), 1);
+  EXPECT_EQ(found.second_anchor_frame(), -1);
+  // A second anchor (asked for at any scatter) comes back in the query's own frames, a quarter
+  // of the query or more from the characteristic frame.
+  v1::SearchRequest second = query;
+  second.set_second_anchor_scatter(1e-6);
+  ASSERT_TRUE(client.Search(second, &found).ok());
+  ASSERT_GE(found.results_size(), 1);
+  EXPECT_GE(found.second_anchor_frame(), raise.first_frame);
+  EXPECT_LE(found.second_anchor_frame(), raise.last_frame);
+  EXPECT_GE(std::abs(found.second_anchor_frame() - found.characteristic_frame()),
+            (raise.last_frame - raise.first_frame) / 4 - 1);
   // Several characteristic points, given in the query's own frames, come back in them.
   v1::SearchRequest several = query;
   several.add_characteristic_frames(raise.first_frame + 5);
@@ -1376,6 +1387,8 @@ TEST_F(ServerTest, BadInputsGetTheirStatusCodes) {
        "characteristic_frames[0]: 5000 is outside the query's frames 10..60"},
       {[](v1::SearchRequest* r) { r->set_characteristic_points(17); }, "characteristic_points"},
       {[](v1::SearchRequest* r) { r->set_max_point_gap_s(-1); }, "max_point_gap_s"},
+      {[](v1::SearchRequest* r) { r->set_second_anchor_scatter(1.5); },
+       "second_anchor_scatter = 1.5 is out of range; expected 0..1"},
       {[](v1::SearchRequest* r) { r->mutable_clip()->set_last_frame(100000); }, "last_frame"},
       {[](v1::SearchRequest* r) { r->mutable_clip()->set_first_frame(-1); }, "first_frame"},
       {[](v1::SearchRequest* r) { r->set_neutral(static_cast<v1::NeutralPose>(9)); }, "neutral"},

@@ -48,6 +48,19 @@ int FarthestFrame(CoordinateView query, const std::vector<double>& centre, int64
 
 }  // namespace
 
+int FindSecondAnchor(CoordinateView query, int anchor, int dims) {
+  const std::vector<double> centre(query.row(anchor), query.row(anchor) + dims);
+  const int64_t reach = std::max<int64_t>(2, query.rows / 4);
+  const int64_t before_end = anchor - reach + 1, after_first = anchor + reach;
+  const int before = before_end > 0 ? FarthestFrame(query, centre, 0, before_end) : -1;
+  const int after =
+      after_first < query.rows ? FarthestFrame(query, centre, after_first, query.rows) : -1;
+  if (before < 0 || after < 0) return std::max(before, after);
+  // The first of equals, as FarthestFrame.
+  return SquaredDistance(query, after, centre) > SquaredDistance(query, before, centre) ? after
+                                                                                        : before;
+}
+
 int FindCharacteristicFrame(CoordinateView query, int dims, NeutralPose neutral) {
   return FarthestFrame(query, NeutralCentre(query, dims, neutral), 0, query.rows);
 }

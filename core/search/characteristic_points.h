@@ -34,6 +34,12 @@ std::vector<int> FindCharacteristicFrames(CoordinateView query, int dims, Neutra
 // second.
 std::vector<int> FindActionFrames(CoordinateView query, int dims, double rate);
 
+// The second anchor of a one-point search whose characteristic pose is common
+// (SearchParams::second_anchor_scatter): the frame farthest from frame `anchor` over the first
+// `dims` coordinates among those at least a quarter of the query (and 2 frames) away; -1 when
+// the query is too short to have one.
+int FindSecondAnchor(CoordinateView query, int anchor, int dims);
+
 // The frames a search anchors at by SearchParams' rules: characteristic_frames, else
 // characteristic_frame, else characteristic_points found (0: one per action,
 // FindActionFrames). Assumes the parameters passed PrepareQuery's checks.

@@ -48,6 +48,7 @@ struct Seed {
   int clip;
   int64_t frame;
   float distance;
+  int anchor = 0;  // the query frame the seed's warp passes through
 };
 
 // Per clip, runs of seed frames with gaps of at most `gap` frames (thesis 6.2.3). A run is
@@ -182,31 +183,57 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
   const bool distinct = params.seed_selection == SeedSelection::kDistinctPlaces;
-  const std::vector<Neighbour> neighbours =
-      distinct ? library.NearestPlaces(query.row(anchor), params.ann_dims, params.places,
-                                       PlaceSeparation(gap, query.rows), params.epsilon, allowed)
-               : library.Nearest(query.row(anchor), params.ann_dims,
-                                 NearestFrameSeeds(library, params), params.epsilon, allowed);
-  stats.seeds = static_cast<int64_t>(neighbours.size());
+  const int seed_count = NearestFrameSeeds(library, params);
+  const auto seeds_of = [&](int query_frame, int count) {
+    const std::vector<Neighbour> neighbours =
+        distinct ? library.NearestPlaces(query.row(query_frame), params.ann_dims, params.places,
+                                         PlaceSeparation(gap, query.rows), params.epsilon, allowed)
+                 : library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon,
+                                   allowed);
+    std::vector<Seed> seeds;
+    seeds.reserve(neighbours.size());
+    for (const Neighbour& n : neighbours) {
+      const auto [clip, frame] = library.Locate(n.frame);
+      seeds.push_back({clip, frame, n.distance, query_frame});
+    }
+    return seeds;
+  };
+  std::vector<Seed> nearest = seeds_of(anchor, seed_count);  // nearest first
+  stats.seeds = static_cast<int64_t>(nearest.size());
   stats.seeds_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
-  std::vector<Seed> order;
-  order.reserve(neighbours.size());
-  for (const Neighbour& n : neighbours) {
-    const auto [clip, frame] = library.Locate(n.frame);
-    order.push_back({clip, frame, n.distance});
-  }
   // Distinct places are their own clusters.
-  if (!distinct) order = ClusterSeeds(std::move(order), gap, separation);
+  std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation);
+  const int second = distinct || params.second_anchor_scatter <= 0 ||
+                             static_cast<double>(order.size()) <=
+                                 params.second_anchor_scatter * static_cast<double>(stats.seeds)
+                         ? -1
+                         : FindSecondAnchor(query, anchor, params.ann_dims);
+  double second_seeds_ms = 0;
+  if (second >= 0) {
+    const size_t half = nearest.size() / 2;
+    nearest.resize(half);
+    order = ClusterSeeds(std::move(nearest), gap, separation);
+    const Clock::time_point second_start = Clock::now();
+    std::vector<Seed> second_seeds = seeds_of(second, seed_count - static_cast<int>(half));
+    second_seeds_ms = MillisecondsSince(second_start);
+    std::vector<Seed> more = ClusterSeeds(std::move(second_seeds), gap, separation);
+    order.insert(order.end(), more.begin(), more.end());
+    stats.second_anchor = second;
+  }
   stats.clusters = static_cast<int64_t>(order.size());
-  stats.clusters_ms = MillisecondsSince(stage);
+  stats.seeds_ms += second_seeds_ms;
+  stats.clusters_ms = MillisecondsSince(stage) - second_seeds_ms;
 
   // With refinement to follow, the warps run at about 15 Hz (core/index/coarse_rate.h).
   const int factor = params.refine ? CoarseFactor(library.rate()) : 1;
   const CoordinateView warp_query = CoarseView(query, factor);
-  const int warp_anchor = static_cast<int>(
-      std::min<int64_t>(std::lround(anchor / static_cast<double>(factor)), warp_query.rows - 1));
+  const auto coarse = [&](int frame) {
+    return static_cast<int>(
+        std::min<int64_t>(std::lround(frame / static_cast<double>(factor)), warp_query.rows - 1));
+  };
+  const int warp_anchor = coarse(anchor);
 
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
@@ -224,14 +251,21 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
     if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     const Seed& seed = order[i];
     const int64_t phase = seed.frame % factor;
+    // A second anchor's warp needs its path to say where it passes the characteristic frame.
+    const bool second_anchor = seed.anchor != anchor;
+    const bool keep_path = params.return_path || params.refine;
     std::optional<Warp> warp =
         AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
-                     warp_anchor, seed.frame / factor, constraints,
-                     params.return_path || params.refine, workspace, top.threshold());
+                     coarse(seed.anchor), seed.frame / factor, constraints,
+                     keep_path || second_anchor, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
     SearchResult candidate = MakeResult(seed.clip, *std::move(warp), seed.frame / factor);
     ToClipFrames(factor, phase, candidate);
+    if (second_anchor) {
+      candidate.seed_frame = candidate.path[warp_anchor];
+      if (!keep_path) candidate.path = {};
+    }
     top.Offer(std::move(candidate));
   }
   stats.warps_ms = MillisecondsSince(stage);

@@ -294,6 +294,8 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
   SearchParams part_params = params;
   part_params.characteristic_frames.clear();
   part_params.characteristic_points = 1;
+  // Each part is one anchor of the chain; a second anchor inside a part is not measured there.
+  part_params.second_anchor_scatter = 0;
   part_params.return_path = true;
   part_params.max_results = std::min(
       kMaxSearchResults, std::max(kMinPartMatches, kPartMatchesPerResult * params.max_results));

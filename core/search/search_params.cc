@@ -61,6 +61,10 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
     return absl::InvalidArgumentError(
         "characteristic_frame and characteristic_frames are both set; give one");
   }
+  if (!std::isfinite(params.second_anchor_scatter) || params.second_anchor_scatter < 0 ||
+      params.second_anchor_scatter > 1) {
+    return OutOfRange("second_anchor_scatter", params.second_anchor_scatter, "0..1 (0: never)");
+  }
   if (!std::isfinite(params.max_point_gap_s) || params.max_point_gap_s < 0 ||
       params.max_point_gap_s > 3600) {
     return OutOfRange("max_point_gap_s", params.max_point_gap_s, "0..3600 seconds");

@@ -28,6 +28,9 @@ struct SearchResult {
 struct SearchStats {
   int characteristic_frame = -1;           // query frame at the space rate (the first of several)
   std::vector<int> characteristic_frames;  // every point used, at the space rate, in order
+  // The query frame of SearchParams::second_anchor_scatter's second anchor, at the space rate;
+  // -1 when there was none.
+  int second_anchor = -1;
   int64_t seeds = 0;
   int64_t clusters = 0;  // cluster representatives, each the anchor of one warp
   int64_t warps = 0;     // warps completed (inside their clip, not abandoned)

@@ -158,6 +158,9 @@ absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
     params.characteristic_points = request.characteristic_points();
   }
   if (request.has_max_point_gap_s()) params.max_point_gap_s = request.max_point_gap_s();
+  if (request.has_second_anchor_scatter()) {
+    params.second_anchor_scatter = request.second_anchor_scatter();
+  }
   params.clip_ids.assign(request.clip_ids().begin(), request.clip_ids().end());
   params.tags.assign(request.tags().begin(), request.tags().end());
   return params;
@@ -422,6 +425,7 @@ void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
   }
   response->set_characteristic_frame(outcome.characteristic_frame);
   for (const int frame : outcome.characteristic_frames) response->add_characteristic_frames(frame);
+  response->set_second_anchor_frame(outcome.second_anchor_frame);
   const SearchStats& stats = outcome.stats;
   v1::SearchTimings* timings = response->mutable_timings();
   timings->set_characteristic_ms(stats.characteristic_ms);
