@@ -390,6 +390,8 @@ TEST(SearchSecondAnchor, ReachesWhatACommonPoseHides) {
   params.second_anchor_scatter = 0;
   const SearchResponse one = *Search(*library, q, params);
   EXPECT_EQ(one.stats.second_anchor, -1);
+  // The seeds scatter: past the default share.
+  EXPECT_GT(one.stats.clusters, SearchParams().second_anchor_scatter * one.stats.seeds);
   for (const SearchResult& r : one.results) EXPECT_NE(r.clip_id, 60);
 
   params.second_anchor_scatter = SearchParams().second_anchor_scatter;
@@ -398,8 +400,8 @@ TEST(SearchSecondAnchor, ReachesWhatACommonPoseHides) {
     params.refine = refine;
     const SearchResponse two = *Search(*library, q, params);
     EXPECT_THAT(two.stats.second_anchor, ::testing::AllOf(::testing::Ge(25), ::testing::Le(34)))
-        << refine;  // -A's peak
-    EXPECT_GT(two.stats.clusters, params.second_anchor_scatter * two.stats.seeds) << refine;
+        << refine;                                            // -A's peak
+    EXPECT_EQ(two.stats.seeds, params.neighbours) << refine;  // half at each anchor
     ASSERT_FALSE(two.results.empty());
     EXPECT_EQ(two.results[0].clip_id, 60) << refine;
     if (refine) {
@@ -410,9 +412,16 @@ TEST(SearchSecondAnchor, ReachesWhatACommonPoseHides) {
       EXPECT_EQ(r.path[10], r.seed_frame) << refine;
     }
   }
-  // Below the share, or with several points, there is no second anchor.
+  // Below the share, from one seed, or with several points, there is no second anchor.
   params.second_anchor_scatter = 1;
   EXPECT_EQ(Search(*library, q, params)->stats.second_anchor, -1);
+  params.second_anchor_scatter = 0.5;
+  params.neighbours = 1;
+  const SearchResponse single = *Search(*library, q, params);
+  EXPECT_EQ(single.stats.second_anchor, -1);
+  EXPECT_EQ(single.stats.seeds, 1);
+  EXPECT_FALSE(single.results.empty());
+  params.neighbours = 40;
   params.second_anchor_scatter = 0.5;
   params.characteristic_frame = -1;
   params.characteristic_frames = {10, 30};

@@ -155,31 +155,20 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
   return candidates;
 }
 
-}  // namespace
+// Query frame `frame`'s row (the nearest) in the CoarseView of `coarse_rows` rows at 1 / factor.
+int CoarseRow(int frame, int factor, int64_t coarse_rows) {
+  return static_cast<int>(
+      std::min<int64_t>(std::lround(frame / static_cast<double>(factor)), coarse_rows - 1));
+}
 
-absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateView query,
-                                      const SearchParams& params) {
-  if (query.rows == 1) return PoseSearch(library, query, params);
-  const Clock::time_point start = Clock::now();
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
+// The seeds the warps are anchored at, clustered in time: the nearest frames to the
+// characteristic pose `anchor` (or distinct places), half of them at a second anchor when they
+// scatter (SearchParams::second_anchor_scatter). `coarse_rows`, `factor`: the warps' query.
+// Fills the seed and cluster stages' stats.
+std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView query, int anchor,
+                                 int64_t coarse_rows, int factor, const std::vector<bool>& allowed,
+                                 const SearchParams& params, SearchStats& stats) {
   Clock::time_point stage = Clock::now();
-  const std::vector<int> anchors = CharacteristicFrames(query, library.rate(), params);
-  if (anchors.size() > 1) {
-    const double characteristic_ms = MillisecondsSince(stage);
-    MOTIONDB_ASSIGN_OR_RETURN(SearchResponse response,
-                              MultiPointSearch(library, query, anchors, params));
-    response.stats.characteristic_ms += characteristic_ms;
-    response.stats.total_ms = MillisecondsSince(start);
-    return response;
-  }
-  SearchResponse response;
-  SearchStats& stats = response.stats;
-  const int anchor = anchors.front();
-  stats.characteristic_frame = anchor;
-  stats.characteristic_frames = anchors;
-  stats.characteristic_ms = MillisecondsSince(stage);
-
-  stage = Clock::now();
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
   const bool distinct = params.seed_selection == SeedSelection::kDistinctPlaces;
@@ -205,19 +194,25 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stage = Clock::now();
   // Distinct places are their own clusters.
   std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation);
-  const int second = distinct || params.second_anchor_scatter <= 0 ||
-                             static_cast<double>(order.size()) <=
-                                 params.second_anchor_scatter * static_cast<double>(stats.seeds)
-                         ? -1
-                         : FindSecondAnchor(query, anchor, params.ann_dims);
+  const bool scattered = !distinct && params.second_anchor_scatter > 0 && nearest.size() >= 2 &&
+                         static_cast<double>(order.size()) >
+                             params.second_anchor_scatter * static_cast<double>(nearest.size());
+  int second = scattered ? FindSecondAnchor(query, anchor, params.ann_dims) : -1;
+  // The warps pass their anchor's row at the coarse rate, where the two must differ.
+  if (second >= 0 &&
+      CoarseRow(second, factor, coarse_rows) == CoarseRow(anchor, factor, coarse_rows)) {
+    second = -1;
+  }
   double second_seeds_ms = 0;
   if (second >= 0) {
     const size_t half = nearest.size() / 2;
+    const int rest = static_cast<int>(nearest.size() - half);
     nearest.resize(half);
     order = ClusterSeeds(std::move(nearest), gap, separation);
     const Clock::time_point second_start = Clock::now();
-    std::vector<Seed> second_seeds = seeds_of(second, seed_count - static_cast<int>(half));
+    std::vector<Seed> second_seeds = seeds_of(second, rest);
     second_seeds_ms = MillisecondsSince(second_start);
+    stats.seeds = static_cast<int64_t>(half + second_seeds.size());
     std::vector<Seed> more = ClusterSeeds(std::move(second_seeds), gap, separation);
     order.insert(order.end(), more.begin(), more.end());
     stats.second_anchor = second;
@@ -225,15 +220,40 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   stats.clusters = static_cast<int64_t>(order.size());
   stats.seeds_ms += second_seeds_ms;
   stats.clusters_ms = MillisecondsSince(stage) - second_seeds_ms;
+  return order;
+}
+
+}  // namespace
+
+absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateView query,
+                                      const SearchParams& params) {
+  if (query.rows == 1) return PoseSearch(library, query, params);
+  const Clock::time_point start = Clock::now();
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
+  Clock::time_point stage = Clock::now();
+  const std::vector<int> anchors = CharacteristicFrames(query, library.rate(), params);
+  if (anchors.size() > 1) {
+    const double characteristic_ms = MillisecondsSince(stage);
+    MOTIONDB_ASSIGN_OR_RETURN(SearchResponse response,
+                              MultiPointSearch(library, query, anchors, params));
+    response.stats.characteristic_ms += characteristic_ms;
+    response.stats.total_ms = MillisecondsSince(start);
+    return response;
+  }
+  SearchResponse response;
+  SearchStats& stats = response.stats;
+  const int anchor = anchors.front();
+  stats.characteristic_frame = anchor;
+  stats.characteristic_frames = anchors;
+  stats.characteristic_ms = MillisecondsSince(stage);
 
   // With refinement to follow, the warps run at about 15 Hz (core/index/coarse_rate.h).
   const int factor = params.refine ? CoarseFactor(library.rate()) : 1;
   const CoordinateView warp_query = CoarseView(query, factor);
-  const auto coarse = [&](int frame) {
-    return static_cast<int>(
-        std::min<int64_t>(std::lround(frame / static_cast<double>(factor)), warp_query.rows - 1));
-  };
-  const int warp_anchor = coarse(anchor);
+  const int warp_anchor = CoarseRow(anchor, factor, warp_query.rows);
+
+  std::vector<Seed> order =
+      ClusteredSeeds(library, query, anchor, warp_query.rows, factor, allowed, params, stats);
 
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
@@ -256,8 +276,8 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
     const bool keep_path = params.return_path || params.refine;
     std::optional<Warp> warp =
         AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
-                     coarse(seed.anchor), seed.frame / factor, constraints,
-                     keep_path || second_anchor, workspace, top.threshold());
+                     CoarseRow(seed.anchor, factor, warp_query.rows), seed.frame / factor,
+                     constraints, keep_path || second_anchor, workspace, top.threshold());
     if (!warp) continue;
     ++stats.warps;
     SearchResult candidate = MakeResult(seed.clip, *std::move(warp), seed.frame / factor);

@@ -39,6 +39,8 @@ void StreamingTopResults::Offer(SearchResult candidate) {
     by_clip_.resize(candidate.clip_index + 1);
   }
   std::vector<Kept>& group = by_clip_[candidate.clip_index];
+  // A group that has never held a result has never allocated.
+  if (group.capacity() == 0) held_.push_back(candidate.clip_index);
   for (const Kept& kept : group) {
     if (kept.result.score <= candidate.score && Overlaps(candidate, kept.result, max_overlap_)) {
       return;
@@ -65,8 +67,8 @@ float StreamingTopResults::threshold() const {
 std::vector<SearchResult> StreamingTopResults::Take() {
   std::vector<Kept> all;
   all.reserve(kept_count_);
-  for (std::vector<Kept>& group : by_clip_) {
-    std::move(group.begin(), group.end(), std::back_inserter(all));
+  for (const int clip : held_) {
+    std::move(by_clip_[clip].begin(), by_clip_[clip].end(), std::back_inserter(all));
   }
   std::sort(all.begin(), all.end(),
             [](const Kept& a, const Kept& b) { return a.offered < b.offered; });
@@ -74,6 +76,7 @@ std::vector<SearchResult> StreamingTopResults::Take() {
   results.reserve(all.size());
   for (Kept& kept : all) results.push_back(std::move(kept.result));
   by_clip_.clear();
+  held_.clear();
   kept_count_ = 0;
   worst_score_cache_ = std::numeric_limits<double>::quiet_NaN();
   return results;
@@ -82,13 +85,13 @@ std::vector<SearchResult> StreamingTopResults::Take() {
 std::pair<int, size_t> StreamingTopResults::FindWorst() const {
   std::pair<int, size_t> worst{-1, 0};
   const Kept* worst_kept = nullptr;
-  for (size_t c = 0; c < by_clip_.size(); ++c) {
+  for (const int c : held_) {
     for (size_t i = 0; i < by_clip_[c].size(); ++i) {
       const Kept& kept = by_clip_[c][i];
       if (worst_kept == nullptr || kept.result.score > worst_kept->result.score ||
           (kept.result.score == worst_kept->result.score && kept.offered < worst_kept->offered)) {
         worst_kept = &kept;
-        worst = {static_cast<int>(c), i};
+        worst = {c, i};
       }
     }
   }

@@ -20,7 +20,9 @@ struct SearchResult {
   double end_s = 0;
   double score = 0;  // mean pose distance along the warp; lower is better
   // The clip frame matched to the characteristic query frame (the first of several): the seed
-  // the warp was anchored at, or where refinement moved it (-1 in exact mode).
+  // the warp was anchored at, or where refinement moved it, or, for a warp through a second
+  // anchor's seed (SearchParams::second_anchor_scatter), where its path passes that frame (-1
+  // in exact mode).
   int64_t seed_frame = -1;
   std::vector<int64_t> path;  // clip frame per query frame, when requested
 };
@@ -91,6 +93,9 @@ class StreamingTopResults {
   double max_overlap_;
   int64_t query_rows_;
   std::vector<std::vector<Kept>> by_clip_;  // by clip index
+  // The clips whose group has held a result, each once: what FindWorst and Take scan (a library
+  // of 8,175 clips has a few hundred).
+  std::vector<int> held_;
   int kept_count_ = 0;
   int64_t offers_ = 0;
   // worst_score()'s value while kept_count_ is unchanged and full, or NaN.
