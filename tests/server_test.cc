@@ -1509,6 +1509,20 @@ TEST_F(ServerTest, OversizeRequestsAreResourceExhausted) {
   EXPECT_TRUE(client.Ingest("small.bvh", BvhText(ChainClip()), &ingested).ok());
 }
 
+// True once the server's /metrics holds `line` (a sample, e.g. "motiondb_uploads_in_progress 1"),
+// waiting up to 30 s: what a test sends is not yet what the server runs.
+bool WaitForMetric(const ServerProcess& server, const std::string& line) {
+  httplib::Client http("127.0.0.1", server.http_port());
+  const auto holds = [&] {
+    const httplib::Result metrics = http.Get("/metrics");
+    return metrics && metrics->body.find("\n" + line + "\n") != std::string::npos;
+  };
+  for (int i = 0; i < 3000 && !holds(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return holds();
+}
+
 // Idle ingest streams hold a thread and, with --threads, a call slot each. With the watchdog off
 // two of them lock a --threads 2 server out; with it on they are ended after a second and the
 // waiting call runs.
@@ -1528,6 +1542,11 @@ TEST_F(ServerTest, IdleStreamsAreEndedAndReleaseTheirThreads) {
       contexts.push_back(client.Context());
       idle.push_back(client.clips().IngestClipStream(contexts.back().get(), &responses[i]));
       ASSERT_TRUE(idle.back()->Write(header));
+    }
+    // Unwatched, both streams must hold the two places before the third call is sent (it would
+    // otherwise run first, failed once under load); watched, they may already have been ended.
+    if (!watched) {
+      ASSERT_TRUE(WaitForMetric(*server, "motiondb_uploads_in_progress 2")) << server->Log();
     }
     v1::ServerInfo info;
     const grpc::Status status = client.server().GetServerInfo(
@@ -1562,15 +1581,7 @@ TEST_F(ServerTest, UploadsInProgressAreBounded) {
   ASSERT_TRUE(writer->Write(first));
   // A second upload is refused once the server has taken the first in (seen on /metrics: the
   // stream's call may reach the server after a unary one sent later).
-  httplib::Client http("127.0.0.1", server->http_port());
-  const auto uploads_in_progress = [&http] {
-    const httplib::Result metrics = http.Get("/metrics");
-    return metrics && metrics->body.find("\nmotiondb_uploads_in_progress 1\n") != std::string::npos;
-  };
-  for (int i = 0; i < 3000 && !uploads_in_progress(); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_TRUE(uploads_in_progress()) << server->Log();
+  ASSERT_TRUE(WaitForMetric(*server, "motiondb_uploads_in_progress 1")) << server->Log();
   v1::IngestClipResponse response;
   const grpc::Status refused = client.Ingest("unary.bvh", bvh, &response);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
