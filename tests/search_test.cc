@@ -422,7 +422,6 @@ TEST(SearchSecondAnchor, ReachesWhatACommonPoseHides) {
   EXPECT_EQ(single.stats.seeds, 1);
   EXPECT_FALSE(single.results.empty());
   params.neighbours = 40;
-  params.second_anchor_scatter = 0.5;
   params.characteristic_frame = -1;
   params.characteristic_frames = {10, 30};
   EXPECT_EQ(Search(*library, q, params)->stats.second_anchor, -1);
