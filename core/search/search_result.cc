@@ -16,21 +16,42 @@ bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap) 
   return overlap > max_overlap * static_cast<double>(a.last_frame - a.first_frame + 1);
 }
 
-std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
-                                      int max_results) {
-  std::sort(candidates.begin(), candidates.end(), [](const SearchResult& a, const SearchResult& b) {
+namespace {
+
+// The indices of the candidates RankResults keeps, in its order.
+std::vector<size_t> RankedOrder(const std::vector<SearchResult>& candidates, double max_overlap,
+                                int max_results) {
+  std::vector<size_t> order(candidates.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) {
+    const SearchResult &a = candidates[i], &b = candidates[j];
     return std::tie(a.score, a.clip_index, a.first_frame) <
            std::tie(b.score, b.clip_index, b.first_frame);
   });
-  std::vector<SearchResult> kept;
-  for (SearchResult& candidate : candidates) {
+  std::vector<size_t> kept;
+  for (size_t i : order) {
     if (static_cast<int>(kept.size()) == max_results) break;
-    const bool suppressed = std::any_of(kept.begin(), kept.end(), [&](const SearchResult& better) {
-      return Overlaps(candidate, better, max_overlap);
+    const bool suppressed = std::any_of(kept.begin(), kept.end(), [&](size_t better) {
+      return Overlaps(candidates[i], candidates[better], max_overlap);
     });
-    if (!suppressed) kept.push_back(std::move(candidate));
+    if (!suppressed) kept.push_back(i);
   }
   return kept;
+}
+
+}  // namespace
+
+std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
+                                      int max_results) {
+  std::vector<SearchResult> kept;
+  for (size_t i : RankedOrder(candidates, max_overlap, max_results)) {
+    kept.push_back(std::move(candidates[i]));
+  }
+  return kept;
+}
+
+int RankedCount(const std::vector<SearchResult>& candidates, double max_overlap, int max_results) {
+  return static_cast<int>(RankedOrder(candidates, max_overlap, max_results).size());
 }
 
 void StreamingTopResults::Offer(SearchResult candidate) {

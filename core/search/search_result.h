@@ -62,6 +62,8 @@ bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap);
 // better kept one by more than `max_overlap` of its length, and keeps at most `max_results`.
 std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
                                       int max_results);
+// How many results RankResults would keep, the candidates left as they are.
+int RankedCount(const std::vector<SearchResult>& candidates, double max_overlap, int max_results);
 
 // The best `k` non-overlapping results seen so far, kept greedily as candidates stream in, and
 // the cost a partial warp must stay below to still have a chance (early abandoning). A fast
