@@ -25,11 +25,12 @@ using Clock = std::chrono::steady_clock;
 // 2000 seeds, 16 and 24 gave 0.87 and 0.95.
 constexpr double kRefinePoolPerThousandSeeds = 12;
 // The best this share of the refined pool are settled at the full rate from the coarse rate:
-// coarse scores order nearly equal matches less surely the denser the library (100 h, 2000
-// seeds: 160 settled gave 0.87, 320 gave 0.95), and a settle costs factor^2 times a coarse one,
-// so from 45 Hz (factor 3) a third (10 h at 120 Hz: 80 settled gave 0.96 at 4 ms, 160 took
-// 5.3 ms for the same).
-double FineShare(int factor) { return factor <= 2 ? 2.0 / 3.0 : 1.0 / 3.0; }
+// coarse scores order nearly equal matches less surely the denser the library, and a settle
+// costs factor^2 times a coarse one. Measured over 20 queries each (bench/RESULTS.md, issue 11,
+// 2026-12-04; recall@10 against the exact search): at factor 2, two thirds gave 0.945 at 10 h and
+// 0.925 at 100 h, all of it 0.950 (2.8 ms) and 0.955 (9.2 ms); at 10 h / 120 Hz (factor 8) a
+// third gave 0.925 (3.4 ms), half 0.950 (4.1 ms), two thirds 0.960 (4.7 ms).
+double FineShare(int factor) { return factor <= 2 ? 1.0 : 2.0 / 3.0; }
 
 // The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
 // to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
