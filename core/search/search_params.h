@@ -81,8 +81,8 @@ struct SearchParams {
   // least a quarter of the query away (and a row of its own at the warps' coarse rate), each
   // warp passing through its own seed's anchor. On 10 h of real capture (794 clusters from 1000
   // seeds) recall@10 against the exact search rose from 0.85 to 0.94 (20 queries) for about
-  // 0.6 ms more at the median; synthetic capture (at most 175 clusters) does not reach it, and Bandai's figures
-  // are unchanged (bench/RESULTS.md, issue 11). 0: one anchor always.
+  // 0.6 ms more at the median; synthetic capture (at most 175 clusters) does not reach it, and
+  // Bandai's figures are unchanged (bench/RESULTS.md, issue 11). 0: one anchor always.
   double second_anchor_scatter = 0.5;
   // Seeds of one clip closer than this in time join one cluster.
   double cluster_gap_s = 0.1;
