@@ -9,6 +9,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "tests/test_data.h"
 
@@ -393,14 +394,16 @@ TEST(BvhReaderFile, MissingFileIsNotFoundAndErrorsNameThePath) {
   EXPECT_EQ(missing.status().code(), absl::StatusCode::kNotFound);
   EXPECT_THAT(std::string(missing.status().message()), HasSubstr("/nonexistent/walk.bvh"));
 
-  const std::string path = ::testing::TempDir() + "/bad_reader_test.bvh";
+  const std::filesystem::path dir = testing::MakeTempDir("bvh_reader_test");
+  const std::filesystem::path path = dir / "bad.bvh";
   FILE* f = std::fopen(path.c_str(), "wb");
   ASSERT_NE(f, nullptr);
   const std::string text = Replace(kMinimal, "50.0", "x");
   std::fwrite(text.data(), 1, text.size(), f);
   std::fclose(f);
   absl::StatusOr<BvhReadResult> bad = ReadBvhFile(path);
-  EXPECT_THAT(std::string(bad.status().message()), HasSubstr(path + ": line 19"));
+  EXPECT_THAT(std::string(bad.status().message()), HasSubstr(path.string() + ": line 19"));
+  std::filesystem::remove_all(dir);
 }
 
 // The conformance corpus: each real quirk, with what the corpus README says about it.
@@ -505,9 +508,7 @@ std::vector<std::vector<size_t>> CutsToTry(size_t size) {
 }
 
 std::string Describe(const std::vector<size_t>& cuts) {
-  std::string text = "cuts:";
-  for (size_t cut : cuts) text += " " + std::to_string(cut);
-  return text;
+  return "cuts: " + absl::StrJoin(cuts, " ");
 }
 
 void ExpectSameInEveryPieces(const std::string& text, const BvhReadOptions& options = {}) {

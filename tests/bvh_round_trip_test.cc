@@ -90,12 +90,14 @@ TEST(BvhRoundTrip, WriteBvhFileIsReadBack) {
   const Clip clip = testing::MakeClip(
       testing::ChainSkeleton(), 5, 0.01, [](int, int) { return Quat::Identity(); },
       [](int f, int) { return Eigen::Vector3d(f, f, f); });
-  const std::string path = ::testing::TempDir() + "/round_trip_file.bvh";
+  const std::filesystem::path dir = testing::MakeTempDir("bvh_round_trip_test");
+  const std::string path = (dir / "round_trip.bvh").string();
   ASSERT_TRUE(WriteBvhFile(path, clip).ok());
   absl::StatusOr<BvhReadResult> back = ReadBvhFile(path);
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->clip.frame_count(), 5);
   EXPECT_FALSE(WriteBvhFile("/nonexistent-dir/x.bvh", clip).ok());
+  std::filesystem::remove_all(dir);
 }
 
 void ExpectFolderRoundTrips(const std::filesystem::path& dir) {

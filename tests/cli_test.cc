@@ -28,10 +28,7 @@ using testing::RunCli;
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("cli_test_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("cli_test");
     // 61 frames at 30 fps: two seconds of a slow turn.
     const Clip clip = testing::MakeClip(
         testing::ChainSkeleton(), 61, 1.0 / 30,

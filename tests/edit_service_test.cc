@@ -2,7 +2,6 @@
 // result as BVH with the source's hierarchy, stored as a clip with its provenance when asked,
 // searchable and exportable; the closed forms that survive the trip (identities, endpoints,
 // weights); and bad input of every kind refused naming the field, with nothing stored.
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -89,10 +88,7 @@ class EditServiceTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     library = new Library;
-    library->dir = std::filesystem::path(::testing::TempDir()) /
-                   ("edit_service_test_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(library->dir);
-    std::filesystem::create_directories(library->dir);
+    library->dir = testing::MakeTempDir("edit_service_test");
     std::string error;
     ASSERT_TRUE(library->server.Start({"--db", (library->dir / "db.sqlite").string()}, &error))
         << error;

@@ -86,10 +86,7 @@ std::string HumanoidBvh(int seed) {
 class HttpTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("http_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
+    dir_ = testing::MakeTempDir("http_test");
     std::filesystem::create_directories(dir_ / "web" / "assets");
     Write("web/index.html", "<!doctype html><title>motiondb</title>");
     Write("web/assets/app.js", "console.log('motiondb');");

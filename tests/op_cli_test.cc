@@ -1,7 +1,6 @@
 // `motiondb op` (issue 16), run as a user would run it against a real server: each command's
 // help, its result written with -o and kept with --store (provenance shown by `clip show`), the
 // figures each prints, and the server's complaints told in the command's own words.
-#include <unistd.h>
 
 #include <filesystem>
 
@@ -27,10 +26,7 @@ constexpr int kFrames = 90;  // per clip, at 30 fps
 class OpCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("op_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("op_cli_test");
     std::string error;
     ASSERT_TRUE(server_.Start({"--db", (dir_ / "motiondb.sqlite").string()}, &error)) << error;
     ASSERT_TRUE(testing::WaitUntilServing(testing::InsecureChannel(server_.address()), ""));

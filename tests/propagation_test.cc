@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "server/catalog.h"
 #include "testing/synthetic_corpus.h"
+#include "tests/test_data.h"
 
 namespace motiondb::server {
 namespace {
@@ -59,9 +60,7 @@ TEST(KeepStrongest, KeepsRangesSharingHalfOrLessOfTheShorterOne) {
 class SpaceScaleTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           absl::StrCat("propagation_test_", ::testing::UnitTest::GetInstance()->random_seed());
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("propagation_test");
     auto opened = storage::Database::Open((dir_ / "library.sqlite").string());
     ASSERT_TRUE(opened.ok()) << opened.status();
     database_ = std::move(*opened);

@@ -23,6 +23,7 @@
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "testing/server_process.h"
 #include "testing/synthetic_corpus.h"
+#include "tests/test_data.h"
 
 namespace motiondb {
 
@@ -117,11 +118,7 @@ class Client {
 class ServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("server_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("server_test");
     db_ = (dir_ / "motiondb.sqlite").string();
   }
   void TearDown() override {

@@ -29,10 +29,7 @@ std::vector<std::string> Lines(const std::string& text) {
 class SpaceCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::path(::testing::TempDir()) /
-           ("space_cli_test_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::create_directories(dir_);
+    dir_ = testing::MakeTempDir("space_cli_test");
     const auto skeleton = testing::HumanoidSkeleton(/*still_root=*/true);
     // 120 frames at 60 fps each: 60 samples at the default 30 Hz.
     a_ = Write("a.bvh", testing::SyntheticClip(skeleton, {.turn_rate = 0.5, .seed = 1}));

@@ -8,6 +8,7 @@
 
 #include "core/motion/skeleton_coding.h"
 #include "tests/synthetic_motion.h"
+#include "tests/test_data.h"
 #include "util/byte_coding.h"
 #include "util/crc32.h"
 
@@ -151,8 +152,7 @@ TEST_F(SpaceSerializationTest, RejectsSealedButInconsistentContents) {
 }
 
 TEST_F(SpaceSerializationTest, FilesRoundTripAndErrorsNameThePath) {
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "space_files";
-  std::filesystem::create_directories(dir);
+  const std::filesystem::path dir = testing::MakeTempDir("space_files");
   const std::string path = (dir / "walk.mcs").string();
   ASSERT_TRUE(WriteSpaceFile(path, space_).ok());
   const absl::StatusOr<MotionSpace> read = ReadSpaceFile(path);

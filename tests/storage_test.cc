@@ -122,9 +122,7 @@ void ExpectSameFrames(const Clip& expected, const Clip& actual) {
 class StorageTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (std::filesystem::temp_directory_path() / "motiondb_storage_XXXXXX");
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
+    dir_ = testing::MakeTempDir("storage_test");
     path_ = (dir_ / "motion.db").string();
   }
   void TearDown() override {

@@ -3,8 +3,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -24,6 +26,14 @@ std::optional<std::filesystem::path> ExistingDir(const std::filesystem::path& pa
 std::optional<std::filesystem::path> AssimpBvhDir() { return ExistingDir(MOTIONDB_ASSIMP_BVH_DIR); }
 
 std::string CliPath() { return MOTIONDB_CLI_PATH; }
+
+std::filesystem::path MakeTempDir(const std::string& prefix) {
+  std::string pattern = (std::filesystem::path(::testing::TempDir()) / (prefix + "_XXXXXX"));
+  if (mkdtemp(pattern.data()) == nullptr) {
+    ADD_FAILURE() << "mkdtemp " << pattern << ": " << std::strerror(errno);
+  }
+  return pattern;
+}
 
 absl::StatusOr<TlsFiles> MakeTlsCertificate(const std::filesystem::path& dir) {
   if (std::system("command -v openssl >/dev/null 2>&1") != 0) {

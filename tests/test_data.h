@@ -37,6 +37,11 @@ struct TlsFiles {
 absl::StatusOr<TlsFiles> MakeTlsCertificate(const std::filesystem::path& dir);
 
 // Every *.bvh below `dir`, sorted.
+// A new, empty folder below GoogleTest's temporary directory, named `prefix` and a unique
+// suffix (mkdtemp): ctest runs tests in parallel, each in its own process, so a name built from
+// the test or the pid alone can be shared by two of them or by a second checkout's run.
+std::filesystem::path MakeTempDir(const std::string& prefix);
+
 std::vector<std::filesystem::path> BvhFilesUnder(const std::filesystem::path& dir);
 std::string ReadFileOrDie(const std::filesystem::path& path);
 
