@@ -272,7 +272,9 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
         ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
         MOTIONDB_RETURN_IF_ERROR(scan.Run(
             c, params, [&] { return finished.bound(); }, top, stats[thread]));
-        finished.Add(top.Take());
+        // Most clips hold nothing under the bound: adding nothing would only take the lock.
+        std::vector<SearchResult> results = top.Take();
+        if (!results.empty()) finished.Add(std::move(results));
         return absl::OkStatus();
       }));
   for (const SearchStats& thread_stats : stats) {
