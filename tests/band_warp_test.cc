@@ -58,8 +58,8 @@ TEST(BandWarp, MatchesExhaustiveEnumerationInTheBand) {
         RandomCentre(6, s, static_cast<int64_t>(rng() % 6), rng);  // may start at the clip's edge
     BandWorkspace ws;
     bool touches_edge = false;
-    const Warp warp = BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, radius, {s, 3},
-                               ws, &touches_edge);
+    const Warp warp = *BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, radius,
+                                {s, 3}, ws, &touches_edge);
     EXPECT_NEAR(warp.score, BruteForce(q, x, s, centre, radius), 1e-5) << "trial " << trial;
     EXPECT_LE(warp.score, testing::MeanPathDistance(q, x, centre, 3) + 1e-6) << "trial " << trial;
     // The path is one of the model's, in the band, and has the reported score.
@@ -93,10 +93,38 @@ TEST(BandWarp, AWideBandFindsTheBestWarpAnywhereInTheClip) {
     const std::vector<int64_t> centre = RandomCentre(5, s, 4, rng);
     BandWorkspace ws;
     bool touches_edge = true;
-    const Warp warp = BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, 40, {s, 3}, ws,
-                               &touches_edge);
+    const Warp warp = *BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, 40, {s, 3},
+                                ws, &touches_edge);
     EXPECT_NEAR(warp.score, BruteForce(q, x, s, std::vector<int64_t>(5, 0), 1000), 1e-5);
     EXPECT_FALSE(touches_edge);
+  }
+}
+
+// Abandoning gives up exactly the warps that cost more than the bound, and changes nothing else.
+TEST(BandWarp, AbandonsOnlyWarpsCostingMoreThanTheBound) {
+  std::mt19937 rng(13);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int s = 1 + trial % 3;
+    const int radius = 1 + trial % 4;
+    const RowMatrixXf q = testing::SmoothNoise(12, 3, 900 + trial);
+    const RowMatrixXf x = testing::SmoothNoise(60, 3, 1000 + trial);
+    const std::vector<int64_t> centre =
+        RandomCentre(12, s, 2 + static_cast<int64_t>(rng() % 8), rng);
+    BandWorkspace ws;
+    bool touches_edge = false;
+    const Warp full = *BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, radius,
+                                {s, 3}, ws, &touches_edge);
+    const bool full_touches_edge = touches_edge;
+    const float cost = static_cast<float>(full.score * 12);
+    EXPECT_FALSE(BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, radius, {s, 3}, ws,
+                          &touches_edge, cost * 0.999f))
+        << "trial " << trial;
+    const std::optional<Warp> kept = BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre,
+                                              radius, {s, 3}, ws, &touches_edge, cost * 1.001f);
+    ASSERT_TRUE(kept) << "trial " << trial;
+    EXPECT_EQ(kept->score, full.score);
+    EXPECT_EQ(kept->path, full.path);
+    EXPECT_EQ(touches_edge, full_touches_edge);
   }
 }
 
@@ -112,8 +140,8 @@ TEST(BandWarp, CentreWithPauses) {
     for (int i = 1; i < 6; ++i) centre[i] = centre[i - 1] + static_cast<int>(rng() % (s + 1));
     BandWorkspace ws;
     bool touches_edge = false;
-    const Warp warp = BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, 1 + trial % 3,
-                               {s, 3}, ws, &touches_edge);
+    const Warp warp = *BandWarp(CoordinateView::Of(q), CoordinateView::Of(x), centre, 1 + trial % 3,
+                                {s, 3}, ws, &touches_edge);
     EXPECT_NEAR(warp.score, BruteForce(q, x, s, centre, 1 + trial % 3), 1e-5) << trial;
   }
 }
@@ -127,15 +155,15 @@ TEST(BandWarp, FollowsAShiftedCopy) {
   for (int i = 0; i < 30; ++i) centre[i] = 50 + i;
   BandWorkspace ws;
   bool touches_edge = false;
-  Warp warp = BandWarp(CoordinateView::Of(query), CoordinateView::Of(clip), centre, 3, {2, 4}, ws,
-                       &touches_edge);
+  Warp warp = *BandWarp(CoordinateView::Of(query), CoordinateView::Of(clip), centre, 3, {2, 4}, ws,
+                        &touches_edge);
   EXPECT_NEAR(warp.score, 0.0, 1e-6);
   EXPECT_EQ(warp.first, 53);
   EXPECT_EQ(warp.last, 82);
   EXPECT_TRUE(touches_edge);
   // Radius 2 cannot reach it, and says so.
-  warp = BandWarp(CoordinateView::Of(query), CoordinateView::Of(clip), centre, 2, {2, 4}, ws,
-                  &touches_edge);
+  warp = *BandWarp(CoordinateView::Of(query), CoordinateView::Of(clip), centre, 2, {2, 4}, ws,
+                   &touches_edge);
   EXPECT_GT(warp.score, 0.0);
   EXPECT_TRUE(touches_edge);
 }

@@ -1,11 +1,15 @@
 #include "core/search/warp_refinement.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "tests/search_test_data.h"
 
 namespace motiondb {
 namespace {
+
+constexpr double kNoBound = std::numeric_limits<double>::infinity();
 
 // The first five columns of a view's rows.
 RowMatrixXf CopyRows(CoordinateView view) {
@@ -51,7 +55,7 @@ TEST(RefineCandidate, MovesALateCandidateOntoTheMatch) {
     if (factor > 1) {
       for (int64_t& frame : candidate.path) frame *= factor;  // in the clip's own frames
       ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 100, factor,
-                                   {2, 5}, workspace, candidate));
+                                   {2, 5}, kNoBound, workspace, candidate));
     }
     EXPECT_LT(candidate.score, 1e-6);
     EXPECT_EQ(candidate.first_frame, 400);
@@ -73,7 +77,7 @@ TEST(RefineFromCoarse, GivesAFullRateWarpOfTheModel) {
   for (int64_t& frame : candidate.path) frame *= 4;          // in the clip's own frames
   BandWorkspace workspace;
   ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
-                               workspace, candidate));
+                               kNoBound, workspace, candidate));
   ASSERT_EQ(candidate.path.size(), 120u);
   EXPECT_EQ(candidate.seed_frame, candidate.path[60]);
   for (size_t i = 1; i < candidate.path.size(); ++i) {
@@ -82,6 +86,35 @@ TEST(RefineFromCoarse, GivesAFullRateWarpOfTheModel) {
   }
   EXPECT_NEAR(testing::MeanPathDistance(query, clip, candidate.path, 5), candidate.score, 1e-6);
   EXPECT_LT(candidate.score, 0.05);
+}
+
+// A bound under the settled warp's score leaves the candidate as it was; one over it changes
+// nothing.
+TEST(RefineFromCoarse, GivesUpOnlyOverTheBound) {
+  const RowMatrixXf query = testing::Pattern(120, 5);
+  RowMatrixXf clip = testing::SmoothNoise(900, 5, 24);
+  testing::Plant(clip, query, 300);
+  for (int i = 0; i < 120; ++i)
+    clip.row(300 + i) += testing::SmoothNoise(1, 5, 100 + i).row(0) * 0.1f;
+  const RowMatrixXf q = CopyRows(CoarseView(CoordinateView::Of(query), 4));
+  const RowMatrixXf c = CopyRows(CoarseView(CoordinateView::Of(clip), 4));
+  SearchResult coarse = DiagonalCandidate(q, c, 75, 15);
+  for (int64_t& frame : coarse.path) frame *= 4;
+  BandWorkspace workspace;
+  SearchResult settled = coarse;
+  ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
+                               kNoBound, workspace, settled));
+  ASSERT_GT(settled.score, 0);
+  SearchResult under = coarse;
+  EXPECT_FALSE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
+                                settled.score * 0.99, workspace, under));
+  EXPECT_EQ(under.score, coarse.score);
+  EXPECT_EQ(under.path, coarse.path);
+  SearchResult over = coarse;
+  ASSERT_TRUE(RefineFromCoarse(CoordinateView::Of(query), CoordinateView::Of(clip), 60, 4, {2, 5},
+                               settled.score * 1.01, workspace, over));
+  EXPECT_EQ(over.score, settled.score);
+  EXPECT_EQ(over.path, settled.path);
 }
 
 TEST(RefineCandidate, KeepsACandidateNothingNearBeats) {

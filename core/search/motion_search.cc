@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <vector>
 
+#include "absl/container/flat_hash_map.h"
 #include "core/search/characteristic_points.h"
 #include "core/search/internal/search_query.h"
 #include "core/search/multi_point_search.h"
@@ -115,6 +118,34 @@ void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
   for (int64_t& frame : candidate.path) unscale(frame);
 }
 
+// A score that no candidate above it can rank with among the max_results best of the
+// candidates seen, nor of any more to come: the k-th least of the clips' best scores. Each
+// clip's best is ranked whatever else overlaps it (ranking keeps the best of each clip, as one
+// clip's results never overlap another's), so the k-th ranked score is at most this, and more
+// candidates only lower it. (The k-th ranked score itself can rise with a new candidate that
+// suppresses two others.)
+class ClipBestScores {
+ public:
+  explicit ClipBestScores(int k) : k_(k) {}
+  double bound() const { return bound_; }
+  void Add(int clip, double score) {
+    if (score >= bound_) return;
+    const auto [it, inserted] = best_.try_emplace(clip, score);
+    if (!inserted) it->second = std::min(it->second, score);
+    if (static_cast<int>(best_.size()) < k_) return;
+    scores_.clear();
+    for (const auto& [c, s] : best_) scores_.push_back(s);
+    std::nth_element(scores_.begin(), scores_.begin() + (k_ - 1), scores_.end());
+    bound_ = scores_[k_ - 1];
+  }
+
+ private:
+  const int k_;
+  double bound_ = std::numeric_limits<double>::infinity();
+  absl::flat_hash_map<int, double> best_;
+  std::vector<double> scores_;
+};
+
 // The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
 // settled at the full rate.
@@ -144,6 +175,7 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
     // average, the exact search 20), so while the settled hold fewer than max_results distinct
     // places, the next best candidates are settled too.
     std::vector<SearchResult> settled;
+    ClipBestScores ranked_above(params.max_results);
     for (size_t i = 0; i < candidates.size(); ++i) {
       if (i >= fine_pool &&
           RankedCount(settled, params.max_overlap, params.max_results) == params.max_results) {
@@ -152,7 +184,8 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
       if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
       SearchResult& candidate = candidates[i];
       if (RefineFromCoarse(query, library.clip_coordinates(candidate.clip_index), anchor, factor,
-                           constraints, workspace, candidate)) {
+                           constraints, ranked_above.bound(), workspace, candidate)) {
+        ranked_above.Add(candidate.clip_index, candidate.score);
         settled.push_back(std::move(candidate));
       }
     }

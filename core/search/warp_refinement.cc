@@ -16,17 +16,22 @@ constexpr int kMinRadius = 2;
 constexpr int kMaxRounds = 8;
 
 // Banded warps re-centred on their own best path while it beats `score` and touches the band's
-// edge; the last one that beat `score`, if any.
+// edge; the last one that beat `score`, if any. Warps scoring over `abandon_score` are
+// abandoned as they go.
 std::optional<Warp> Settle(CoordinateView query, CoordinateView clip, std::vector<int64_t> centre,
-                           int radius, double score, const WarpConstraints& constraints,
-                           BandWorkspace& workspace) {
+                           int radius, double score, double abandon_score,
+                           const WarpConstraints& constraints, BandWorkspace& workspace) {
   std::optional<Warp> best;
   for (int round = 0; round < kMaxRounds; ++round) {
     bool touches_edge = false;
-    Warp warp = BandWarp(query, clip, centre, radius, constraints, workspace, &touches_edge);
-    if (!(warp.score < score)) break;
-    score = warp.score;
-    centre = warp.path;
+    // Loosened a little, so that float rounding never abandons a warp that would be kept.
+    const float abandon_at = static_cast<float>(std::min(score, abandon_score) *
+                                                static_cast<double>(query.rows) * (1 + 1e-5));
+    std::optional<Warp> warp =
+        BandWarp(query, clip, centre, radius, constraints, workspace, &touches_edge, abandon_at);
+    if (!warp || !(warp->score < score)) break;
+    score = warp->score;
+    centre = warp->path;
     best = std::move(warp);
     if (!touches_edge) break;
   }
@@ -63,21 +68,21 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate) {
   const int radius = std::max(kMinRadius, static_cast<int>(std::lround(kMovingRadiusS * rate)));
-  std::optional<Warp> warp =
-      Settle(query, clip, candidate.path, radius, candidate.score, constraints, workspace);
+  std::optional<Warp> warp = Settle(query, clip, candidate.path, radius, candidate.score,
+                                    candidate.score, constraints, workspace);
   if (warp) Adopt(*std::move(warp), anchor, candidate);
 }
 
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
-                      const WarpConstraints& constraints, BandWorkspace& workspace,
-                      SearchResult& candidate) {
+                      const WarpConstraints& constraints, double abandon_score,
+                      BandWorkspace& workspace, SearchResult& candidate) {
   // The coarse path is within about `factor` frames of the best warp near it; a band that
   // narrow re-centres when the best path touches its edge (2 * factor: the same results at
   // 10 h / 120 Hz, a third more time).
   std::optional<Warp> warp =
       Settle(query, clip, Upsample(candidate.path, factor, query.rows, clip.rows),
-             std::max(kMinRadius, factor), std::numeric_limits<double>::infinity(), constraints,
-             workspace);
+             std::max(kMinRadius, factor), std::numeric_limits<double>::infinity(), abandon_score,
+             constraints, workspace);
   if (!warp) return false;
   Adopt(*std::move(warp), anchor, candidate);
   return true;

@@ -35,10 +35,11 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
 // `candidate`, a warp of CoarseView(query, factor) onto every factor-th frame of `clip` with its
 // path, its frames given as the clip's own, becomes the best full-rate warp in a narrow band
 // around it (whatever its score: coarse and full-rate scores are not comparable); false when
-// the band holds no warp within the constraints (the candidate is then unchanged).
+// the band holds no warp within the constraints or its warps score over `abandon_score` (the
+// candidate is then unchanged).
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
-                      const WarpConstraints& constraints, BandWorkspace& workspace,
-                      SearchResult& candidate);
+                      const WarpConstraints& constraints, double abandon_score,
+                      BandWorkspace& workspace, SearchResult& candidate);
 
 }  // namespace motiondb
 

@@ -11,6 +11,7 @@ namespace motiondb {
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+constexpr int64_t kRowsPerAbandonLook = 4;
 
 // One row of the band from the previous one, padding included: `prev` and `row` point at state
 // 0's first cell, state z lies `padded` floats further, `d` holds the row's distances. S, the slope
@@ -51,10 +52,11 @@ StepRowFn StepRowFor(int slope_limit, std::integer_sequence<int, S...>) {
 // cost[(i * s + z) * padded + s + k]. Frames outside the clip are infinite. As the centre
 // advances 0..s frames per row, so does the band: a step of `advance` from the previous row's
 // cell k + shift - advance lands on cell k (shift: how far the band moved), a pause from k + shift.
-MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
-                                     const std::vector<int64_t>& centre, int radius,
-                                     const WarpConstraints& constraints, BandWorkspace& ws,
-                                     bool* touches_edge) {
+MOTIONDB_VECTOR_CLONES std::optional<Warp> BandWarp(CoordinateView query, CoordinateView clip,
+                                                    const std::vector<int64_t>& centre, int radius,
+                                                    const WarpConstraints& constraints,
+                                                    BandWorkspace& ws, bool* touches_edge,
+                                                    float abandon_at) {
   const int s = constraints.slope_limit;
   const int64_t m = query.rows, width = 2 * radius + 1, padded = width + 2 * s;
   ws.row_first.resize(m);
@@ -79,6 +81,16 @@ MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
                       ws.row_first[i] + lo - span_first, hi - lo, ws.distances.data() + lo);
   };
 
+  // Distances are not negative, so no path through row i costs less than its cheapest cell.
+  // Looked at every few rows: a look costs about half a row's step at the default slope limit.
+  const bool may_abandon = abandon_at < kInfinity;
+  const auto row_exceeds = [&](int64_t i) {
+    float cheapest = kInfinity;
+    for (int z = 0; z < s; ++z) {
+      cheapest = std::min(cheapest, *std::min_element(cell(i, z), cell(i, z) + width));
+    }
+    return cheapest > abandon_at;
+  };
   row_distances(0);
   std::copy(ws.distances.begin(), ws.distances.end(), cell(0, 0));
   const StepRowFn step = StepRowFor(s, std::make_integer_sequence<int, kMaxSlopeLimit>());
@@ -86,6 +98,7 @@ MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
     row_distances(i);
     step(cell(i - 1, 0), padded, ws.row_first[i] - ws.row_first[i - 1], ws.distances.data(), width,
          cell(i, 0));
+    if (may_abandon && i % kRowsPerAbandonLook == 0 && row_exceeds(i)) return std::nullopt;
   }
 
   // The best end, then the path back from it, re-deriving each step from the stored costs.
@@ -101,6 +114,7 @@ MOTIONDB_VECTOR_CLONES Warp BandWarp(CoordinateView query, CoordinateView clip,
       }
     }
   }
+  if (end_cost > abandon_at) return std::nullopt;
   Warp warp;
   warp.score = end_cost / static_cast<double>(m);
   warp.path.resize(m);

@@ -8,6 +8,8 @@
 #define MOTIONDB_CORE_SEARCH_WARP_BAND_WARP_H_
 
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/index/coordinate_view.h"
@@ -27,10 +29,13 @@ struct BandWorkspace {
 // frames per row, such as a warp's path), with its path; never worse than `centre` when that is
 // itself a warp of the model. Sets `*touches_edge` when the best path reaches the band's edge
 // somewhere other than the clip's ends: a wider band, or one around the new path, might do
-// better still.
-Warp BandWarp(CoordinateView query, CoordinateView clip, const std::vector<int64_t>& centre,
-              int radius, const WarpConstraints& constraints, BandWorkspace& workspace,
-              bool* touches_edge);
+// better still. Early abandoning: nullopt, as soon as it is sure, when the warp's cost (the sum
+// over the query's frames) exceeds `abandon_at` (`*touches_edge` is then unspecified).
+std::optional<Warp> BandWarp(CoordinateView query, CoordinateView clip,
+                             const std::vector<int64_t>& centre, int radius,
+                             const WarpConstraints& constraints, BandWorkspace& workspace,
+                             bool* touches_edge,
+                             float abandon_at = std::numeric_limits<float>::infinity());
 
 }  // namespace motiondb
 
