@@ -35,8 +35,10 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
 // `candidate`, a warp of CoarseView(query, factor) onto every factor-th frame of `clip` with its
 // path, its frames given as the clip's own, becomes the best full-rate warp in a narrow band
 // around it (whatever its score: coarse and full-rate scores are not comparable); false when
-// the band holds no warp within the constraints or its warps score over `abandon_score` (the
-// candidate is then unchanged).
+// the band holds no warp within the constraints, or when a band's best warp scores over
+// `abandon_score` (the candidate is then unchanged). The bound is a band's, not the settling's:
+// a band whose best path touches its edge would be followed by one around that path, which can
+// score under the bound, so a candidate can be given up that would have settled just under it.
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
                       const WarpConstraints& constraints, double abandon_score,
                       BandWorkspace& workspace, SearchResult& candidate);
