@@ -173,16 +173,18 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
     const size_t fine_pool =
         std::max<size_t>(params.max_results,
                          std::lround(FineShare(factor) * static_cast<double>(candidates.size())));
-    candidates =
-        RankResults(std::move(candidates), params.max_overlap, static_cast<int>(candidates.size()));
+    const int pool = static_cast<int>(candidates.size());
+    candidates = RankResults(std::move(candidates), params.max_overlap, pool);
     // Settled candidates can converge on one place (70 s at 120 Hz: 19.9 results of 20 on
     // average, the exact search 20), so while the settled hold fewer than max_results distinct
     // places, the next best candidates are settled too.
     std::vector<SearchResult> settled;
     ClipBestScores ranked_above(params.max_results);
     for (size_t i = 0; i < candidates.size(); ++i) {
+      // A finite bound means max_results clips hold a settled result, each of them ranked.
       if (i >= fine_pool &&
-          RankedCount(settled, params.max_overlap, params.max_results) == params.max_results) {
+          (std::isfinite(ranked_above.bound()) ||
+           RankedCount(settled, params.max_overlap, params.max_results) == params.max_results)) {
         break;
       }
       if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));

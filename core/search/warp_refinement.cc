@@ -68,8 +68,10 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate) {
   const int radius = std::max(kMinRadius, static_cast<int>(std::lround(kMovingRadiusS * rate)));
-  std::optional<Warp> warp = Settle(query, clip, candidate.path, radius, candidate.score,
-                                    candidate.score, constraints, workspace);
+  // Its own score bounds every band already.
+  std::optional<Warp> warp =
+      Settle(query, clip, candidate.path, radius, candidate.score,
+             std::numeric_limits<double>::infinity(), constraints, workspace);
   if (warp) Adopt(*std::move(warp), anchor, candidate);
 }
 
