@@ -213,6 +213,7 @@ double RecallAtTen(const Run& fast, const Run& exact) {
 struct VariantFlags {
   std::vector<int> places;
   std::vector<int> neighbours;
+  std::vector<int> windows;           // seeds by window (SeedSelection::kNearestWindows)
   std::vector<int> points;            // characteristic points (0: by the query's length)
   std::vector<double> second_anchor;  // SearchParams::second_anchor_scatter values
 };
@@ -229,6 +230,12 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     SearchParams params;
     params.neighbours = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " neighbours"), params);
+  }
+  for (int count : flags.windows) {
+    SearchParams params;
+    params.seed_selection = SeedSelection::kNearestWindows;
+    params.neighbours = count;
+    variants.emplace_back(absl::StrCat("fast, ", count, " window seeds"), params);
   }
   for (int count : flags.points) {
     SearchParams params;
@@ -392,6 +399,10 @@ int main(int argc, char** argv) {
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--neighbours", variants.neighbours,
                  "also measure the fast search with these numbers of nearest-frame seeds")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--windows", variants.windows,
+                 "also measure the fast search with these numbers of window seeds")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,

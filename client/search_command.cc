@@ -54,7 +54,8 @@ constexpr Parameter kParameters[] = {
     {"--places", "places", "N", "128", "--seeds places: distinct places, one warp each",
      &SearchFlags::places, &v1::SearchRequest::set_places},
     {"--neighbours", "neighbours", "K", "0",
-     "--seeds frames: nearest frames, clustered (0: by the library's size, 1000 up to 10 h)",
+     "--seeds frames|windows: seeds, clustered (0: frames by the library's size, 1000 up to "
+     "10 h; windows 500)",
      &SearchFlags::neighbours, &v1::SearchRequest::set_neighbours, 0},
     {"--ann-dims", "ann_dims", "N", "5", "dimensions of the seed search", &SearchFlags::ann_dims,
      &v1::SearchRequest::set_ann_dims},
@@ -110,8 +111,9 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   if (flags.max_point_gap) request.set_max_point_gap_s(*flags.max_point_gap);
   if (flags.second_anchor) request.set_second_anchor_scatter(*flags.second_anchor);
   if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
-  request.set_seed_selection(flags.seeds == "places" ? v1::SEED_SELECTION_DISTINCT_PLACES
-                                                     : v1::SEED_SELECTION_NEAREST_FRAMES);
+  request.set_seed_selection(flags.seeds == "places"    ? v1::SEED_SELECTION_DISTINCT_PLACES
+                             : flags.seeds == "windows" ? v1::SEED_SELECTION_NEAREST_WINDOWS
+                                                        : v1::SEED_SELECTION_NEAREST_FRAMES);
   if (flags.epsilon) request.set_epsilon(static_cast<float>(*flags.epsilon));
   request.set_neutral(flags.neutral == "boundary" ? v1::NEUTRAL_POSE_BOUNDARY_MEAN
                       : flags.neutral == "origin" ? v1::NEUTRAL_POSE_ORIGIN
@@ -276,8 +278,9 @@ void AddSearch(Commands& commands) {
         {"mean", "boundary", "origin"})
       ->capture_default_str();
   OneOf(search->add_option("--seeds", flags->seeds,
-                           "seeds: the thesis's nearest frames, or distinct places"),
-        {"frames", "places"})
+                           "seeds: the thesis's nearest frames, distinct places, or the frames "
+                           "nearest by their poses a quarter second either side too"),
+        {"frames", "places", "windows"})
       ->capture_default_str();
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
   search->add_option("--threads", flags->exact_threads, "--exact: threads scanning the library")
@@ -304,6 +307,9 @@ void AddSearch(Commands& commands) {
   search->footer(
       "Unset parameters take the server's defaults, the thesis's (Table 6.2), shown here.\n"
       "--seeds places: warps from distinct places (higher recall in hours of capture, slower).\n"
+      "--seeds windows: seeds matched by three poses, a quarter second apart (more distinct\n"
+      "takes: higher recall where many takes pass the query's pose; the first such search\n"
+      "of a space builds its window index).\n"
       "--ann-dims and --dtw-dims are at most the space's dimensions. --neutral: the query's\n"
       "mean pose, the mean of its first and last poses, or the space's origin. --no-refine\n"
       "skips re-warping each candidate free of its seed. --exact ignores the seed parameters.\n"

@@ -122,9 +122,7 @@ std::string ParametersJson(const PropagationRequest& request) {
                {"max_results", params.max_results},
                {"neighbours", params.neighbours},
                {"places", params.places},
-               {"seed_selection", params.seed_selection == SeedSelection::kDistinctPlaces
-                                      ? "distinct_places"
-                                      : "nearest_frames"},
+               {"seed_selection", SeedSelectionName(params.seed_selection)},
                {"epsilon", params.epsilon},
                {"slope_limit", params.slope_limit},
                {"cluster_gap_s", params.cluster_gap_s},

@@ -171,7 +171,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--bvh FILE",
                              "--from F=0",
                              "--to T=last",
-                             "--seeds frames|places=frames",
+                             "--seeds frames|places|windows=frames",
                              "--places N=128",
                              "--neighbours K=0",
                              "--threads N=0 = one per core",
@@ -383,12 +383,13 @@ TEST_F(CliServerTest, SearchRowsShowTheClipId) {
       << r.out;
 }
 
-// Both seed selections and a threaded exact search answer through the CLI; the query finds
+// Every seed selection and a threaded exact search answer through the CLI; the query finds
 // itself first in each. The server's range errors name the CLI's flags.
 TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
   for (const std::vector<std::string>& extra :
        {std::vector<std::string>{"--seeds", "places", "--places", "16"},
         {"--seeds", "frames", "--neighbours", "200"},
+        {"--seeds", "windows", "--neighbours", "100"},
         {"--exact", "--threads", "2"},
         {"--char-frames", "15,35"},
         {"--points", "2", "--max-point-gap", "1"},

@@ -248,15 +248,16 @@ TEST(ExactSearchThreads, StopWhenTheCallerSays) {
             absl::StatusCode::kInvalidArgument);
 }
 
-// Both seed selections find every planted copy that the exact search ranks first.
-TEST(SeedSelection, DistinctPlacesAndTheThesisFindThePlantedCopies) {
+// Every seed selection finds every planted copy that the exact search ranks first.
+TEST(SeedSelection, EverySelectionFindsThePlantedCopies) {
   const std::unique_ptr<LibraryIndex> library = PlantedLibrary();
   const RowMatrixXf query = testing::Pattern(36, kDims);
   SearchParams params;
   params.max_results = 8;
   const SearchResponse exact = *ExactSearch(*library, CoordinateView::Of(query), params);
   ASSERT_EQ(exact.results.size(), 8u);
-  for (SeedSelection selection : {SeedSelection::kDistinctPlaces, SeedSelection::kNearestFrames}) {
+  for (SeedSelection selection : {SeedSelection::kDistinctPlaces, SeedSelection::kNearestFrames,
+                                  SeedSelection::kNearestWindows}) {
     params.seed_selection = selection;
     const SearchResponse fast = *Search(*library, CoordinateView::Of(query), params);
     EXPECT_LE(fast.stats.clusters, fast.stats.seeds);

@@ -1,12 +1,16 @@
 #include "core/index/library_index.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <mutex>
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
+
+#include <Eigen/Eigenvalues>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -23,16 +27,16 @@ bool Nearer(const Neighbour& a, const Neighbour& b) {
 
 }  // namespace
 
-// A single kd-tree (exact, and the fastest FLANN index at ~10 dimensions) over the first
-// ann_dims columns of every `every`-th row of the coordinate block from row `first`, read in
-// place through the row stride. Its point i is the block's row first + i * every.
+// A single kd-tree (exact, and the fastest FLANN index at ~10 dimensions) over the first `dims`
+// columns of `count` rows `stride` floats apart from `points`, read in place. Its point i is the
+// block's row first + i * every.
 class LibraryIndex::Tree {
  public:
-  Tree(const RowMatrixXf& coordinates, int ann_dims, int leaf_size, int64_t first, int every)
-      : index_(flann::Matrix<float>(const_cast<float*>(coordinates.row(first).data()),
-                                    (coordinates.rows() - first + every - 1) / every, ann_dims,
-                                    every * coordinates.cols() * sizeof(float)),
-               flann::KDTreeSingleIndexParams(leaf_size, /*reorder=*/false)),
+  Tree(const float* points, int64_t count, int dims, int stride, int leaf_size, int64_t first,
+       int every)
+      : index_(
+            flann::Matrix<float>(const_cast<float*>(points), count, dims, stride * sizeof(float)),
+            flann::KDTreeSingleIndexParams(leaf_size, /*reorder=*/false)),
         first_(first),
         every_(every) {
     index_.buildIndex();
@@ -91,10 +95,23 @@ class LibraryIndex::Tree {
   int every_;
 };
 
+// A block's seed windows and their kd-tree.
+struct LibraryIndex::Windows {
+  RowMatrixXf rows;       // per pose-tree point, its window (3 x ann_dims) in `basis`
+  Eigen::MatrixXf basis;  // the first block's: the query is turned once for every block
+  std::unique_ptr<Tree> tree;
+};
+
 struct LibraryIndex::Block {
   RowMatrixXf coordinates;
   int64_t first_frame = 0;  // global number of row 0
-  std::unique_ptr<Tree> tree;
+  std::unique_ptr<Tree> pose_tree;
+  // The seed windows of the pose tree's points, built by the first search that asks
+  // (WindowsOf): most searches never do, and they take 1.5 x ann_dims floats a tree point and a
+  // second kd-tree build.
+  mutable std::once_flag windows_built;
+  mutable std::atomic<bool> windows_ready{false};  // set once `windows` holds a tree
+  mutable Windows windows;
 };
 
 namespace {
@@ -120,10 +137,39 @@ absl::Status ValidateClips(const std::vector<LibraryClip>& clips, Eigen::Index d
   return absl::OkStatus();
 }
 
+// Writes the seed window of `rows` at `frame` (LibraryIndex::NearestWindows) to `out`, 3 x dims.
+void WriteWindow(CoordinateView rows, int64_t frame, int offset, int dims, float* out) {
+  for (const int64_t at : {frame - offset, frame, frame + offset}) {
+    const float* pose = rows.row(std::clamp<int64_t>(at, 0, rows.rows - 1));
+    out = std::copy(pose, pose + dims, out);
+  }
+}
+
+float WindowDistance(const float* window, CoordinateView rows, int64_t frame, int offset,
+                     int dims) {
+  float sum = 0.0f;
+  for (const int64_t at : {frame - offset, frame, frame + offset}) {
+    const float* pose = rows.row(std::clamp<int64_t>(at, 0, rows.rows - 1));
+    for (int k = 0; k < dims; ++k, ++window) sum += (*window - pose[k]) * (*window - pose[k]);
+  }
+  return std::sqrt(sum);
+}
+
+// The eigenvectors of the rows' covariance, by decreasing eigenvalue: an orthonormal basis.
+Eigen::MatrixXf PrincipalAxes(const RowMatrixXf& rows) {
+  const Eigen::MatrixXd centred =
+      rows.cast<double>().rowwise() - rows.cast<double>().colwise().mean();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(centred.transpose() * centred);
+  return solver.eigenvectors().rowwise().reverse().cast<float>();
+}
+
 }  // namespace
 
 LibraryIndex::LibraryIndex(double rate, const LibraryIndexOptions& options, int dims)
-    : rate_(rate), options_(options), dims_(dims) {}
+    : rate_(rate),
+      options_(options),
+      dims_(dims),
+      window_frames_(static_cast<int>(std::lround(options.seed_window_s * rate))) {}
 
 LibraryIndex::~LibraryIndex() = default;
 
@@ -134,6 +180,10 @@ absl::StatusOr<std::unique_ptr<LibraryIndex>> LibraryIndex::Build(
   }
   if (options.ann_dims < 1 || options.leaf_size < 1) {
     return absl::InvalidArgumentError("ann_dims and leaf_size must be at least 1");
+  }
+  if (!(options.seed_window_s >= 0.0 && options.seed_window_s <= kMaxSeedWindowS)) {
+    return absl::InvalidArgumentError(absl::StrCat("seed_window_s must be in [0, ", kMaxSeedWindowS,
+                                                   "], got ", options.seed_window_s));
   }
   if (clips.empty()) return absl::InvalidArgumentError("library has no clips");
   const Eigen::Index dims = clips[0].coordinates.cols();
@@ -219,12 +269,47 @@ void LibraryIndex::AddBlock(std::vector<LibraryClip> clips, int64_t first_frame)
   // A block shorter than the gap to its first such frame has none, and no tree.
   const int every = tree_every();
   const int64_t first_tree_row = (every - first_frame % every) % every;
+  const int ann_dims = options_.ann_dims;
   if (first_tree_row < rows) {
-    block->tree = std::make_unique<Tree>(block->coordinates, options_.ann_dims, options_.leaf_size,
-                                         first_tree_row, every);
+    const int64_t points = (rows - first_tree_row + every - 1) / every;
+    block->pose_tree =
+        std::make_unique<Tree>(block->coordinates.row(first_tree_row).data(), points, ann_dims,
+                               every * dims_, options_.leaf_size, first_tree_row, every);
   }
   blocks_.push_back(std::move(block));
   total_frames_ += rows;
+}
+
+const LibraryIndex::Windows& LibraryIndex::WindowsOf(int b) const {
+  const Block& block = *blocks_[b];
+  std::call_once(block.windows_built, [&] {
+    if (!block.pose_tree) return;
+    const Tree& poses = *block.pose_tree;
+    const int dims = options_.ann_dims;
+    RowMatrixXf& rows = block.windows.rows;
+    rows.resize(poses.points(), 3 * dims);
+    for (int c = 0; c < clip_count(); ++c) {
+      if (clip_block_[c] != b) continue;
+      const CoordinateView clip = clip_coordinates(c);
+      const int64_t clip_row = clips_[c].first_frame - block.first_frame;
+      // The clip's first tree row, then every every()-th.
+      int64_t row = poses.first() +
+                    (clip_row - poses.first() + poses.every() - 1) / poses.every() * poses.every();
+      for (; row < clip_row + clip.rows; row += poses.every()) {
+        WriteWindow(clip, row - clip_row, window_frames_, dims,
+                    rows.row((row - poses.first()) / poses.every()).data());
+      }
+    }
+    // The windows' principal axes: distances are the same, but the kd-tree, which splits one
+    // axis at a time, then separates windows of correlated poses in fewer levels (10 h of real
+    // capture, 500 seeds: 2.65 -> 2.04 ms).
+    block.windows.basis = b == 0 ? PrincipalAxes(rows) : WindowsOf(0).basis;
+    rows *= block.windows.basis;
+    block.windows.tree = std::make_unique<Tree>(rows.data(), rows.rows(), 3 * dims, 3 * dims,
+                                                options_.leaf_size, poses.first(), poses.every());
+    block.windows_ready.store(true, std::memory_order_release);
+  });
+  return block.windows;
 }
 
 CoordinateView LibraryIndex::clip_coordinates(int index) const {
@@ -242,24 +327,21 @@ RowMatrixXf LibraryIndex::CopyClipCoordinates(int index) const {
   return copy;
 }
 
-std::vector<Neighbour> LibraryIndex::TreeNearest(const float* point, int dims, int k,
+std::vector<Neighbour> LibraryIndex::TreeNearest(absl::FunctionRef<const Tree*(int block)> tree_of,
+                                                 const float* point, int dims, int k,
                                                  float epsilon) const {
-  const Tree& base = *blocks_[0]->tree;  // the first block starts at frame 0, a tree frame
-  if (blocks_.size() == 1 || !blocks_[1]->tree) {
-    return base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())),
-                        epsilon);
-  }
-  // The recent additions' tree is asked only for frames nearer than the base's k-th nearest:
-  // with k in the thousands, that is most of the cost of a second tree saved.
+  const Tree& base = *tree_of(0);  // the first block starts at frame 0, a tree frame
   std::vector<Neighbour> all =
       base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())), epsilon);
+  const Tree* added = blocks_.size() > 1 ? tree_of(1) : nullptr;
+  if (!added) return all;
+  // The recent additions' tree is asked only for frames nearer than the base's k-th nearest:
+  // with k in the thousands, that is most of the cost of a second tree saved.
   const float within = static_cast<int>(all.size()) == k ? all.back().distance
                                                          : std::numeric_limits<float>::infinity();
-  const Block& recent = *blocks_[1];
-  for (Neighbour n : recent.tree->Nearest(
-           point, dims, static_cast<int>(std::min<int64_t>(k, recent.tree->points())), epsilon,
-           within)) {
-    n.frame += recent.first_frame;
+  for (Neighbour n : added->Nearest(
+           point, dims, static_cast<int>(std::min<int64_t>(k, added->points())), epsilon, within)) {
+    n.frame += blocks_[1]->first_frame;
     all.push_back(n);
   }
   const size_t keep = std::min<size_t>(k, all.size());
@@ -289,13 +371,17 @@ std::pair<int, int64_t> LibraryIndex::Locate(int64_t global_frame) const {
 
 int LibraryIndex::tree_every() const { return options_.coarse_tree ? CoarseFactor(rate_) : 1; }
 
-std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k, float epsilon,
-                                             const std::vector<bool>& allowed_clips) const {
+std::vector<Neighbour> LibraryIndex::FilteredNearest(
+    int k, const std::vector<bool>& allowed_clips, bool tree_usable,
+    absl::FunctionRef<std::vector<Neighbour>(int k)> tree_nearest,
+    absl::FunctionRef<float(int clip, int64_t frame)> distance) const {
   k = static_cast<int>(std::min<int64_t>(k, total_frames()));
-  if (dims == options_.ann_dims) {
+  if (tree_usable) {
+    if (allowed_clips.empty()) return tree_nearest(k);
     int64_t tree_points = 0;
-    for (const auto& block : blocks_) tree_points += block->tree ? block->tree->points() : 0;
-    if (allowed_clips.empty()) return TreeNearest(point, dims, k, epsilon);
+    for (const auto& block : blocks_) {
+      tree_points += block->pose_tree ? block->pose_tree->points() : 0;
+    }
     // When the filter keeps most frames, ask the tree for enough extra neighbours to cover the
     // filtered-out ones (doubling a few times), and scan only if that is not enough.
     const int64_t allowed_frames = AllowedFrames(allowed_clips);
@@ -303,7 +389,7 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
         k + (k * (total_frames() - allowed_frames)) / std::max<int64_t>(1, allowed_frames) + 16;
     for (int attempt = 0; allowed_frames * 2 >= total_frames() && attempt < 4; ++attempt) {
       wanted = std::min(wanted, tree_points);
-      std::vector<Neighbour> found = TreeNearest(point, dims, static_cast<int>(wanted), epsilon);
+      std::vector<Neighbour> found = tree_nearest(static_cast<int>(wanted));
       std::erase_if(found,
                     [&](const Neighbour& n) { return !allowed_clips[Locate(n.frame).first]; });
       if (static_cast<int64_t>(found.size()) >= k || wanted == tree_points) {
@@ -316,15 +402,48 @@ std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k
   std::vector<Neighbour> all;
   for (int c = 0; c < clip_count(); ++c) {
     if (!allowed_clips.empty() && !allowed_clips[c]) continue;
-    const CoordinateView view = clip_coordinates(c);
-    for (int64_t f = 0; f < view.rows; ++f) {
-      all.push_back({clips_[c].first_frame + f, Distance(point, view.row(f), dims)});
+    for (int64_t f = 0; f < clips_[c].frame_count; ++f) {
+      all.push_back({clips_[c].first_frame + f, distance(c, f)});
     }
   }
   const size_t keep = std::min<size_t>(k, all.size());
   std::partial_sort(all.begin(), all.begin() + keep, all.end(), Nearer);
   all.resize(keep);
   return all;
+}
+
+std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k, float epsilon,
+                                             const std::vector<bool>& allowed_clips) const {
+  return FilteredNearest(
+      k, allowed_clips, dims == options_.ann_dims,
+      [&](int wanted) {
+        return TreeNearest([&](int b) { return blocks_[b]->pose_tree.get(); }, point, dims, wanted,
+                           epsilon);
+      },
+      [&](int clip, int64_t frame) {
+        return Distance(point, clip_coordinates(clip).row(frame), dims);
+      });
+}
+
+std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t frame, int dims,
+                                                    int k, float epsilon,
+                                                    const std::vector<bool>& allowed_clips) const {
+  if (window_frames_ == 0) return Nearest(rows.row(frame), dims, k, epsilon, allowed_clips);
+  Eigen::RowVectorXf window(3 * dims);
+  WriteWindow(rows, frame, window_frames_, dims, window.data());
+  const bool tree_usable = dims == options_.ann_dims;
+  const Eigen::RowVectorXf turned =
+      tree_usable ? Eigen::RowVectorXf(window * WindowsOf(0).basis) : window;
+  return FilteredNearest(
+      k, allowed_clips, tree_usable,
+      [&](int wanted) {
+        return TreeNearest([&](int b) { return WindowsOf(b).tree.get(); }, turned.data(), 3 * dims,
+                           wanted, epsilon);
+      },
+      [&](int clip, int64_t clip_frame) {
+        return WindowDistance(window.data(), clip_coordinates(clip), clip_frame, window_frames_,
+                              dims);
+      });
 }
 
 int64_t LibraryIndex::AllowedFrames(const std::vector<bool>& allowed_clips) const {
@@ -343,9 +462,9 @@ std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims,
   DistinctPlaces places(k, separation, clip_of, allowed_clips);
   if (dims == options_.ann_dims && AllowedFrames(allowed_clips) * 2 >= total_frames_) {
     for (const auto& block : blocks_) {
-      if (!block->tree) continue;
-      places.set_rows(block->first_frame + block->tree->first(), block->tree->every());
-      block->tree->Offer(point, epsilon, places);
+      if (!block->pose_tree) continue;
+      places.set_rows(block->first_frame + block->pose_tree->first(), block->pose_tree->every());
+      block->pose_tree->Offer(point, epsilon, places);
     }
     return places.Take();
   }
@@ -371,7 +490,15 @@ int64_t LibraryIndex::coordinate_bytes() const {
 
 int64_t LibraryIndex::tree_bytes() const {
   int64_t bytes = 0;
-  for (const auto& block : blocks_) bytes += block->tree ? block->tree->bytes() : 0;
+  for (const auto& block : blocks_) {
+    bytes += block->pose_tree ? block->pose_tree->bytes() : 0;
+    // Read unsynchronised only if built: the once_flag has no "done?" query, and a build under
+    // way must not be waited for here.
+    if (block->windows_ready.load(std::memory_order_acquire)) {
+      bytes += block->windows.tree->bytes() +
+               block->windows.rows.size() * static_cast<int64_t>(sizeof(float));
+    }
+  }
   return bytes;
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
+#include "absl/functional/function_ref.h"
 #include "absl/status/statusor.h"
 #include "core/index/coordinate_view.h"
 #include "core/motion/matrix.h"
@@ -40,6 +41,13 @@ struct LibraryClip {
 // issue 11).
 inline constexpr int kDefaultAnnDims = 5;
 
+// Seed windows a quarter of a second either side of the frame. Measured by brute force on 10 h
+// of real capture (bench/RESULTS.md, issue 11; recall@10 against the exact search, 20 queries,
+// 500 seeds): one pose 0.885, windows of 0.13 s 0.940, 0.27 s 0.950, 0.5 s 0.895.
+inline constexpr double kDefaultSeedWindowS = 0.25;
+// Longer windows than this span whole actions rather than a pose's motion.
+inline constexpr double kMaxSeedWindowS = 2.0;
+
 struct LibraryIndexOptions {
   // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
   int ann_dims = kDefaultAnnDims;
@@ -49,6 +57,12 @@ struct LibraryIndexOptions {
   // 30 Hz, 8 at 120 Hz): seeds at about 15 Hz, a tree 1/n the size, built n times faster.
   // false: every frame.
   bool coarse_tree = true;
+  // Seconds between the three poses of a seed window: a tree frame's pose and the poses this far
+  // before and after it (clamped to the clip), in a second kd-tree of 3 x ann_dims dimensions
+  // (NearestWindows). A window tells a take's own motion through a pose from other takes
+  // passing the same pose: see kDefaultSeedWindowS. 0: no window tree (NearestWindows scans
+  // the nearest frames instead), for 1.5 x ann_dims floats a tree frame less.
+  double seed_window_s = kDefaultSeedWindowS;
 };
 
 struct Neighbour {
@@ -120,12 +134,24 @@ class LibraryIndex {
   std::vector<Neighbour> NearestPlaces(const float* point, int dims, int k, int64_t separation,
                                        float epsilon, const std::vector<bool>& allowed_clips) const;
 
-  // Bytes held: the coordinate blocks and the kd-trees.
+  // Frames between the poses of a seed window (LibraryIndexOptions::seed_window_s at rate()),
+  // 0 when the index has no window tree.
+  int window_frames() const { return window_frames_; }
+  // The k frames whose seed windows are nearest to `rows`' window at `frame` (its poses at
+  // frame - window_frames(), frame and frame + window_frames(), each clamped to its own rows,
+  // over their first `dims` coordinates), nearest first, with the window distance. Tree and
+  // scan as Nearest() does, over the window tree; window_frames() 0: Nearest() at `frame`.
+  std::vector<Neighbour> NearestWindows(CoordinateView rows, int64_t frame, int dims, int k,
+                                        float epsilon,
+                                        const std::vector<bool>& allowed_clips) const;
+
+  // Bytes held: the coordinate blocks; the kd-trees and the seed windows they index.
   int64_t coordinate_bytes() const;
   int64_t tree_bytes() const;
 
  private:
   class Tree;
+  struct Windows;
   struct Block;
   LibraryIndex(double rate, const LibraryIndexOptions& options, int dims);
   // A block of `clips` (validated) after `first_frame` global frames, with its kd-tree; appends
@@ -134,12 +160,24 @@ class LibraryIndex {
   void AddEntry(ClipEntry entry, int block);
   // Frames of the allowed clips (empty: all).
   int64_t AllowedFrames(const std::vector<bool>& allowed_clips) const;
-  // The k nearest over the kd-trees of every block, merged.
-  std::vector<Neighbour> TreeNearest(const float* point, int dims, int k, float epsilon) const;
+  // Block b's seed windows, built on first use (thread-safe).
+  const Windows& WindowsOf(int b) const;
+  // The k nearest over one kd-tree of every block (tree_of(b): block b's, null if none),
+  // merged; the first block's must exist.
+  std::vector<Neighbour> TreeNearest(absl::FunctionRef<const Tree*(int block)> tree_of,
+                                     const float* point, int dims, int k, float epsilon) const;
+  // The k nearest frames of the allowed clips by `distance` (frame of a clip, by index): through
+  // `tree_nearest` (the k nearest of every clip) when `tree_usable` and the allowed clips hold
+  // most frames, else by a scan.
+  std::vector<Neighbour> FilteredNearest(
+      int k, const std::vector<bool>& allowed_clips, bool tree_usable,
+      absl::FunctionRef<std::vector<Neighbour>(int k)> tree_nearest,
+      absl::FunctionRef<float(int clip, int64_t frame)> distance) const;
 
   double rate_;
   LibraryIndexOptions options_;
   int dims_;
+  int window_frames_;
   int64_t total_frames_ = 0;
   // The first block holds the clips of the last full build; a second one, if any, those added
   // since. Clips are numbered across blocks in order.

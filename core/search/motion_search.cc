@@ -39,8 +39,15 @@ double FineShare(int factor) { return factor <= 2 ? 1.0 : 2.0 / 3.0; }
 // to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
 // Measured at 100 h of synthetic capture at 30 Hz with every candidate refined: 1000 seeds gave
 // recall@10 0.88, 2000 gave 0.95 (8.2 ms).
+// Seed windows (SeedSelection::kNearestWindows) spread over more places than nearest frames do,
+// so fewer of them cover as much: on 10 h of real capture (bench/RESULTS.md, issue 11, 20
+// queries; recall@10 against the exact search) 250, 500 and 1000 gave 0.875, 0.945 and 0.975
+// (3.8, 5.5 and 8.7 ms), where 1000 nearest frames give 0.940 (6.5 ms).
+constexpr int kWindowSeeds = 500;
+
 int NearestFrameSeeds(const LibraryIndex& library, const SearchParams& params) {
   if (params.neighbours > 0) return params.neighbours;
+  if (params.seed_selection == SeedSelection::kNearestWindows) return kWindowSeeds;
   constexpr double kTenHoursOfSeeds = 10 * 3600 * kCoarseRate;
   const double tree_frames = static_cast<double>(library.total_frames()) / library.tree_every();
   return static_cast<int>(
@@ -221,12 +228,21 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
   const bool distinct = params.seed_selection == SeedSelection::kDistinctPlaces;
   const int seed_count = NearestFrameSeeds(library, params);
+  const auto nearest_of = [&](int query_frame, int count) {
+    switch (params.seed_selection) {
+      case SeedSelection::kDistinctPlaces:
+        return library.NearestPlaces(query.row(query_frame), params.ann_dims, params.places,
+                                     PlaceSeparation(gap, query.rows), params.epsilon, allowed);
+      case SeedSelection::kNearestWindows:
+        return library.NearestWindows(query, query_frame, params.ann_dims, count, params.epsilon,
+                                      allowed);
+      case SeedSelection::kNearestFrames:
+        break;
+    }
+    return library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon, allowed);
+  };
   const auto seeds_of = [&](int query_frame, int count) {
-    const std::vector<Neighbour> neighbours =
-        distinct ? library.NearestPlaces(query.row(query_frame), params.ann_dims, params.places,
-                                         PlaceSeparation(gap, query.rows), params.epsilon, allowed)
-                 : library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon,
-                                   allowed);
+    const std::vector<Neighbour> neighbours = nearest_of(query_frame, count);
     std::vector<Seed> seeds;
     seeds.reserve(neighbours.size());
     for (const Neighbour& n : neighbours) {

@@ -15,6 +15,18 @@ absl::Status OutOfRange(absl::string_view name, double value, absl::string_view 
 
 }  // namespace
 
+const char* SeedSelectionName(SeedSelection selection) {
+  switch (selection) {
+    case SeedSelection::kDistinctPlaces:
+      return "distinct_places";
+    case SeedSelection::kNearestWindows:
+      return "nearest_windows";
+    case SeedSelection::kNearestFrames:
+      break;
+  }
+  return "nearest_frames";
+}
+
 absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   const std::string dims_range = absl::StrCat("1..", dims, " (the library's dimensions)");
   if (params.ann_dims < 1 || params.ann_dims > dims) {

@@ -32,6 +32,10 @@ enum class SeedSelection {
   // apart in a clip (LibraryIndex::NearestPlaces), one warp each: no better than the nearest
   // frames at these sizes.
   kDistinctPlaces,
+  // The `neighbours` frames whose seed windows (the pose and the poses a quarter second either
+  // side, LibraryIndex::NearestWindows) are nearest to the query's around the characteristic
+  // frame, clustered in time as the nearest frames are.
+  kNearestWindows,
 };
 
 // The most results one search returns (max_results' upper bound).
@@ -103,6 +107,9 @@ struct SearchParams {
   // Polled inside long loops; returning true stops the search with CANCELLED.
   std::function<bool()> should_stop;
 };
+
+// "nearest_frames", "distinct_places" or "nearest_windows".
+const char* SeedSelectionName(SeedSelection selection);
 
 // INVALID_ARGUMENT naming the first out-of-range parameter; `dims` is the library's dimensions.
 absl::Status ValidateSearchParams(const SearchParams& params, int dims);

@@ -35,6 +35,8 @@ absl::StatusOr<SeedSelection> FromProto(v1::SeedSelection selection) {
       return SeedSelection::kNearestFrames;
     case v1::SEED_SELECTION_DISTINCT_PLACES:
       return SeedSelection::kDistinctPlaces;
+    case v1::SEED_SELECTION_NEAREST_WINDOWS:
+      return SeedSelection::kNearestWindows;
     default:
       return absl::InvalidArgumentError(absl::StrCat("seed_selection: unknown value ", selection));
   }
