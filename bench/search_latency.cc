@@ -235,7 +235,8 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     SearchParams params;
     params.seed_selection = SeedSelection::kNearestWindows;
     params.neighbours = count;
-    variants.emplace_back(absl::StrCat("fast, ", count, " window seeds"), params);
+    variants.emplace_back(
+        count == 0 ? "fast, window seeds" : absl::StrCat("fast, ", count, " window seeds"), params);
   }
   for (int count : flags.points) {
     SearchParams params;
@@ -300,10 +301,11 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
     const auto start = std::chrono::steady_clock::now();
     MOTIONDB_RETURN_IF_ERROR(
         Search(library, CoordinateView::Of(bench.queries[0].coordinates), params).status());
-    std::printf("first window search (builds the window index) %.1f ms; kd-trees and windows "
-                "then %.1f MiB = %.2fx\n",
-                SecondsSince(start) * 1000, library.tree_bytes() / 1048576.0,
-                library.tree_bytes() / 1048576.0 / indexed_mib);
+    std::printf(
+        "first window search (builds the window index) %.1f ms; kd-trees and windows "
+        "then %.1f MiB = %.2fx\n",
+        SecondsSince(start) * 1000, library.tree_bytes() / 1048576.0,
+        library.tree_bytes() / 1048576.0 / indexed_mib);
   }
   for (const auto& [label, params] : Variants(variant_flags)) {
     MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
@@ -414,9 +416,10 @@ int main(int argc, char** argv) {
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--windows", variants.windows,
-                 "also measure the fast search with these numbers of window seeds")
+                 "also measure the fast search with these numbers of window seeds (0: the "
+                 "default)")
       ->type_name("N ...")
-      ->check(motiondb::cli::WholeAtLeast(1));
+      ->check(motiondb::cli::WholeAtLeast(0));
   app.add_option("--points", variants.points,
                  "also measure the fast search with these numbers of characteristic points (0: "
                  "one per action of the query)")

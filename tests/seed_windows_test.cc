@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/index/library_index.h"
+#include "core/search/motion_search.h"
 #include "tests/search_test_data.h"
 
 namespace motiondb {
@@ -195,6 +196,39 @@ TEST(NearestWindows, ConcurrentFirstSearchesAgree) {
   // The windows (15 floats a tree point) and their tree now count in the index's memory.
   EXPECT_GE((*library)->tree_bytes(),
             unbuilt_bytes + (*library)->total_frames() / (*library)->tree_every() * 15 * 4);
+}
+
+// Clips at 120 Hz, six holding the query's peak pose for 4 s: 500 seed windows pile into the
+// holds, too few places to fill 20 results; the default count takes them again, twice as many,
+// until they fill them; a count the search is given is kept.
+TEST(DefaultSeeds, AreTakenAgainWhileTooFewPlacesToFillTheResults) {
+  constexpr int kQueryFrames = 240;
+  const RowMatrixXf pattern = testing::Pattern(kQueryFrames, kDims);
+  RowMatrixXf held(kQueryFrames + 480, kDims);
+  held.topRows(kQueryFrames / 2) = pattern.topRows(kQueryFrames / 2);
+  held.middleRows(kQueryFrames / 2, 480).rowwise() = pattern.row(kQueryFrames / 2);
+  held.bottomRows(kQueryFrames / 2) = pattern.bottomRows(kQueryFrames / 2);
+  std::vector<LibraryClip> clips;
+  for (int c = 0; c < 8; ++c) {
+    RowMatrixXf curve = testing::SmoothNoise(3000, kDims, 7 + c);
+    if (c < 6) testing::Plant(curve, held, 300 + 200 * c);
+    clips.push_back({c, "held", {}, std::move(curve)});
+  }
+  const auto library = LibraryIndex::Build(std::move(clips), 120.0, {});
+  ASSERT_TRUE(library.ok()) << library.status();
+  SearchParams params;
+  params.seed_selection = SeedSelection::kNearestWindows;
+  params.characteristic_frame = kQueryFrames / 2;
+  params.neighbours = 500;
+  const SearchResponse given = *Search(**library, CoordinateView::Of(pattern), params);
+  EXPECT_EQ(given.stats.seeds, 500);
+  EXPECT_LT(given.stats.clusters, 2 * params.max_results);
+  EXPECT_LT(given.results.size(), 20u);
+  params.neighbours = 0;  // the default, 500 first
+  const SearchResponse found = *Search(**library, CoordinateView::Of(pattern), params);
+  EXPECT_GT(found.stats.seeds, 500);
+  EXPECT_GE(found.stats.clusters, 2 * params.max_results);
+  EXPECT_EQ(found.results.size(), 20u);
 }
 
 }  // namespace

@@ -39,6 +39,13 @@ double FineShare(int factor) { return factor <= 2 ? 1.0 : 2.0 / 3.0; }
 // to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
 // Measured at 100 h of synthetic capture at 30 Hz with every candidate refined: 1000 seeds gave
 // recall@10 0.88, 2000 gave 0.95 (8.2 ms).
+// The default seeds are taken again, twice as many, at most this many times while they fall in
+// fewer than kPlacesPerResult clusters a result. Measured on 70 s at 120 Hz (one clip; 20
+// queries, bench/RESULTS.md, issue 11): 500 seed windows fell in 23 clusters and filled 16.1 of
+// 20 results, 1000 in 40 clusters and 19.9.
+constexpr int kMostSeedDoublings = 3;
+constexpr size_t kPlacesPerResult = 2;
+
 // Seed windows (SeedSelection::kNearestWindows) spread over more places than nearest frames do,
 // so fewer of them cover as much: on 10 h of real capture (bench/RESULTS.md, issue 11, 20
 // queries; recall@10 against the exact search) 250, 500 and 1000 gave 0.875, 0.945 and 0.975
@@ -227,7 +234,7 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
   const bool distinct = params.seed_selection == SeedSelection::kDistinctPlaces;
-  const int seed_count = NearestFrameSeeds(library, params);
+  int seed_count = NearestFrameSeeds(library, params);
   const auto nearest_of = [&](int query_frame, int count) {
     switch (params.seed_selection) {
       case SeedSelection::kDistinctPlaces:
@@ -252,12 +259,26 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
     return seeds;
   };
   std::vector<Seed> nearest = seeds_of(anchor, seed_count);  // nearest first
-  stats.seeds = static_cast<int64_t>(nearest.size());
   stats.seeds_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
   // Distinct places are their own clusters.
   std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation);
+  double reseed_ms = 0;
+  // Seeds by the library's default count that pile into too few places to fill max_results (a
+  // short library, a pose held long) are taken again, twice as many, while the library has
+  // more.
+  for (int more = 0; !distinct && params.neighbours == 0 && more < kMostSeedDoublings &&
+                     order.size() < kPlacesPerResult * static_cast<size_t>(params.max_results) &&
+                     nearest.size() == static_cast<size_t>(seed_count);
+       ++more) {
+    seed_count *= 2;
+    const Clock::time_point again = Clock::now();
+    nearest = seeds_of(anchor, seed_count);
+    reseed_ms += MillisecondsSince(again);
+    order = ClusterSeeds(nearest, gap, separation);
+  }
+  stats.seeds = static_cast<int64_t>(nearest.size());
   const bool scattered = !distinct && params.second_anchor_scatter > 0 && nearest.size() >= 2 &&
                          static_cast<double>(order.size()) >
                              params.second_anchor_scatter * static_cast<double>(nearest.size());
@@ -282,8 +303,8 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
     stats.second_anchor = second;
   }
   stats.clusters = static_cast<int64_t>(order.size());
-  stats.seeds_ms += second_seeds_ms;
-  stats.clusters_ms = MillisecondsSince(stage) - second_seeds_ms;
+  stats.seeds_ms += reseed_ms + second_seeds_ms;
+  stats.clusters_ms = MillisecondsSince(stage) - reseed_ms - second_seeds_ms;
   return order;
 }
 

@@ -50,8 +50,10 @@ struct SearchParams {
   SeedSelection seed_selection = SeedSelection::kNearestFrames;
   // kDistinctPlaces: seeds, one warp each.
   int places = 128;
-  // kNearestFrames: seeds, nearest library frames to the characteristic pose; 0: by the
-  // library's size (1000 up to 10 hours, 2000 at 100 hours; core/search/motion_search.cc).
+  // kNearestFrames and kNearestWindows: seeds, nearest library frames to the characteristic
+  // pose (or window); 0: by the library's size (frames: 1000 up to 10 hours, 2000 at 100 hours;
+  // windows: 500), taken again, twice as many, while they fall in fewer than two places a
+  // result (core/search/motion_search.cc).
   int neighbours = 0;
   // Approximation bound of the seed search (0 = exact).
   float epsilon = 0.0f;
