@@ -36,6 +36,15 @@ RowMatrixXf Pattern(int frames, int dims) {
   return pattern;
 }
 
+RowMatrixXf HeldPattern(int frames, int hold, int dims) {
+  const RowMatrixXf pattern = Pattern(frames, dims);
+  RowMatrixXf held(frames + hold, dims);
+  held.topRows(frames / 2) = pattern.topRows(frames / 2);
+  held.middleRows(frames / 2, hold).rowwise() = pattern.row(frames / 2);
+  held.bottomRows(frames - frames / 2) = pattern.bottomRows(frames - frames / 2);
+  return held;
+}
+
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at) {
   curve.middleRows(at, pattern.rows()) = pattern;
 }

@@ -17,6 +17,9 @@ RowMatrixXf SmoothNoise(int64_t frames, int dims, uint32_t seed);
 // longer pattern is the same motion performed more slowly).
 RowMatrixXf Pattern(int frames, int dims);
 
+// Pattern(frames, dims) with its middle pose held for `hold` more frames.
+RowMatrixXf HeldPattern(int frames, int hold, int dims);
+
 // Writes `pattern` into `curve` starting at `at`.
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at);
 

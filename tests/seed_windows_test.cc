@@ -204,10 +204,7 @@ TEST(NearestWindows, ConcurrentFirstSearchesAgree) {
 TEST(DefaultSeeds, AreTakenAgainWhileTooFewPlacesToFillTheResults) {
   constexpr int kQueryFrames = 240;
   const RowMatrixXf pattern = testing::Pattern(kQueryFrames, kDims);
-  RowMatrixXf held(kQueryFrames + 480, kDims);
-  held.topRows(kQueryFrames / 2) = pattern.topRows(kQueryFrames / 2);
-  held.middleRows(kQueryFrames / 2, 480).rowwise() = pattern.row(kQueryFrames / 2);
-  held.bottomRows(kQueryFrames / 2) = pattern.bottomRows(kQueryFrames / 2);
+  const RowMatrixXf held = testing::HeldPattern(kQueryFrames, 480, kDims);
   std::vector<LibraryClip> clips;
   for (int c = 0; c < 8; ++c) {
     RowMatrixXf curve = testing::SmoothNoise(3000, kDims, 7 + c);

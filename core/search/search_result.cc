@@ -23,10 +23,13 @@ std::vector<size_t> RankedOrder(const std::vector<SearchResult>& candidates, dou
                                 int max_results) {
   std::vector<size_t> order(candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  // Equal scores go by end frame, the order in which a clip's scan (ExactSearch) offers its
+  // warps to StreamingTopResults, which keeps the first of equal overlapping ones: ranked
+  // otherwise, a result the scan kept could be dropped here, leaving fewer than max_results.
   std::sort(order.begin(), order.end(), [&](size_t i, size_t j) {
     const SearchResult &a = candidates[i], &b = candidates[j];
-    return std::tie(a.score, a.clip_index, a.first_frame) <
-           std::tie(b.score, b.clip_index, b.first_frame);
+    return std::tie(a.score, a.clip_index, a.last_frame, a.first_frame) <
+           std::tie(b.score, b.clip_index, b.last_frame, b.first_frame);
   });
   std::vector<size_t> kept;
   for (size_t i : order) {
