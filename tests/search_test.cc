@@ -782,36 +782,34 @@ TEST(SearchRecall, FillsMaxResultsWhereTheExactSearchDoes) {
 }
 
 // The kept set of the streaming top results, as it was kept before the per-clip grouping: one
-// vector in the order offered, every offer compared with every kept result.
+// vector in the order offered, every offer compared with every kept result, in the ranking's
+// order (RanksBefore: ties by clip and frames, as RankResults breaks them).
 std::vector<SearchResult> ReferenceTop(const std::vector<SearchResult>& offers, int k,
                                        double max_overlap) {
   std::vector<SearchResult> kept;
-  const auto by_score = [](const SearchResult& a, const SearchResult& b) {
-    return a.score < b.score;
-  };
   for (const SearchResult& candidate : offers) {
     if (static_cast<int>(kept.size()) == k &&
-        candidate.score >= std::max_element(kept.begin(), kept.end(), by_score)->score) {
+        !RanksBefore(candidate, *std::max_element(kept.begin(), kept.end(), RanksBefore))) {
       continue;
     }
     if (std::any_of(kept.begin(), kept.end(), [&](const SearchResult& other) {
-          return other.score <= candidate.score && Overlaps(candidate, other, max_overlap);
+          return !RanksBefore(candidate, other) && Overlaps(candidate, other, max_overlap);
         })) {
       continue;
     }
     std::erase_if(kept, [&](const SearchResult& other) {
-      return other.score > candidate.score && Overlaps(other, candidate, max_overlap);
+      return RanksBefore(candidate, other) && Overlaps(other, candidate, max_overlap);
     });
     kept.push_back(candidate);
     if (static_cast<int>(kept.size()) > k) {
-      kept.erase(std::max_element(kept.begin(), kept.end(), by_score));
+      kept.erase(std::max_element(kept.begin(), kept.end(), RanksBefore));
     }
   }
   return kept;
 }
 
 // Random offers with overlaps and tied scores: the same kept results, in the same order, and
-// the same threshold after every offer.
+// the same threshold after every offer; RankResults keeps every one of them.
 TEST(StreamingTopResults, KeepsWhatOneOrderedListKeeps) {
   std::mt19937 random(7);
   for (int round = 0; round < 100; ++round) {
@@ -840,6 +838,7 @@ TEST(StreamingTopResults, KeepsWhatOneOrderedListKeeps) {
     const std::vector<SearchResult> kept = top.Take();
     const std::vector<SearchResult> reference = ReferenceTop(offers, k, 0.5);
     ASSERT_EQ(kept.size(), reference.size()) << "round " << round;
+    EXPECT_EQ(RankedCount(kept, 0.5, k), static_cast<int>(kept.size())) << "round " << round;
     for (size_t i = 0; i < kept.size(); ++i) {
       EXPECT_EQ(
           std::tie(kept[i].clip_index, kept[i].first_frame, kept[i].last_frame, kept[i].score),

@@ -124,19 +124,28 @@ TEST(NearestWindows, AgreeWithBruteForceInALibraryGrownClipByClip) {
   auto added = (*grown)->WithClips({{13, "added", {}, testing::SmoothNoise(101, kDims, 43)}});
   ASSERT_TRUE(added.ok()) << added.status();
   ASSERT_EQ((*added)->block_count(), 2);
+  EXPECT_GT((*added)->tree_bytes(), (*grown)->tree_bytes());  // the first block's windows too
   ExpectWindowsAgreeWithBruteForce(**added);
 }
 
-// Searches over other dimensions than the tree's scan every frame.
+// Searches over other dimensions than the tree's scan every frame, as do searches of a few
+// clips: neither builds the window trees.
 TEST(NearestWindows, OverOtherDimensionsScan) {
   const auto library = LibraryIndex::Build(NoiseClips(), kRate, {kTreeDims, 32, true});
   ASSERT_TRUE(library.ok());
+  const int64_t unbuilt_bytes = (*library)->tree_bytes();
+  ASSERT_EQ((*library)
+                ->NearestWindows((*library)->clip_coordinates(2), 100, kTreeDims, 10, 0.0f,
+                                 {false, false, true})
+                .size(),
+            10u);
   const CoordinateView query = (*library)->clip_coordinates(2);
   const std::vector<float> expected = BruteForceWindows(**library, query, 100, 7, {}, 1);
   const std::vector<Neighbour> found = (*library)->NearestWindows(query, 100, 7, 30, 0.0f, {});
   ASSERT_EQ(found.size(), 30u);
   for (size_t i = 0; i < found.size(); ++i) EXPECT_NEAR(found[i].distance, expected[i], 1e-4);
   EXPECT_EQ(found[0].distance, 0.0f);  // the query's own frame
+  EXPECT_EQ((*library)->tree_bytes(), unbuilt_bytes);
 }
 
 TEST(NearestWindows, WithoutWindowsAreTheNearestFrames) {

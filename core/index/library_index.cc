@@ -107,7 +107,7 @@ struct LibraryIndex::Block {
   int64_t first_frame = 0;  // global number of row 0
   std::unique_ptr<Tree> pose_tree;
   // The seed windows of the pose tree's points, built by the first search that asks
-  // (WindowsOf): most searches never do, and they take 1.5 x ann_dims floats a tree point and a
+  // (WindowsOf): most searches never do, and they take 3 x ann_dims floats a tree point and a
   // second kd-tree build.
   mutable std::once_flag windows_built;
   mutable std::atomic<bool> windows_ready{false};  // set once `windows` holds a tree
@@ -155,12 +155,33 @@ float WindowDistance(const float* window, CoordinateView rows, int64_t frame, in
   return std::sqrt(sum);
 }
 
+// Rows taken at once by PrincipalAxes and TurnRows: a copy of millions of rows would double the
+// build's memory for nothing.
+constexpr Eigen::Index kRowChunk = 4096;
+
 // The eigenvectors of the rows' covariance, by decreasing eigenvalue: an orthonormal basis.
 Eigen::MatrixXf PrincipalAxes(const RowMatrixXf& rows) {
-  const Eigen::MatrixXd centred =
-      rows.cast<double>().rowwise() - rows.cast<double>().colwise().mean();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(centred.transpose() * centred);
+  const Eigen::Index n = rows.rows(), d = rows.cols();
+  Eigen::RowVectorXd sum = Eigen::RowVectorXd::Zero(d);
+  Eigen::MatrixXd products = Eigen::MatrixXd::Zero(d, d);
+  for (Eigen::Index first = 0; first < n; first += kRowChunk) {
+    const Eigen::MatrixXd chunk =
+        rows.middleRows(first, std::min(kRowChunk, n - first)).cast<double>();
+    sum += chunk.colwise().sum();
+    products.noalias() += chunk.transpose() * chunk;
+  }
+  const Eigen::RowVectorXd mean = sum / static_cast<double>(std::max<Eigen::Index>(1, n));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(
+      products - static_cast<double>(n) * mean.transpose() * mean);
   return solver.eigenvectors().rowwise().reverse().cast<float>();
+}
+
+// rows = rows * basis, a chunk at a time.
+void TurnRows(RowMatrixXf& rows, const Eigen::MatrixXf& basis) {
+  for (Eigen::Index first = 0; first < rows.rows(); first += kRowChunk) {
+    auto chunk = rows.middleRows(first, std::min(kRowChunk, rows.rows() - first));
+    chunk = (chunk * basis).eval();
+  }
 }
 
 }  // namespace
@@ -169,7 +190,8 @@ LibraryIndex::LibraryIndex(double rate, const LibraryIndexOptions& options, int 
     : rate_(rate),
       options_(options),
       dims_(dims),
-      window_frames_(static_cast<int>(std::lround(options.seed_window_s * rate))) {}
+      // Capped: only a rate beyond any capture's could reach it.
+      window_frames_(static_cast<int>(std::lround(std::min(options.seed_window_s * rate, 1e9)))) {}
 
 LibraryIndex::~LibraryIndex() = default;
 
@@ -304,7 +326,7 @@ const LibraryIndex::Windows& LibraryIndex::WindowsOf(int b) const {
     // axis at a time, then separates windows of correlated poses in fewer levels (10 h of real
     // capture, 500 seeds: 2.65 -> 2.04 ms).
     block.windows.basis = b == 0 ? PrincipalAxes(rows) : WindowsOf(0).basis;
-    rows *= block.windows.basis;
+    TurnRows(rows, block.windows.basis);
     block.windows.tree = std::make_unique<Tree>(rows.data(), rows.rows(), 3 * dims, 3 * dims,
                                                 options_.leaf_size, poses.first(), poses.every());
     block.windows_ready.store(true, std::memory_order_release);
@@ -378,7 +400,7 @@ std::vector<Neighbour> LibraryIndex::FilteredNearest(
   k = static_cast<int>(std::min<int64_t>(k, total_frames()));
   if (tree_usable) {
     if (allowed_clips.empty()) return tree_nearest(k);
-    int64_t tree_points = 0;
+    int64_t tree_points = 0;  // the window trees hold the same points as the pose trees
     for (const auto& block : blocks_) {
       tree_points += block->pose_tree ? block->pose_tree->points() : 0;
     }
@@ -431,12 +453,11 @@ std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t
   if (window_frames_ == 0) return Nearest(rows.row(frame), dims, k, epsilon, allowed_clips);
   Eigen::RowVectorXf window(3 * dims);
   WriteWindow(rows, frame, window_frames_, dims, window.data());
-  const bool tree_usable = dims == options_.ann_dims;
-  const Eigen::RowVectorXf turned =
-      tree_usable ? Eigen::RowVectorXf(window * WindowsOf(0).basis) : window;
   return FilteredNearest(
-      k, allowed_clips, tree_usable,
+      k, allowed_clips, dims == options_.ann_dims,
       [&](int wanted) {
+        // Only here, where the trees are asked, are they built.
+        const Eigen::RowVectorXf turned = window * WindowsOf(0).basis;
         return TreeNearest([&](int b) { return WindowsOf(b).tree.get(); }, turned.data(), 3 * dims,
                            wanted, epsilon);
       },
@@ -492,8 +513,8 @@ int64_t LibraryIndex::tree_bytes() const {
   int64_t bytes = 0;
   for (const auto& block : blocks_) {
     bytes += block->pose_tree ? block->pose_tree->bytes() : 0;
-    // Read unsynchronised only if built: the once_flag has no "done?" query, and a build under
-    // way must not be waited for here.
+    // The flag, not the once_flag, says whether the windows are built: a build under way must not
+    // be waited for here (its release store makes the windows visible to this acquire load).
     if (block->windows_ready.load(std::memory_order_acquire)) {
       bytes += block->windows.tree->bytes() +
                block->windows.rows.size() * static_cast<int64_t>(sizeof(float));

@@ -59,9 +59,9 @@ struct LibraryIndexOptions {
   bool coarse_tree = true;
   // Seconds between the three poses of a seed window: a tree frame's pose and the poses this far
   // before and after it (clamped to the clip), in a second kd-tree of 3 x ann_dims dimensions
-  // (NearestWindows). A window tells a take's own motion through a pose from other takes
-  // passing the same pose: see kDefaultSeedWindowS. 0: no window tree (NearestWindows scans
-  // the nearest frames instead), for 1.5 x ann_dims floats a tree frame less.
+  // (NearestWindows), built by the first call that needs it, for 3 x ann_dims floats a tree
+  // frame. A window tells a take's own motion through a pose from other takes passing the same
+  // pose: see kDefaultSeedWindowS. 0: no windows (NearestWindows gives the nearest frames).
   double seed_window_s = kDefaultSeedWindowS;
 };
 

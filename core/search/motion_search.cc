@@ -35,16 +35,12 @@ constexpr double kRefinePoolPerThousandSeeds = 12;
 // third gave 0.925 (3.4 ms), half 0.950 (4.1 ms), two thirds 0.960 (4.7 ms).
 double FineShare(int factor) { return factor <= 2 ? 1.0 : 2.0 / 3.0; }
 
-// The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
-// to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
-// Measured at 100 h of synthetic capture at 30 Hz with every candidate refined: 1000 seeds gave
-// recall@10 0.88, 2000 gave 0.95 (8.2 ms).
 // The default seeds are taken again, twice as many, at most this many times while they fall in
-// fewer than kPlacesPerResult clusters a result. Measured on 70 s at 120 Hz (one clip; 20
-// queries, bench/RESULTS.md, issue 11): 500 seed windows fell in 23 clusters and filled 16.1 of
-// 20 results, 1000 in 40 clusters and 19.9.
+// fewer than kClustersPerResult clusters a result, and while a doubling adds clusters. Measured
+// on 70 s at 120 Hz (one clip; 20 queries, bench/RESULTS.md, issue 11): 500 seed windows fell in
+// 23 clusters and filled 16.1 of 20 results, 1000 in 40 clusters and 19.9.
 constexpr int kMostSeedDoublings = 3;
-constexpr size_t kPlacesPerResult = 2;
+constexpr size_t kClustersPerResult = 2;
 
 // Seed windows (SeedSelection::kNearestWindows) spread over more places than nearest frames do,
 // so fewer of them cover as much: on 10 h of real capture (bench/RESULTS.md, issue 11, 20
@@ -52,6 +48,10 @@ constexpr size_t kPlacesPerResult = 2;
 // (3.8, 5.5 and 8.7 ms), where 1000 nearest frames give 0.940 (6.5 ms).
 constexpr int kWindowSeeds = 500;
 
+// The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
+// to 10 hours of 15 Hz seed frames in the kd-tree, then 1000 more per tenfold (100 h: 2000).
+// Measured at 100 h of synthetic capture at 30 Hz with every candidate refined: 1000 seeds gave
+// recall@10 0.88, 2000 gave 0.95 (8.2 ms). Windows: kWindowSeeds.
 int NearestFrameSeeds(const LibraryIndex& library, const SearchParams& params) {
   if (params.neighbours > 0) return params.neighbours;
   if (params.seed_selection == SeedSelection::kNearestWindows) return kWindowSeeds;
@@ -223,10 +223,11 @@ int CoarseRow(int frame, int factor, int64_t coarse_rows) {
       std::min<int64_t>(std::lround(frame / static_cast<double>(factor)), coarse_rows - 1));
 }
 
-// The seeds the warps are anchored at, clustered in time: the nearest frames to the
-// characteristic pose `anchor` (or distinct places), half of them at a second anchor when they
-// scatter (SearchParams::second_anchor_scatter). `coarse_rows`, `factor`: the warps' query.
-// Fills the seed and cluster stages' stats.
+// The seeds the warps are anchored at, clustered in time: the nearest frames (or windows) to the
+// characteristic pose `anchor` (or distinct places), the default count taken again while they
+// fall in too few places (kMostSeedDoublings), half of them at a second anchor when they scatter
+// (SearchParams::second_anchor_scatter). `coarse_rows`, `factor`: the warps' query. Fills the
+// seed and cluster stages' stats.
 std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView query, int anchor,
                                  int64_t coarse_rows, int factor, const std::vector<bool>& allowed,
                                  const SearchParams& params, SearchStats& stats) {
@@ -264,24 +265,28 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
   stage = Clock::now();
   // Distinct places are their own clusters.
   std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation);
-  double reseed_ms = 0;
-  // Seeds by the library's default count that pile into too few places to fill max_results (a
-  // short library, a pose held long) are taken again, twice as many, while the library has
-  // more.
-  for (int more = 0; !distinct && params.neighbours == 0 && more < kMostSeedDoublings &&
-                     order.size() < kPlacesPerResult * static_cast<size_t>(params.max_results) &&
-                     nearest.size() == static_cast<size_t>(seed_count);
-       ++more) {
-    seed_count *= 2;
-    const Clock::time_point again = Clock::now();
-    nearest = seeds_of(anchor, seed_count);
-    reseed_ms += MillisecondsSince(again);
-    order = ClusterSeeds(nearest, gap, separation);
-  }
-  stats.seeds = static_cast<int64_t>(nearest.size());
   const bool scattered = !distinct && params.second_anchor_scatter > 0 && nearest.size() >= 2 &&
                          static_cast<double>(order.size()) >
                              params.second_anchor_scatter * static_cast<double>(nearest.size());
+  double reseed_ms = 0;
+  // Seeds by the library's default count that pile into too few places to fill max_results (a
+  // short library, a pose held long) are taken again, twice as many, while the library has
+  // more and they reach more places. (Scattered seeds are in many places already.)
+  const size_t wanted_clusters = kClustersPerResult * static_cast<size_t>(params.max_results);
+  for (int more = 0;
+       !distinct && !scattered && params.neighbours == 0 && more < kMostSeedDoublings &&
+       order.size() < wanted_clusters && nearest.size() == static_cast<size_t>(seed_count);
+       ++more) {
+    seed_count *= 2;
+    const Clock::time_point again = Clock::now();
+    std::vector<Seed> more_seeds = seeds_of(anchor, seed_count);
+    reseed_ms += MillisecondsSince(again);
+    std::vector<Seed> more_order = ClusterSeeds(more_seeds, gap, separation);
+    if (more_order.size() <= order.size()) break;  // no new places: the seeds piled up anyway
+    nearest = std::move(more_seeds);
+    order = std::move(more_order);
+  }
+  stats.seeds = static_cast<int64_t>(nearest.size());
   int second = scattered ? FindSecondAnchor(query, anchor, params.ann_dims) : -1;
   // The warps pass their anchor's row at the coarse rate, where the two must differ.
   if (second >= 0 &&

@@ -81,12 +81,12 @@ struct SearchParams {
   // held pose longer than the query's is absorbed there, where one slope-limited warp cannot
   // absorb it).
   double max_point_gap_s = 10.0;
-  // Nearest frames, one characteristic point: when its seeds fall in more clusters than this
-  // share of them (a pose common to many takes, so that its seeds scatter over them), half of
-  // the seeds go to a second anchor, the query frame farthest from the characteristic pose at
-  // least a quarter of the query away (and a row of its own at the warps' coarse rate), each
-  // warp passing through its own seed's anchor. On 10 h of real capture (794 clusters from 1000
-  // seeds) recall@10 against the exact search rose from 0.85 to 0.94 (20 queries) for about
+  // Nearest frames or windows, one characteristic point: when its seeds fall in more clusters
+  // than this share of them (a pose common to many takes, so that its seeds scatter over them),
+  // half of the seeds go to a second anchor, the query frame farthest from the characteristic
+  // pose at least a quarter of the query away (and a row of its own at the warps' coarse rate),
+  // each warp passing through its own seed's anchor. On 10 h of real capture (794 clusters from
+  // 1000 seeds) recall@10 against the exact search rose from 0.85 to 0.94 (20 queries) for about
   // 0.6 ms more at the median; synthetic capture (at most 175 clusters) does not reach it, and
   // Bandai's figures are unchanged (bench/RESULTS.md, issue 11). 0: one anchor always.
   double second_anchor_scatter = 0.5;

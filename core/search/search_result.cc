@@ -16,6 +16,11 @@ bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap) 
   return overlap > max_overlap * static_cast<double>(a.last_frame - a.first_frame + 1);
 }
 
+bool RanksBefore(const SearchResult& a, const SearchResult& b) {
+  return std::tie(a.score, a.clip_index, a.last_frame, a.first_frame) <
+         std::tie(b.score, b.clip_index, b.last_frame, b.first_frame);
+}
+
 namespace {
 
 // The indices of the candidates RankResults keeps, in its order.
@@ -23,14 +28,8 @@ std::vector<size_t> RankedOrder(const std::vector<SearchResult>& candidates, dou
                                 int max_results) {
   std::vector<size_t> order(candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  // Equal scores go by end frame, the order in which a clip's scan (ExactSearch) offers its
-  // warps to StreamingTopResults, which keeps the first of equal overlapping ones: ranked
-  // otherwise, a result the scan kept could be dropped here, leaving fewer than max_results.
-  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) {
-    const SearchResult &a = candidates[i], &b = candidates[j];
-    return std::tie(a.score, a.clip_index, a.last_frame, a.first_frame) <
-           std::tie(b.score, b.clip_index, b.last_frame, b.first_frame);
-  });
+  std::sort(order.begin(), order.end(),
+            [&](size_t i, size_t j) { return RanksBefore(candidates[i], candidates[j]); });
   std::vector<size_t> kept;
   for (size_t i : order) {
     if (static_cast<int>(kept.size()) == max_results) break;
@@ -58,20 +57,22 @@ int RankedCount(const std::vector<SearchResult>& candidates, double max_overlap,
 }
 
 void StreamingTopResults::Offer(SearchResult candidate) {
-  if (kept_count_ == k_ && candidate.score >= worst_score()) return;
+  if (kept_count_ == k_ && candidate.score > worst_score()) return;
   if (static_cast<int>(by_clip_.size()) <= candidate.clip_index) {
     by_clip_.resize(candidate.clip_index + 1);
   }
   std::vector<Kept>& group = by_clip_[candidate.clip_index];
   // A group that has never held a result has never allocated.
   if (group.capacity() == 0) held_.push_back(candidate.clip_index);
+  // Kept and dropped as RankResults would rank them, so that it keeps every kept one.
   for (const Kept& kept : group) {
-    if (kept.result.score <= candidate.score && Overlaps(candidate, kept.result, max_overlap_)) {
+    // (An equal one, which ranks neither before nor after, suppresses it too, as it would there.)
+    if (!RanksBefore(candidate, kept.result) && Overlaps(candidate, kept.result, max_overlap_)) {
       return;
     }
   }
   kept_count_ -= static_cast<int>(std::erase_if(group, [&](const Kept& kept) {
-    return kept.result.score > candidate.score && Overlaps(kept.result, candidate, max_overlap_);
+    return RanksBefore(candidate, kept.result) && Overlaps(kept.result, candidate, max_overlap_);
   }));
   group.push_back({std::move(candidate), offers_++});
   ++kept_count_;
@@ -112,8 +113,7 @@ std::pair<int, size_t> StreamingTopResults::FindWorst() const {
   for (const int c : held_) {
     for (size_t i = 0; i < by_clip_[c].size(); ++i) {
       const Kept& kept = by_clip_[c][i];
-      if (worst_kept == nullptr || kept.result.score > worst_kept->result.score ||
-          (kept.result.score == worst_kept->result.score && kept.offered < worst_kept->offered)) {
+      if (worst_kept == nullptr || RanksBefore(worst_kept->result, kept.result)) {
         worst_kept = &kept;
         worst = {c, i};
       }

@@ -58,8 +58,13 @@ struct SearchResponse {
 // True when `a` overlaps `b` (same clip) by more than `max_overlap` of a's length.
 bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap);
 
-// Sorts by score (then clip and frame, for determinism), drops every result that overlaps a
-// better kept one by more than `max_overlap` of its length, and keeps at most `max_results`.
+// The ranking order: by score, equal scores by clip, end frame and start frame (the order in
+// which a clip's scan, ExactSearch, meets its warps). StreamingTopResults and RankResults keep
+// the same results only because they break ties alike.
+bool RanksBefore(const SearchResult& a, const SearchResult& b);
+
+// Sorts by RanksBefore, drops every result that overlaps a better kept one by more than
+// `max_overlap` of its length, and keeps at most `max_results`.
 std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
                                       int max_results);
 // How many results RankResults would keep, the candidates left as they are.
@@ -85,9 +90,9 @@ class StreamingTopResults {
  private:
   struct Kept {
     SearchResult result;
-    int64_t offered = 0;  // the offer's number: Take's order, and ties of the worst score
+    int64_t offered = 0;  // the offer's number: Take's order
   };
-  // The kept result with the highest score (the first offered among equals).
+  // The kept result that ranks last (RanksBefore).
   std::pair<int, size_t> FindWorst() const;  // (clip index, position in its group)
   double worst_score() const;
 
