@@ -34,6 +34,20 @@ storage::LabelRecord Range(int64_t first, int64_t last, double value, double sco
 
 // Overlap is measured against the shorter range: a long weaker range holding a stronger short
 // one is dropped (against the long one's own length it shares only a fifth).
+// The job's parameters name its seed selection, each by its own name.
+TEST(ParametersJson, NamesTheSeedSelection) {
+  PropagationRequest request;
+  request.space = "body";
+  for (const auto& [selection, name] :
+       {std::pair{SeedSelection::kNearestFrames, "\"nearest_frames\""},
+        std::pair{SeedSelection::kDistinctPlaces, "\"distinct_places\""},
+        std::pair{SeedSelection::kNearestWindows, "\"nearest_windows\""}}) {
+    request.search.params.seed_selection = selection;
+    const std::string json = ParametersJson(request);
+    EXPECT_NE(json.find(absl::StrCat("\"seed_selection\":", name)), std::string::npos) << json;
+  }
+}
+
 TEST(KeepStrongest, DropsALongWeakerRangeAroundAStrongerShortOne) {
   const std::vector<storage::LabelRecord> kept =
       KeepStrongest({Range(0, 99, 0.5), Range(40, 59, 0.9)}, {});
