@@ -141,6 +141,7 @@ class LibraryIndex {
   // frame - window_frames(), frame and frame + window_frames(), each clamped to its own rows,
   // over their first `dims` coordinates), nearest first, with the window distance. Tree and
   // scan as Nearest() does, over the window tree; window_frames() 0: Nearest() at `frame`.
+  // `frame` must be one of `rows`' (0 <= frame < rows.rows), as the search's anchors are.
   std::vector<Neighbour> NearestWindows(CoordinateView rows, int64_t frame, int dims, int k,
                                         float epsilon,
                                         const std::vector<bool>& allowed_clips) const;
