@@ -27,6 +27,12 @@ using Clock = std::chrono::steady_clock;
 // pools of 2 and 4 per result gave 0.81 and 0.95; 10 h, 4 and 8 gave 0.92 and 0.95; 100 h,
 // 2000 seeds, 16 and 24 gave 0.87 and 0.95.
 constexpr double kRefinePoolPerThousandSeeds = 12;
+// Seed windows need half of it: their warps start nearer where refinement ends. Measured with
+// 500 windows (bench/RESULTS.md, issue 11, 2026-12-05; recall@10, p50), 12 / 6 / 4 per
+// thousand: 10 h of real capture 0.945 / 0.945 / 0.945 (5.0 / 4.3 / 4.1 ms), 10 h at 30 Hz
+// 0.985 / 0.980 / 0.960 (3.8 / 2.9 / 2.8 ms), 10 h at 120 Hz 0.970 / 0.965 / 0.935 (6.5 / 4.7 /
+// 3.9 ms), 1 h 1.000 / 1.000 / 0.990, 70 s at 120 Hz 0.995 each.
+constexpr double kWindowRefinePoolPerThousandSeeds = 6;
 // The best this share of the refined pool are settled at the full rate from the coarse rate:
 // coarse scores order nearly equal matches less surely the denser the library, and a settle
 // costs factor^2 times a coarse one. Measured over 20 queries each (bench/RESULTS.md, issue 11,
@@ -45,7 +51,8 @@ constexpr size_t kClustersPerResult = 2;
 // Seed windows (SeedSelection::kNearestWindows) spread over more places than nearest frames do,
 // so fewer of them cover as much: on 10 h of real capture (bench/RESULTS.md, issue 11, 20
 // queries; recall@10 against the exact search) 250, 500 and 1000 gave 0.875, 0.945 and 0.975
-// (3.8, 5.5 and 8.7 ms), where 1000 nearest frames give 0.940 (6.5 ms).
+// (3.8, 5.5 and 8.7 ms with the nearest frames' refinement pool), where 1000 nearest frames
+// give 0.940 (6.5 ms).
 constexpr int kWindowSeeds = 500;
 
 // The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
@@ -353,7 +360,10 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   WarpWorkspace workspace;
   const int pool =
       params.refine
-          ? static_cast<int>(std::lround(params.max_results * kRefinePoolPerThousandSeeds *
+          ? static_cast<int>(std::lround(params.max_results *
+                                         (params.seed_selection == SeedSelection::kNearestWindows
+                                              ? kWindowRefinePoolPerThousandSeeds
+                                              : kRefinePoolPerThousandSeeds) *
                                          std::max(1.0, static_cast<double>(stats.seeds) / 1000.0)))
           : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
