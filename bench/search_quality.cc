@@ -34,7 +34,7 @@ struct QualityFlags {
   std::string metric = "unit";
   std::string weights = "mass";
   std::string neutral = "mean";
-  bool keep_heading = false, no_refine = false;
+  bool keep_heading = false, no_refine = false, windows = false;
   int places = 0;
   std::vector<std::string> weight_overrides;  // JOINT=W
   double root_velocity = SpaceOptions().root_velocity_weight;
@@ -97,6 +97,7 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
              {"mean", "boundary", "origin"})
       ->capture_default_str();
   app.add_flag("--no-refine", flags->no_refine, "the thesis's search as is");
+  app.add_flag("--windows", flags->windows, "seeds by window (the poses 0.25 s either side too)");
   app.add_option("--second-anchor", params.second_anchor_scatter,
                  "a second anchor when the seeds scatter over more clusters than this share of "
                  "them (0: never)")
@@ -147,6 +148,8 @@ absl::Status Run(QualityFlags& flags) {
   if (flags.places > 0) {
     params.seed_selection = SeedSelection::kDistinctPlaces;
     params.places = flags.places;
+  } else if (flags.windows) {
+    params.seed_selection = SeedSelection::kNearestWindows;
   }
 
   const bench::Clock::time_point start = bench::Clock::now();
@@ -165,7 +168,7 @@ absl::Status Run(QualityFlags& flags) {
       "metric %s, weights %s, root velocity %g, %s %d, ann_dims %d, dtw_dims %d, slope %d, "
       "neutral %s%s%s\n",
       metric.c_str(), std::string(WeightPresetName(space_options.weights.preset)).c_str(),
-      flags.root_velocity, flags.places > 0 ? "distinct places" : "neighbours",
+      flags.root_velocity, SeedSelectionName(params.seed_selection),
       flags.places > 0 ? flags.places : params.neighbours, params.ann_dims, params.dtw_dims,
       params.slope_limit, neutral.c_str(),
       space_options.pose.remove_heading ? "" : ", heading kept",
