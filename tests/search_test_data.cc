@@ -45,6 +45,17 @@ RowMatrixXf HeldPattern(int frames, int hold, int dims) {
   return held;
 }
 
+std::vector<LibraryClip> HeldPoseClips(int dims) {
+  const RowMatrixXf held = HeldPattern(240, 480, dims);
+  std::vector<LibraryClip> clips;
+  for (int c = 0; c < 8; ++c) {
+    RowMatrixXf curve = SmoothNoise(3000, dims, 7 + c);
+    if (c < 6) Plant(curve, held, 300 + 200 * c);
+    clips.push_back({c, "held", {}, std::move(curve)});
+  }
+  return clips;
+}
+
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at) {
   curve.middleRows(at, pattern.rows()) = pattern;
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/index/library_index.h"
 #include "core/motion/matrix.h"
 
 namespace motiondb::testing {
@@ -19,6 +20,10 @@ RowMatrixXf Pattern(int frames, int dims);
 
 // Pattern(frames, dims) with its middle pose held for `hold` more frames.
 RowMatrixXf HeldPattern(int frames, int hold, int dims);
+
+// Eight clips at 120 Hz of 3000 frames of smooth noise (ids 0-7), the first six holding
+// HeldPattern(240, 480, dims) (the query Pattern(240, dims) with its middle pose held 4 s).
+std::vector<LibraryClip> HeldPoseClips(int dims);
 
 // Writes `pattern` into `curve` starting at `at`.
 void Plant(RowMatrixXf& curve, const RowMatrixXf& pattern, int64_t at);

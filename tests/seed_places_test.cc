@@ -253,15 +253,8 @@ TEST(ExactSearchThreads, StopWhenTheCallerSays) {
 // kept is dropped at the end and the search returns fewer than max_results (18 of 20 here
 // when ties went by start frame).
 TEST(ExactSearch, FillsTheResultsAmongEqualWarps) {
-  const RowMatrixXf held = testing::HeldPattern(240, 480, kDims);
-  std::vector<LibraryClip> clips;
-  for (int c = 0; c < 8; ++c) {
-    RowMatrixXf curve = testing::SmoothNoise(3000, kDims, 7 + c);
-    if (c < 6) testing::Plant(curve, held, 300 + 200 * c);
-    clips.push_back({c, "held", {}, std::move(curve)});
-  }
   const std::unique_ptr<LibraryIndex> library =
-      *LibraryIndex::Build(std::move(clips), 120.0, {kTreeDims, 32, true});
+      *LibraryIndex::Build(testing::HeldPoseClips(kDims), 120.0, {kTreeDims, 32, true});
   SearchParams params;
   params.characteristic_frame = 120;
   const SearchResponse exact =

@@ -213,14 +213,7 @@ TEST(NearestWindows, ConcurrentFirstSearchesAgree) {
 TEST(DefaultSeeds, AreTakenAgainWhileTooFewPlacesToFillTheResults) {
   constexpr int kQueryFrames = 240;
   const RowMatrixXf pattern = testing::Pattern(kQueryFrames, kDims);
-  const RowMatrixXf held = testing::HeldPattern(kQueryFrames, 480, kDims);
-  std::vector<LibraryClip> clips;
-  for (int c = 0; c < 8; ++c) {
-    RowMatrixXf curve = testing::SmoothNoise(3000, kDims, 7 + c);
-    if (c < 6) testing::Plant(curve, held, 300 + 200 * c);
-    clips.push_back({c, "held", {}, std::move(curve)});
-  }
-  const auto library = LibraryIndex::Build(std::move(clips), 120.0, {});
+  const auto library = LibraryIndex::Build(testing::HeldPoseClips(kDims), 120.0, {});
   ASSERT_TRUE(library.ok()) << library.status();
   SearchParams params;
   params.seed_selection = SeedSelection::kNearestWindows;

@@ -145,16 +145,6 @@ void WriteWindow(CoordinateView rows, int64_t frame, int offset, int dims, float
   }
 }
 
-float WindowDistance(const float* window, CoordinateView rows, int64_t frame, int offset,
-                     int dims) {
-  float sum = 0.0f;
-  for (const int64_t at : {frame - offset, frame, frame + offset}) {
-    const float* pose = rows.row(std::clamp<int64_t>(at, 0, rows.rows - 1));
-    for (int k = 0; k < dims; ++k, ++window) sum += (*window - pose[k]) * (*window - pose[k]);
-  }
-  return std::sqrt(sum);
-}
-
 // Rows taken at once by PrincipalAxes and TurnRows: a copy of millions of rows would double the
 // build's memory for nothing.
 constexpr Eigen::Index kRowChunk = 4096;
@@ -453,6 +443,7 @@ std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t
   if (window_frames_ == 0) return Nearest(rows.row(frame), dims, k, epsilon, allowed_clips);
   Eigen::RowVectorXf window(3 * dims);
   WriteWindow(rows, frame, window_frames_, dims, window.data());
+  Eigen::RowVectorXf scanned(3 * dims);  // a scanned frame's window
   return FilteredNearest(
       k, allowed_clips, dims == options_.ann_dims,
       [&](int wanted) {
@@ -462,8 +453,8 @@ std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t
                            wanted, epsilon);
       },
       [&](int clip, int64_t clip_frame) {
-        return WindowDistance(window.data(), clip_coordinates(clip), clip_frame, window_frames_,
-                              dims);
+        WriteWindow(clip_coordinates(clip), clip_frame, window_frames_, dims, scanned.data());
+        return Distance(window.data(), scanned.data(), 3 * dims);
       });
 }
 

@@ -33,6 +33,11 @@ constexpr double kRefinePoolPerThousandSeeds = 12;
 // 0.985 / 0.980 / 0.960 (3.8 / 2.9 / 2.8 ms), 10 h at 120 Hz 0.970 / 0.965 / 0.935 (6.5 / 4.7 /
 // 3.9 ms), 1 h 1.000 / 1.000 / 0.990, 70 s at 120 Hz 0.995 each.
 constexpr double kWindowRefinePoolPerThousandSeeds = 6;
+
+double RefinePoolPerThousandSeeds(SeedSelection selection) {
+  return selection == SeedSelection::kNearestWindows ? kWindowRefinePoolPerThousandSeeds
+                                                     : kRefinePoolPerThousandSeeds;
+}
 // The best this share of the refined pool are settled at the full rate from the coarse rate:
 // coarse scores order nearly equal matches less surely the denser the library, and a settle
 // costs factor^2 times a coarse one. Measured over 20 queries each (bench/RESULTS.md, issue 11,
@@ -359,13 +364,10 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
   WarpWorkspace workspace;
   const int pool =
-      params.refine
-          ? static_cast<int>(std::lround(params.max_results *
-                                         (params.seed_selection == SeedSelection::kNearestWindows
-                                              ? kWindowRefinePoolPerThousandSeeds
-                                              : kRefinePoolPerThousandSeeds) *
-                                         std::max(1.0, static_cast<double>(stats.seeds) / 1000.0)))
-          : params.max_results;
+      params.refine ? static_cast<int>(std::lround(
+                          params.max_results * RefinePoolPerThousandSeeds(params.seed_selection) *
+                          std::max(1.0, static_cast<double>(stats.seeds) / 1000.0)))
+                    : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
     if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
