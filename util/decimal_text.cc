@@ -41,6 +41,13 @@ void WriteSixDigits(char* out, uint32_t v) {
 
 char* WriteDecimal12(char* out, double value) {
   const double a = std::fabs(value);
+  // Zero, a quarter of a BVH's numbers (the angles of joints that never turn): "0" or "-0".
+  if (a == 0) {
+    char* p = out;
+    if (std::signbit(value)) *p++ = '-';
+    *p++ = '0';
+    return p;
+  }
   // %g's fixed notation: the rounded value's decimal exponent x in -4..11.
   if (!(a >= 1e-4 && a < 1e12)) return WriteByToChars(out, value);
   // 2^e <= a < 2^(e + 1) puts x at floor(e log10 2) (1233 / 4096 = 0.30103) or one more.
