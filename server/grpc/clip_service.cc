@@ -1,6 +1,7 @@
 #include "server/grpc/clip_service.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "server/clip_export.h"
@@ -143,10 +144,10 @@ grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
                                          const v1::ExportClipRequest* request,
                                          v1::ExportClipResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<ExportedBvh> exported =
+    absl::StatusOr<ExportedBvh> exported =
         server::ExportClip(database_, FromProto(request->clip()));
     if (!exported.ok()) return ToGrpcStatus(exported.status());
-    ToProto(*exported, response);
+    ToProto(*std::move(exported), response);
     return grpc::Status::OK;
   });
 }

@@ -1,5 +1,7 @@
 #include "server/grpc/edit_service.h"
 
+#include <utility>
+
 #include "server/edit_blends.h"
 #include "server/edit_curves.h"
 #include "server/edit_reconstruct.h"
@@ -17,9 +19,9 @@ grpc::Status EditServiceImpl::Serve(grpc::ServerContext* context, const Request&
   return gate_.Run(context, [&]() -> grpc::Status {
     const auto converted = FromProto(request);
     if (!converted.ok()) return ToGrpcStatus(converted.status());
-    const auto outcome = operation(context_, *converted, StopWhenCallEnds(context));
+    auto outcome = operation(context_, *converted, StopWhenCallEnds(context));
     if (!outcome.ok()) return ToGrpcStatus(ExplainStop(outcome.status(), context));
-    ToProto(*outcome, response);
+    ToProto(*std::move(outcome), response);
     return grpc::Status::OK;
   });
 }

