@@ -1,8 +1,11 @@
 #include "core/motion/rotation.h"
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -103,6 +106,56 @@ TEST_P(EulerOrderTest, ConsecutiveFramesStayContinuousPastHalfATurn) {
 
 INSTANTIATE_TEST_SUITE_P(AllOrders, EulerOrderTest, ::testing::ValuesIn(kAllEulerOrders),
                          [](const auto& info) { return std::string(EulerOrderName(info.param)); });
+
+// NearestEulerTriple's shortcut for nearby angles against the plain rule (both triples, each
+// angle unwrapped by std::round, the nearer kept, the first on a tie): the same bits, signed
+// zeros included, near and far, on and off the shortcut.
+TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
+  const auto plain = [](const Eigen::Vector3d& e, const Eigen::Vector3d& near) {
+    const double pi = std::numbers::pi;
+    Eigen::Vector3d best;
+    double best_distance = INFINITY;
+    for (const Eigen::Vector3d& candidate : {e, Eigen::Vector3d(e[0] + pi, pi - e[1], e[2] + pi)}) {
+      Eigen::Vector3d unwrapped;
+      for (int a = 0; a < 3; ++a) {
+        unwrapped[a] = candidate[a] + 2 * pi * std::round((near[a] - candidate[a]) / (2 * pi));
+      }
+      const double distance = (unwrapped - near).squaredNorm();
+      if (distance < best_distance) {
+        best_distance = distance;
+        best = unwrapped;
+      }
+    }
+    return best;
+  };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  std::normal_distribution<double> step;
+  std::uniform_int_distribution<int> turns(-3, 3);
+  for (int n = 0; n < 200000; ++n) {
+    const Eigen::Vector3d e(angle(rng), angle(rng) / 2, angle(rng));
+    // Near e (a frame's step, a turn or two away), or anywhere.
+    const double scale = std::vector<double>{1e-3, 0.3, 1.5, 3.0}[n % 4];
+    Eigen::Vector3d near = e + scale * Eigen::Vector3d(step(rng), step(rng), step(rng));
+    if (n % 5 == 0) near += 2 * std::numbers::pi * Eigen::Vector3d(turns(rng), 0, turns(rng));
+    if (n % 7 == 0) near = Eigen::Vector3d(angle(rng), angle(rng), angle(rng));
+    const Eigen::Vector3d got = NearestEulerTriple(e, near), want = plain(e, near);
+    for (int a = 0; a < 3; ++a) {
+      ASSERT_EQ(std::bit_cast<uint64_t>(got[a]), std::bit_cast<uint64_t>(want[a]))
+          << "e " << e.transpose() << " near " << near.transpose();
+    }
+  }
+  // Zeros keep UnwrapNear's sign: -0 near +0 gives +0, -0 near -0 gives -0.
+  for (const double zero : {0.0, -0.0}) {
+    for (const double other : {0.0, -0.0}) {
+      const Eigen::Vector3d got = NearestEulerTriple(Eigen::Vector3d::Constant(zero),
+                                                     Eigen::Vector3d::Constant(other)),
+                            want = plain(Eigen::Vector3d::Constant(zero),
+                                         Eigen::Vector3d::Constant(other));
+      EXPECT_EQ(std::signbit(got[1]), std::signbit(want[1])) << zero << " near " << other;
+    }
+  }
+}
 
 TEST(EulerOrder, NamesAndAxesAgree) {
   for (EulerOrder order : kAllEulerOrders) {

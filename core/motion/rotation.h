@@ -41,9 +41,15 @@ Quat EulerToQuaternion(const Eigen::Vector3d& angles, EulerOrder order);
 
 // The Euler angles of q in `order`. Of the equivalent triples (a, b, c) and
 // (a + pi, pi - b, c + pi), each angle unwrapped by multiples of 2 pi, returns the one closest to
-// `near`, which keeps consecutive frames continuous when exporting a clip.
+// `near`, which keeps consecutive frames continuous when exporting a clip. The same as
+// NearestEulerTriple(EulerAngles(q, order), near).
 Eigen::Vector3d QuaternionToEuler(const Quat& q, EulerOrder order,
                                   const Eigen::Vector3d& near = Eigen::Vector3d::Zero());
+// The two halves of QuaternionToEuler, so that a clip's frames can be decomposed in parallel and
+// made continuous after: the Euler angles of q in `order`, each in [-pi, pi] ...
+Eigen::Vector3d EulerAngles(const Quat& q, EulerOrder order);
+// ... and of the triples equivalent to `angles`, the one closest to `near`.
+Eigen::Vector3d NearestEulerTriple(const Eigen::Vector3d& angles, const Eigen::Vector3d& near);
 
 // Spherical linear interpolation along the shorter arc (q and -q are the same rotation).
 Quat Slerp(const Quat& a, const Quat& b, double t);
