@@ -75,7 +75,8 @@ void BM_WriteBvh(benchmark::State& state) {
   const Clip& clip = *TheFixture().clip;
   int64_t bytes = 0;
   for (auto _ : state) {
-    absl::StatusOr<std::string> text = WriteBvh(clip, FrameRange{0, kRangeFrames - 1});
+    absl::StatusOr<std::string> text =
+        WriteBvh(clip, FrameRange{0, kRangeFrames - 1}, static_cast<int>(state.range(0)));
     if (!text.ok()) return Fail(state, text.status());
     bytes = static_cast<int64_t>(text->size());
     benchmark::DoNotOptimize(text->data());
@@ -158,7 +159,7 @@ void BM_ExportClipResponseCopies(benchmark::State& state) {
 }
 
 BENCHMARK(BM_GetClip)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WriteBvh)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WriteBvh)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FormatNumbers)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EulerDecomposition)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExportClip)->Unit(benchmark::kMillisecond);

@@ -14,7 +14,7 @@ absl::StatusOr<ExportedBvh> ExportClip(storage::Database& database,
                             ReadSelectedFrames(database, selection, "clip"));
   ExportedBvh exported;
   exported.frames = selected.frames;
-  MOTIONDB_ASSIGN_OR_RETURN(exported.bvh, WriteBvh(selected.clip));
+  MOTIONDB_ASSIGN_OR_RETURN(exported.bvh, WriteBvh(selected.clip, std::nullopt, kBvhAnswerThreads));
   const bool whole =
       exported.frames.first == 0 && exported.frames.last == selected.record.frame_count - 1;
   // A clip name's '/' separates folders ("session1/take_001"); the suggestion stays one file

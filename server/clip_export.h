@@ -11,6 +11,11 @@
 
 namespace motiondb::server {
 
+// The threads that write one BVH answer, an export's or an edit's (WriteBvh, Resample): every
+// core, so that one caller's 10 s at 120 fps (1200 frames) is not bound to one; calls under way
+// at once share the cores.
+inline constexpr int kBvhAnswerThreads = 0;
+
 struct ExportedBvh {
   // Suggested: "<name>.bvh", or "<name>_<first>-<last>.bvh" for a range, with each '/' (or
   // backslash) in the name as '_': "session1/take_001" suggests "session1_take_001.bvh".

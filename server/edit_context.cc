@@ -7,6 +7,7 @@
 #include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_writer.h"
 #include "core/motion/resample.h"
+#include "server/clip_export.h"
 #include "server/selected_frames.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
@@ -57,9 +58,9 @@ absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSp
       const Clip at_space_rate,
       ToClip(space, like.skeleton, PlaceRotations(space, motion.rotations, motion.placement),
              motion.placement));
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip, Resample(at_space_rate, like.fps));
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip, Resample(at_space_rate, like.fps, kBvhAnswerThreads));
   EditResult result;
-  MOTIONDB_ASSIGN_OR_RETURN(result.bvh, WriteBvh(clip));
+  MOTIONDB_ASSIGN_OR_RETURN(result.bvh, WriteBvh(clip, std::nullopt, kBvhAnswerThreads));
   result.frames = clip.frame_count();
   result.fps = clip.fps();
   const std::string stem = output.store_name.empty() ? like.clip_name : output.store_name;

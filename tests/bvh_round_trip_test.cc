@@ -1,7 +1,11 @@
 // read(write(x)) reproduces every joint rotation within 1e-6 rad and position within 1e-6
 // relative, with the original hierarchy and channel orders.
+#include <cmath>
 #include <numbers>
 #include <random>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -84,6 +88,54 @@ TEST(BvhRoundTrip, FrameRange) {
   ExpectRoundTrip(clip, FrameRange{49, 49});
   EXPECT_EQ(WriteBvh(clip, FrameRange{40, 50}).status().code(), absl::StatusCode::kOutOfRange);
   EXPECT_EQ(WriteBvh(clip, FrameRange{5, 4}).status().code(), absl::StatusCode::kOutOfRange);
+}
+
+// Frames decomposed on several threads and made continuous after (core/bvh/bvh_writer.cc): the
+// angles written are the chain of QuaternionToEuler from frame to frame, whatever the thread
+// count, across pieces and across the writer's blocks of 4096 frames.
+TEST(BvhRoundTrip, ThreadsWriteTheSameContinuousAngles) {
+  const auto skeleton = testing::ChainSkeleton();
+  constexpr int kFrames = 9000;
+  // Winding rotations: the continuous angles reach 90 rad, so a piece or block that started from
+  // the wrong previous angles would write them 2 pi (or the other triple) away.
+  const Clip clip = testing::MakeClip(
+      skeleton, kFrames, 1.0 / 120,
+      [&](int f, int j) {
+        return EulerToQuaternion(
+            Eigen::Vector3d(0.01 * f * (j + 1), 1.2 * std::sin(0.003 * f), -0.007 * f),
+            skeleton->rotation_order(j));
+      },
+      [](int f, int) { return Eigen::Vector3d(f, 0, -f); });
+  for (const FrameRange range : {FrameRange{0, kFrames - 1}, FrameRange{1000, 8999}}) {
+    const absl::StatusOr<std::string> one = WriteBvh(clip, range, 1);
+    ASSERT_TRUE(one.ok()) << one.status();
+    for (const int threads : {2, 3, 7}) {
+      const absl::StatusOr<std::string> several = WriteBvh(clip, range, threads);
+      ASSERT_TRUE(several.ok()) << several.status();
+      EXPECT_TRUE(*several == *one) << threads << " threads";
+    }
+    // The rows' rotation channels against the chain, joint by joint (the chain's joints are
+    // written in index order).
+    std::istringstream text(one->substr(one->find("Frame Time:")));
+    std::string line;
+    std::getline(text, line);
+    std::vector<Eigen::Vector3d> near(skeleton->joint_count(), Eigen::Vector3d::Zero());
+    for (int f = range.first; f <= range.last; ++f) {
+      ASSERT_TRUE(std::getline(text, line)) << f;
+      std::istringstream row(line);
+      for (int j = 0; j < skeleton->joint_count(); ++j) {
+        near[j] = QuaternionToEuler(clip.rotation(f, j), skeleton->rotation_order(j), near[j]);
+        int rotation = 0;
+        for (const Channel c : skeleton->joint(j).channels) {
+          double value = 0;
+          ASSERT_TRUE(row >> value);
+          if (c < Channel::kXrotation) continue;
+          ASSERT_NEAR(value, near[j][rotation++] * 180 / std::numbers::pi, 1e-7)
+              << "frame " << f << " joint " << j;
+        }
+      }
+    }
+  }
 }
 
 TEST(BvhRoundTrip, WriteBvhFileIsReadBack) {

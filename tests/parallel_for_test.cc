@@ -80,5 +80,35 @@ TEST(ThreadsFor, ZeroIsOnePerCore) {
   EXPECT_EQ(ThreadsFor(0), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 }
 
+TEST(PieceCount, OneAThreadButNoneSmallerThanAsked) {
+  EXPECT_EQ(PieceCount(1200, 128, 2), 2);
+  EXPECT_EQ(PieceCount(1200, 128, 64), 10);  // ceil(1200 / 128)
+  EXPECT_EQ(PieceCount(100, 128, 4), 1);
+  EXPECT_EQ(PieceCount(0, 128, 4), 1);
+  EXPECT_EQ(PieceCount(1000, 1, 0), ThreadsFor(0));
+}
+
+TEST(ForEachPiece, CoversTheRangeInOrderOnePieceAThread) {
+  for (const int pieces : {1, 3, 7}) {
+    std::vector<std::pair<int64_t, int64_t>> ranges(pieces);
+    std::vector<std::thread::id> threads(pieces);
+    ForEachPiece(100, pieces, [&](int piece, int64_t begin, int64_t end) {
+      ranges[piece] = {begin, end};
+      threads[piece] = std::this_thread::get_id();
+    });
+    EXPECT_EQ(ranges.front().first, 0);
+    EXPECT_EQ(ranges.back().second, 100);
+    for (int i = 0; i < pieces; ++i) {
+      EXPECT_GE(ranges[i].second - ranges[i].first, 100 / pieces) << i;
+      if (i > 0) {
+        EXPECT_EQ(ranges[i].first, ranges[i - 1].second) << i;
+      }
+    }
+    EXPECT_EQ(threads[0], std::this_thread::get_id());
+    EXPECT_EQ(std::set<std::thread::id>(threads.begin(), threads.end()).size(),
+              static_cast<size_t>(pieces));
+  }
+}
+
 }  // namespace
 }  // namespace motiondb

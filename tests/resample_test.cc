@@ -99,6 +99,24 @@ TEST(Resample, SingleFrameStaysOneFrame) {
   EXPECT_EQ(out->frame_count(), 1);
 }
 
+TEST(Resample, ThreadsMakeTheSameFrames) {
+  const Clip clip = testing::MakeClip(
+      ChainSkeleton(), 700, 1.0 / 30,
+      [](int f, int j) {
+        return Quat(Eigen::AngleAxisd(0.05 * f * (j + 1), Eigen::Vector3d(1, 2, 0).normalized()));
+      },
+      [](int f, int) { return Eigen::Vector3d(std::sin(0.1 * f), f, 0); });
+  const absl::StatusOr<Clip> one = Resample(clip, 119.0, 1);
+  ASSERT_TRUE(one.ok()) << one.status();
+  ASSERT_GT(one->frame_count(), 2000);  // several pieces of 256 frames
+  for (const int threads : {2, 3, 8}) {
+    const absl::StatusOr<Clip> several = Resample(clip, 119.0, threads);
+    ASSERT_TRUE(several.ok()) << several.status();
+    EXPECT_EQ(several->rotations(), one->rotations()) << threads << " threads";
+    EXPECT_EQ(several->positions(), one->positions()) << threads << " threads";
+  }
+}
+
 TEST(Resample, RejectsBadRates) {
   const Clip clip = UniformMotion(30.0, 5);
   for (double rate : std::vector<double>{0.0, -30.0, NAN, INFINITY, 1e9}) {

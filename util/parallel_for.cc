@@ -42,4 +42,20 @@ absl::Status ParallelFor(int64_t count, int threads,
   return failure;
 }
 
+int PieceCount(int64_t count, int64_t min_piece, int threads) {
+  const int64_t piece = std::max<int64_t>(min_piece, 1);
+  return static_cast<int>(std::clamp<int64_t>((count + piece - 1) / piece, 1, ThreadsFor(threads)));
+}
+
+void ForEachPiece(int64_t count, int pieces,
+                  const std::function<void(int piece, int64_t begin, int64_t end)>& body) {
+  const auto run = [&](int piece) {
+    body(piece, count * piece / pieces, count * (piece + 1) / pieces);
+  };
+  std::vector<std::jthread> helpers;
+  helpers.reserve(pieces - 1);
+  for (int piece = 1; piece < pieces; ++piece) helpers.emplace_back(run, piece);
+  run(0);
+}
+
 }  // namespace motiondb

@@ -23,6 +23,16 @@ int ThreadsFor(int requested);
 absl::Status ParallelFor(int64_t count, int threads,
                          const std::function<absl::Status(int64_t index, int thread)>& body);
 
+// Work cut into a few large contiguous pieces, one a thread, for loops that cannot fail.
+// How many pieces to cut `count` items into for `threads` (0: one a core): one a thread, but
+// none smaller than `min_piece` items (a thread costs tens of microseconds to start); at least 1.
+int PieceCount(int64_t count, int64_t min_piece, int threads);
+// Calls body(piece, begin, end) for each of the `pieces` nearly equal ranges, in order, that
+// cover [0, count), each on its own thread (the caller's is piece 0's). The same count and
+// pieces always give the same ranges.
+void ForEachPiece(int64_t count, int pieces,
+                  const std::function<void(int piece, int64_t begin, int64_t end)>& body);
+
 }  // namespace motiondb
 
 #endif  // MOTIONDB_UTIL_PARALLEL_FOR_H_

@@ -13,8 +13,12 @@
 namespace motiondb {
 
 // The BVH text of `range` (default: the whole clip). Fails if the range is outside the clip.
+// `threads` decompose the rotations and write the numbers (0: one a core; a thread for every
+// 128 frames at most); the text is the same for any count. 10 s at 120 fps of 31 joints take
+// about 5 ms on one thread.
 absl::StatusOr<std::string> WriteBvh(const Clip& clip,
-                                     std::optional<FrameRange> range = std::nullopt);
+                                     std::optional<FrameRange> range = std::nullopt,
+                                     int threads = 1);
 
 // Writes to `path` atomically (a temporary file renamed into place).
 absl::Status WriteBvhFile(const std::string& path, const Clip& clip,

@@ -4,12 +4,17 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "util/parallel_for.h"
 
 namespace motiondb {
 namespace {
 
 // Output larger than this many frames is refused (a day at 1 kHz).
 constexpr double kMaxOutputFrames = 86'400'000;
+
+// A thread is started for at least this many output frames (about 0.4 ms of slerps at 31
+// joints).
+constexpr int kFramesPerThread = 256;
 
 // A sample within 1% of a frame past the end takes the last frame: files write the frame time
 // rounded (0.0333333 for 1/30 s), and the last frame should not be lost to that rounding.
@@ -23,7 +28,7 @@ int64_t ResampledFrameCount(int frame_count, double frame_time, double target_fp
   return static_cast<int64_t>(SampleCount(frame_count, frame_time, target_fps));
 }
 
-absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
+absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps, int threads) {
   if (!std::isfinite(target_fps) || target_fps <= 0.0 || target_fps > kMaxResampleRate) {
     return absl::InvalidArgumentError(absl::StrCat("target rate must be in (0, ", kMaxResampleRate,
                                                    "] frames per second, got ", target_fps));
@@ -36,23 +41,25 @@ absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps) {
   }
   const int count = static_cast<int>(samples);
   const int joints = clip.skeleton().joint_count();
-  const RowMatrixXd& rotations = clip.rotations();
   const RowMatrixXd& positions = clip.positions();
-  RowMatrixXd out_rotations(count, rotations.cols());
+  RowMatrixXd out_rotations(count, clip.rotations().cols());
   RowMatrixXd out_positions(count, positions.cols());
-  for (int k = 0; k < count; ++k) {
-    double u = std::min(k / target_fps / clip.frame_time(), n - 1.0);
-    if (std::abs(u - std::round(u)) < 1e-9) u = std::round(u);  // land exactly on source frames
-    const int i = std::min(static_cast<int>(u), n - 1);
-    const int next = std::min(i + 1, n - 1);
-    const double t = u - i;
-    for (int j = 0; j < joints; ++j) {
-      const Quat q =
-          t == 0.0 ? clip.rotation(i, j) : Slerp(clip.rotation(i, j), clip.rotation(next, j), t);
-      out_rotations.block<1, 4>(k, 4 * j) << q.w(), q.x(), q.y(), q.z();
+  const int pieces = PieceCount(count, kFramesPerThread, threads);
+  ForEachPiece(count, pieces, [&](int, int64_t begin, int64_t end) {
+    for (int k = static_cast<int>(begin); k < end; ++k) {
+      double u = std::min(k / target_fps / clip.frame_time(), n - 1.0);
+      if (std::abs(u - std::round(u)) < 1e-9) u = std::round(u);  // land exactly on source frames
+      const int i = std::min(static_cast<int>(u), n - 1);
+      const int next = std::min(i + 1, n - 1);
+      const double t = u - i;
+      for (int j = 0; j < joints; ++j) {
+        const Quat q =
+            t == 0.0 ? clip.rotation(i, j) : Slerp(clip.rotation(i, j), clip.rotation(next, j), t);
+        out_rotations.block<1, 4>(k, 4 * j) << q.w(), q.x(), q.y(), q.z();
+      }
+      out_positions.row(k) = (1.0 - t) * positions.row(i) + t * positions.row(next);
     }
-    out_positions.row(k) = (1.0 - t) * positions.row(i) + t * positions.row(next);
-  }
+  });
   return Clip::Create(clip.shared_skeleton(), 1.0 / target_fps, std::move(out_rotations),
                       std::move(out_positions));
 }

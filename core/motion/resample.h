@@ -15,8 +15,9 @@ inline constexpr double kMaxResampleRate = 10000.0;
 // Samples `clip` at t = k / target_fps for every k with t within the clip's span
 // [0, (frame_count - 1) * frame_time], allowing 1% of an output frame past the end (taken as
 // the last frame) so that rounded frame times such as 0.0333333 keep every frame. `target_fps` must
-// be finite and in (0, kMaxResampleRate].
-absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps);
+// be finite and in (0, kMaxResampleRate]. `threads` share the output frames (0: one a core; a
+// thread for every 256 frames at most); the result is the same for any count.
+absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps, int threads = 1);
 
 // The number of frames Resample() makes of `frame_count` frames `frame_time` apart (without its
 // limit on the output's size). `target_fps` must be in Resample's range.
