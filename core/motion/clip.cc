@@ -38,10 +38,14 @@ absl::StatusOr<Clip> Clip::Create(std::shared_ptr<const Skeleton> skeleton, doub
   if (!rotations.allFinite() || !positions.allFinite()) {
     return absl::InvalidArgumentError("clip contains NaN or infinite values");
   }
+  // |norm - 1| <= 1e-6 on the squared norm, without a square root per quaternion (a clip is
+  // made for every export and edit).
+  constexpr double kLowest = (1 - 1e-6) * (1 - 1e-6), kHighest = (1 + 1e-6) * (1 + 1e-6);
   for (Eigen::Index f = 0; f < rotations.rows(); ++f) {
     for (int j = 0; j < joints; ++j) {
-      const double norm = rotations.block<1, 4>(f, 4 * j).norm();
-      if (std::abs(norm - 1.0) > 1e-6) {
+      const double squared = rotations.block<1, 4>(f, 4 * j).squaredNorm();
+      if (!(squared >= kLowest && squared <= kHighest)) {
+        const double norm = std::sqrt(squared);
         return absl::InvalidArgumentError(absl::StrCat("frame ", f, ", joint '",
                                                        skeleton->joint(j).name,
                                                        "': quaternion norm ", norm, " is not 1"));
