@@ -3,6 +3,9 @@
 // Hermite gap filling against linear. Not part of the test suite; numbers in bench/RESULTS.md.
 //
 // usage: ops_measurements detect|interpolate|smooth|gap [--folder DIR] [options]
+//        ops_measurements speed [--calls N] [--fps F] [--only TEXT]  (every operator through a
+//        server; --only "Scale" times one call alone, e.g. under a profiler; DetectPose needs
+//        CreatePoseModel's model, so keep them together: --only Pose)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +21,7 @@
 
 #include <functional>
 
+#include "absl/strings/match.h"
 #include "bench/measure.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
@@ -282,7 +286,7 @@ std::unique_ptr<grpc::ClientContext> Context() {
 
 // Every operator on a 10 s range of `file` through a real server, beside ExportClip and GetCurve
 // of the same range.
-absl::Status Speed(const std::string& file, int calls, double fps) {
+absl::Status Speed(const std::string& file, int calls, double fps, const std::string& only) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("ops_speed_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
@@ -432,6 +436,7 @@ absl::Status Speed(const std::string& file, int calls, double fps) {
                   }});
   std::printf("call | median ms | p95 ms\n");
   for (const auto& [name, call] : runs) {
+    if (!absl::StrContains(name, only)) continue;
     MOTIONDB_ASSIGN_OR_RETURN(const auto times, Time(calls, call));
     std::printf("%s | %.2f | %.2f\n", name.c_str(), times.first, times.second);
   }
@@ -479,6 +484,8 @@ int main(int argc, char** argv) {
   speed->add_option("--file", speed_file);
   speed->add_option("--calls", calls);
   speed->add_option("--fps", speed_fps, "resample the file to this rate first (0: as it is)");
+  std::string only;
+  speed->add_option("--only", only, "time only the calls whose name holds this text");
   app.require_subcommand(1);
   CLI11_PARSE(app, argc, argv);
   if (speed->parsed()) {
@@ -486,7 +493,7 @@ int main(int argc, char** argv) {
       std::printf("ops_measurements: %s is absent; nothing measured\n", speed_file.c_str());
       return 0;
     }
-    const absl::Status status = Speed(speed_file, calls, speed_fps);
+    const absl::Status status = Speed(speed_file, calls, speed_fps, only);
     if (!status.ok()) std::fprintf(stderr, "%s\n", std::string(status.message()).c_str());
     return status.ok() ? 0 : 1;
   }
