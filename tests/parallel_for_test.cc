@@ -82,10 +82,16 @@ TEST(ThreadsFor, ZeroIsOnePerCore) {
 
 TEST(PieceCount, OneAThreadButNoneSmallerThanAsked) {
   EXPECT_EQ(PieceCount(1200, 128, 2), 2);
-  EXPECT_EQ(PieceCount(1200, 128, 64), 10);  // ceil(1200 / 128)
+  EXPECT_EQ(PieceCount(1200, 128, 64), 9);  // 1200 / 128: no piece under 128
   EXPECT_EQ(PieceCount(100, 128, 4), 1);
   EXPECT_EQ(PieceCount(0, 128, 4), 1);
   EXPECT_EQ(PieceCount(1000, 1, 0), ThreadsFor(0));
+  for (int64_t count = 0; count < 3000; count += 37) {
+    const int pieces = PieceCount(count, 128, 64);
+    if (pieces > 1) {
+      EXPECT_GE(count / pieces, 128) << count;
+    }
+  }
 }
 
 TEST(ForEachPiece, CoversTheRangeInOrderOnePieceAThread) {

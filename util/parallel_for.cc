@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -36,7 +37,11 @@ absl::Status ParallelFor(int64_t count, int threads,
   {
     std::vector<std::jthread> helpers;
     helpers.reserve(used - 1);
-    for (int t = 1; t < used; ++t) helpers.emplace_back(run, t);
+    try {
+      for (int t = 1; t < used; ++t) helpers.emplace_back(run, t);
+    } catch (const std::system_error&) {
+      // Out of threads: the threads started and the caller hand out every index between them.
+    }
     run(0);
   }
   return failure;
@@ -44,7 +49,7 @@ absl::Status ParallelFor(int64_t count, int threads,
 
 int PieceCount(int64_t count, int64_t min_piece, int threads) {
   const int64_t piece = std::max<int64_t>(min_piece, 1);
-  return static_cast<int>(std::clamp<int64_t>((count + piece - 1) / piece, 1, ThreadsFor(threads)));
+  return static_cast<int>(std::clamp<int64_t>(count / piece, 1, ThreadsFor(threads)));
 }
 
 void ForEachPiece(int64_t count, int pieces,
@@ -54,8 +59,14 @@ void ForEachPiece(int64_t count, int pieces,
   };
   std::vector<std::jthread> helpers;
   helpers.reserve(pieces - 1);
-  for (int piece = 1; piece < pieces; ++piece) helpers.emplace_back(run, piece);
+  int started = 1;
+  try {
+    for (; started < pieces; ++started) helpers.emplace_back(run, started);
+  } catch (const std::system_error&) {
+    // Out of threads: the caller runs the pieces no thread took, after its own.
+  }
   run(0);
+  for (int piece = started; piece < pieces; ++piece) run(piece);
 }
 
 }  // namespace motiondb

@@ -25,11 +25,12 @@ absl::Status ParallelFor(int64_t count, int threads,
 
 // Work cut into a few large contiguous pieces, one a thread, for loops that cannot fail.
 // How many pieces to cut `count` items into for `threads` (0: one a core): one a thread, but
-// none smaller than `min_piece` items (a thread costs tens of microseconds to start); at least 1.
+// none smaller than `min_piece` items (a thread costs tens of microseconds to start), except
+// the single piece of fewer than `min_piece` items.
 int PieceCount(int64_t count, int64_t min_piece, int threads);
 // Calls body(piece, begin, end) for each of the `pieces` nearly equal ranges, in order, that
-// cover [0, count), each on its own thread (the caller's is piece 0's). The same count and
-// pieces always give the same ranges.
+// cover [0, count), each on its own thread (the caller's is piece 0's; when no thread can be
+// started, the caller's too). The same count and pieces always give the same ranges.
 void ForEachPiece(int64_t count, int pieces,
                   const std::function<void(int piece, int64_t begin, int64_t end)>& body);
 

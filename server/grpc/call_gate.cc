@@ -4,6 +4,7 @@
 #include <chrono>
 #include <string>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 
 namespace motiondb::server {
@@ -19,9 +20,8 @@ grpc::Status CallGate::Run(const grpc::ServerContext* context,
   if (max_running_ <= 0) return call();
   grpc::Status refusal;
   if (!Enter(context, &refusal)) return refusal;
-  const grpc::Status status = call();
-  Leave();
-  return status;
+  const absl::Cleanup leave = [this] { Leave(); };  // also when the call throws
+  return call();
 }
 
 bool CallGate::Enter(const grpc::ServerContext* context, grpc::Status* refusal) {
