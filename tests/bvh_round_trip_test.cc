@@ -134,7 +134,10 @@ TEST(BvhRoundTrip, ThreadsWriteTheSameContinuousAngles) {
               << "frame " << f << " joint " << j;
         }
       }
+      double extra = 0;
+      EXPECT_FALSE(row >> extra) << "a value past the last channel in frame " << f;
     }
+    EXPECT_FALSE(std::getline(text, line)) << "a row past the last frame: " << line;
   }
 }
 

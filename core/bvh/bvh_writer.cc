@@ -28,6 +28,18 @@ void AppendVector(std::string& out, const Eigen::Vector3d& v) {
   }
 }
 
+// The longest text of a row: each value and a separator, the line end.
+size_t RowRoom(int channels) {
+  return static_cast<size_t>(channels) * (kMaxDecimal12Chars + 1) + 1;
+}
+
+// Room for the text of `frames` rows: about 15 characters a value, sign and separator included
+// ("-32.9847707373 "), and the longest text of a row, in which a row is written before it is cut
+// to what it took.
+size_t RowsRoom(int64_t frames, int channels) {
+  return static_cast<size_t>(frames) * channels * 16 + RowRoom(channels);
+}
+
 class HierarchyWriter {
  public:
   HierarchyWriter(const Skeleton& skeleton, std::string& out) : skeleton_(skeleton), out_(out) {
@@ -110,18 +122,20 @@ class MotionWriter {
     ForEachPiece(block.size(), pieces,
                  [&](int, int64_t begin, int64_t end) { Decompose(frames(begin, end)); });
     MakeContinuous(block);
-    // The first piece goes straight into `out`, the others into texts of their own appended
-    // after.
+    // The first piece goes straight into `out` (which has room for every row), the others into
+    // texts of their own appended after.
     std::vector<std::string> texts(pieces);
     ForEachPiece(block.size(), pieces, [&](int piece, int64_t begin, int64_t end) {
-      std::string& text = piece == 0 ? out : texts[piece];
-      text.reserve(text.size() + (end - begin) * RowRoom());
-      WriteRows(frames(begin, end), text);
+      if (piece > 0) texts[piece].reserve(RowsRoom(end - begin, skeleton_.channel_count()));
+      WriteRows(frames(begin, end), piece == 0 ? out : texts[piece]);
     });
     for (int piece = 1; piece < pieces; ++piece) out += texts[piece];
   }
 
   Eigen::Vector3d& Angles(int frame, int joint) {
+    return angles_[static_cast<size_t>(frame - first_) * skeleton_.joint_count() + joint];
+  }
+  const Eigen::Vector3d& Angles(int frame, int joint) const {
     return angles_[static_cast<size_t>(frame - first_) * skeleton_.joint_count() + joint];
   }
 
@@ -142,14 +156,9 @@ class MotionWriter {
     }
   }
 
-  // The longest text of a row: each value and a separator, the line end.
-  size_t RowRoom() const {
-    return static_cast<size_t>(skeleton_.channel_count()) * (kMaxDecimal12Chars + 1) + 1;
-  }
-
   // A row is written in place: room for its longest text first, cut to what it took after.
-  void WriteRows(FrameRange frames, std::string& out) {
-    const size_t row_room = RowRoom();
+  void WriteRows(FrameRange frames, std::string& out) const {
+    const size_t row_room = RowRoom(skeleton_.channel_count());
     for (int f = frames.first; f <= frames.last; ++f) {
       const size_t row_start = out.size();
       out.resize(row_start + row_room);
@@ -196,8 +205,7 @@ absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange>
   const Skeleton& skeleton = clip.skeleton();
 
   std::string out;
-  // About 15 characters a value, sign and separator included: "-32.9847707373 ".
-  out.reserve(4096 + static_cast<size_t>(frames.size()) * skeleton.channel_count() * 16);
+  out.reserve(4096 + RowsRoom(frames.size(), skeleton.channel_count()));  // 4 KB: the hierarchy
   std::vector<int> order = HierarchyWriter(skeleton, out).Write();
   absl::StrAppend(&out, "MOTION\nFrames: ", frames.size(), "\nFrame Time: ");
   char buffer[32];

@@ -1,5 +1,6 @@
 #include "core/motion/resample.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/status/status.h"
