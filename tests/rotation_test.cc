@@ -145,14 +145,42 @@ TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
           << "e " << e.transpose() << " near " << near.transpose();
     }
   }
-  // Zeros keep UnwrapNear's sign: -0 near +0 gives +0, -0 near -0 gives -0.
-  for (const double zero : {0.0, -0.0}) {
-    for (const double other : {0.0, -0.0}) {
-      const Eigen::Vector3d got = NearestEulerTriple(Eigen::Vector3d::Constant(zero),
-                                                     Eigen::Vector3d::Constant(other)),
-                            want = plain(Eigen::Vector3d::Constant(zero),
-                                         Eigen::Vector3d::Constant(other));
-      EXPECT_EQ(std::signbit(got[1]), std::signbit(want[1])) << zero << " near " << other;
+  const auto expect_plain = [&](const Eigen::Vector3d& e, const Eigen::Vector3d& near) {
+    const Eigen::Vector3d got = NearestEulerTriple(e, near), want = plain(e, near);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(std::bit_cast<uint64_t>(got[a]), std::bit_cast<uint64_t>(want[a]))
+          << "angle " << a << " of " << e.transpose() << " near " << near.transpose();
+    }
+  };
+  // Signed zeros and tiny values, each angle on its own: UnwrapNear adds a zero of the sign of
+  // near - e, so -0 near +0 gives +0 and -0 near -0 gives -0.
+  const double small[] = {0.0, -0.0, 1e-300, -1e-300};
+  for (int combination = 0; combination < 4 * 4 * 4 * 4 * 4 * 4; ++combination) {
+    Eigen::Vector3d e, near;
+    for (int a = 0, rest = combination; a < 3; ++a, rest /= 16) {
+      e[a] = small[rest % 4];
+      near[a] = small[rest / 4 % 4];
+    }
+    expect_plain(e, near);
+  }
+  // Where the shortcut's test tips over and where the triples tie: near - e = s u with s around
+  // where |s u|^2 is 0.999 (1) times the other triple's distance, found by bisection.
+  for (int n = 0; n < 4000; ++n) {
+    const double share = n % 2 == 0 ? 0.999 : 1.0;
+    const Eigen::Vector3d e(angle(rng), angle(rng) / 2, angle(rng));
+    const Eigen::Vector3d u = Eigen::Vector3d(step(rng), step(rng), step(rng)).normalized();
+    const auto margin = [&](double s) {
+      const double pi = std::numbers::pi;
+      const Eigen::Vector3d d = s * u;
+      return d.squaredNorm() - share * ((pi - std::fabs(d[0])) * (pi - std::fabs(d[0])) +
+                                        (pi - std::fabs(d[2])) * (pi - std::fabs(d[2])));
+    };
+    double low = 0, high = 3.09 / u.cwiseAbs().maxCoeff();
+    if (margin(high) < 0) continue;  // no tie before the shortcut's 3.1 limit
+    for (int i = 0; i < 100; ++i)
+      (margin(0.5 * (low + high)) < 0 ? low : high) = 0.5 * (low + high);
+    for (const double offset : {-1e-6, -1e-12, 0.0, 1e-12, 1e-6}) {
+      expect_plain(e, e + (low + offset) * u);
     }
   }
 }

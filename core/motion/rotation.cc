@@ -17,8 +17,8 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kSmallAngle = 1e-12;
 
 // std::round(v), halves away from zero and the sign of zero kept, without the libm call that
-// std::round is on baseline x86-64 (no SSE4.1): a few percent of writing a BVH file, which
-// unwraps three angles twice for every joint of every frame.
+// std::round is on baseline x86-64 (no SSE4.1): NearestEulerTriple's plain rule unwraps six
+// angles a call.
 double Round(double v) {
   if (!(std::fabs(v) < 0x1p52)) return std::round(v);  // no fraction, or not finite
   // Toward zero, then the exact fraction left decides.
@@ -55,8 +55,8 @@ absl::string_view EulerOrderName(EulerOrder order) {
 }
 
 std::array<int, 3> EulerAxes(EulerOrder order) {
-  // A table, not a switch, so that it is inlined into QuaternionToEuler (the BVH writer calls it
-  // for every joint of every frame).
+  // A table, not a switch, so that it is inlined into EulerAngles (the BVH writer calls it for
+  // every joint of every frame).
   static constexpr std::array<std::array<int, 3>, 6> kAxes = {
       {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};  // as kAllEulerOrders
   const auto index = static_cast<size_t>(order);
@@ -107,28 +107,30 @@ Eigen::Vector3d EulerAngles(const Quat& q, EulerOrder order) {
   return e;
 }
 
-Eigen::Vector3d NearestEulerTriple(const Eigen::Vector3d& e, const Eigen::Vector3d& near) {
+Eigen::Vector3d NearestEulerTriple(const Eigen::Vector3d& angles, const Eigen::Vector3d& near) {
   // (a, b, c) and (a + pi, pi - b, c + pi) are the same rotation; take the one nearest `near`.
-  // Consecutive frames nearly always lie well within pi of each other in every angle: then e
-  // needs no turn (UnwrapNear adds a signed zero) and the other triple, pi - |a - near a| and
-  // pi - |c - near c| away in a and c alone, is farther whenever e is nearer than that by a
-  // margin far above rounding. The BVH writer makes every joint of every frame continuous in
-  // frame order; this answers the same, several times faster.
-  const Eigen::Vector3d d = near - e;
+  // Consecutive frames nearly always lie well within pi of each other in every angle: then
+  // `angles` needs no turn (UnwrapNear adds a signed zero) and the other triple, pi - |a - near a|
+  // and pi - |c - near c| away in a and c alone, is farther whenever `angles` is nearer than that
+  // by a margin far above rounding. The BVH writer makes every joint of every frame continuous
+  // in frame order; this answers the same, several times faster. Past it (a joint whose angles
+  // have wound beyond +/-pi, a jump between frames) the plain rule below answers.
+  const Eigen::Vector3d d = near - angles;
   if (d.cwiseAbs().maxCoeff() < 3.1) {
     const double other =
         (std::numbers::pi - std::fabs(d[0])) * (std::numbers::pi - std::fabs(d[0])) +
         (std::numbers::pi - std::fabs(d[2])) * (std::numbers::pi - std::fabs(d[2]));
     if (d.squaredNorm() < 0.999 * other) {
-      return Eigen::Vector3d(e[0] + std::copysign(0.0, d[0]), e[1] + std::copysign(0.0, d[1]),
-                             e[2] + std::copysign(0.0, d[2]));
+      return Eigen::Vector3d(angles[0] + std::copysign(0.0, d[0]),
+                             angles[1] + std::copysign(0.0, d[1]),
+                             angles[2] + std::copysign(0.0, d[2]));
     }
   }
-  const Eigen::Vector3d alternative(e[0] + std::numbers::pi, std::numbers::pi - e[1],
-                                    e[2] + std::numbers::pi);
+  const Eigen::Vector3d alternative(angles[0] + std::numbers::pi, std::numbers::pi - angles[1],
+                                    angles[2] + std::numbers::pi);
   Eigen::Vector3d best;
   double best_distance = INFINITY;
-  for (const Eigen::Vector3d& candidate : {e, alternative}) {
+  for (const Eigen::Vector3d& candidate : {angles, alternative}) {
     Eigen::Vector3d unwrapped;
     for (int a = 0; a < 3; ++a) unwrapped[a] = UnwrapNear(candidate[a], near[a]);
     const double distance = (unwrapped - near).squaredNorm();
