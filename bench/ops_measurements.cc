@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <tuple>
@@ -18,8 +20,6 @@
 
 #include <signal.h>
 #include <unistd.h>
-
-#include <functional>
 
 #include "absl/strings/match.h"
 #include "bench/measure.h"
@@ -284,22 +284,16 @@ std::unique_ptr<grpc::ClientContext> Context() {
   return context;
 }
 
-// Every operator on a 10 s range of `file` through a real server, beside ExportClip and GetCurve
-// of the same range.
-absl::Status Speed(const std::string& file, int calls, double fps, const std::string& only) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("ops_speed_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  testing::ServerProcess server;
-  std::string error;
-  if (!server.Start({"--db", (dir / "db.sqlite").string(), "--quiet"}, &error)) {
-    return absl::InternalError(error);
-  }
-  const auto channel = testing::InsecureChannel(server.address());
-  testing::WaitUntilServing(channel, "");
-  auto clips = v1::ClipService::NewStub(channel);
-  auto spaces = v1::SpaceService::NewStub(channel);
-  auto edits = v1::EditService::NewStub(channel);
+// The clip the speed measurements edit: its id and how many frames make 10 s.
+struct TenSeconds {
+  int64_t id;
+  int frames;
+};
+
+// Ingests `file` (resampled to `fps` first when positive) and creates the space "body".
+absl::StatusOr<TenSeconds> IngestForSpeed(v1::ClipService::Stub& clips,
+                                          v1::SpaceService::Stub& spaces, const std::string& file,
+                                          int calls, double fps) {
   MOTIONDB_ASSIGN_OR_RETURN(std::string bvh, ReadFileBytes(file, int64_t{1} << 30));
   if (fps > 0) {  // the file resampled first, as `motiondb convert --fps` would
     MOTIONDB_ASSIGN_OR_RETURN(const BvhReadResult read, ReadBvh(bvh));
@@ -310,37 +304,47 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
   ingest.set_file_name(std::filesystem::path(file).filename().string());
   ingest.set_bvh(bvh);
   v1::IngestClipResponse ingested;
-  if (!clips->IngestClip(Context().get(), ingest, &ingested).ok())
+  if (!clips.IngestClip(Context().get(), ingest, &ingested).ok())
     return absl::InternalError("ingest");
-  const int64_t id = ingested.clip().clip_id();
-  const int frames = static_cast<int>(std::lround(10 * ingested.clip().fps()));  // 10 s
+  const TenSeconds ten{ingested.clip().clip_id(),
+                       static_cast<int>(std::lround(10 * ingested.clip().fps()))};
   v1::CreateSpaceRequest create;
   create.set_name("body");
   v1::Space space;
-  if (!spaces->CreateSpace(Context().get(), create, &space).ok())
+  if (!spaces.CreateSpace(Context().get(), create, &space).ok())
     return absl::InternalError("space");
   std::printf("%s: %d frames at %.1f fps; 10 s ranges of %d frames; %d calls each\n",
               ingest.file_name().c_str(), ingested.clip().frame_count(), ingested.clip().fps(),
-              frames, calls);
+              ten.frames, calls);
+  return ten;
+}
+
+using TimedCall = std::pair<std::string, std::function<grpc::Status()>>;
+
+// Every operator on 10 s of `clip`, beside ExportClip and GetCurve of the same range.
+std::vector<TimedCall> OperatorCalls(v1::ClipService::Stub* clips, v1::SpaceService::Stub* spaces,
+                                     v1::EditService::Stub* edits, const TenSeconds& clip) {
+  const int64_t id = clip.id;
+  const int frames = clip.frames;
   const v1::ClipRange ten = Range(id, 0, frames - 1), later = Range(id, frames, 2 * frames - 1);
   // Two 5 s ranges, joined into about 10 s.
   const v1::ClipRange half = Range(id, 0, frames / 2 - 1),
                       other_half = Range(id, frames, frames + frames / 2 - 1);
-  std::vector<std::pair<std::string, std::function<grpc::Status()>>> runs;
-  runs.push_back({"ExportClip (baseline)", [&] {
+  std::vector<TimedCall> runs;
+  runs.push_back({"ExportClip (baseline)", [=] {
                     v1::ExportClipRequest r;
                     *r.mutable_clip() = ten;
                     v1::ExportClipResponse o;
                     return clips->ExportClip(Context().get(), r, &o);
                   }});
-  runs.push_back({"GetCurve, 3 dims (baseline)", [&] {
+  runs.push_back({"GetCurve, 3 dims (baseline)", [=] {
                     v1::GetCurveRequest r;
                     r.set_space("body");
                     *r.mutable_clip() = ten;
                     v1::GetCurveResponse o;
                     return spaces->GetCurve(Context().get(), r, &o);
                   }});
-  runs.push_back({"Reconstruct, 10 dims", [&] {
+  runs.push_back({"Reconstruct, 10 dims", [=] {
                     v1::ReconstructRequest r;
                     r.set_space("body");
                     *r.mutable_clip() = ten;
@@ -348,7 +352,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::ReconstructResponse o;
                     return edits->Reconstruct(Context().get(), r, &o);
                   }});
-  runs.push_back({"Interpolate, means of two 10 s ranges, 11 t", [&] {
+  runs.push_back({"Interpolate, means of two 10 s ranges, 11 t", [=] {
                     v1::InterpolateRequest r;
                     r.set_space("body");
                     *r.mutable_from() = ten;
@@ -356,7 +360,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::InterpolateResponse o;
                     return edits->Interpolate(Context().get(), r, &o);
                   }});
-  runs.push_back({"Blend, 3 poses, a 10 s path", [&] {
+  runs.push_back({"Blend, 3 poses, a 10 s path", [=] {
                     v1::BlendRequest r;
                     r.set_space("body");
                     for (int i = 0; i < 3; ++i) {
@@ -371,7 +375,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::BlendResponse o;
                     return edits->Blend(Context().get(), r, &o);
                   }});
-  runs.push_back({"FillGap, 5 s each side, 0.5 s Hermite", [&] {
+  runs.push_back({"FillGap, 5 s each side, 0.5 s Hermite", [=] {
                     v1::FillGapRequest r;
                     r.set_space("body");
                     *r.mutable_first() = half;
@@ -379,7 +383,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::FillGapResponse o;
                     return edits->FillGap(Context().get(), r, &o);
                   }});
-  runs.push_back({"FillGap, 5 s each side, 0.5 s overlap warped", [&] {
+  runs.push_back({"FillGap, 5 s each side, 0.5 s overlap warped", [=] {
                     v1::FillGapRequest r;
                     r.set_space("body");
                     *r.mutable_first() = half;
@@ -388,7 +392,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::FillGapResponse o;
                     return edits->FillGap(Context().get(), r, &o);
                   }});
-  runs.push_back({"Scale x1.5 about the mean, gated", [&] {
+  runs.push_back({"Scale x1.5 about the mean, gated", [=] {
                     v1::ScaleRequest r;
                     r.set_space("body");
                     *r.mutable_clip() = ten;
@@ -402,7 +406,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::EditResponse o;
                     return edits->Scale(Context().get(), r, &o);
                   }});
-  runs.push_back({"Translate toward a pose", [&] {
+  runs.push_back({"Translate toward a pose", [=] {
                     v1::TranslateRequest r;
                     r.set_space("body");
                     *r.mutable_clip() = ten;
@@ -410,7 +414,7 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::EditResponse o;
                     return edits->Translate(Context().get(), r, &o);
                   }});
-  runs.push_back({"Smooth, level 1.5", [&] {
+  runs.push_back({"Smooth, level 1.5", [=] {
                     v1::SmoothRequest r;
                     r.set_space("body");
                     *r.mutable_clip() = ten;
@@ -418,24 +422,44 @@ absl::Status Speed(const std::string& file, int calls, double fps, const std::st
                     v1::EditResponse o;
                     return edits->Smooth(Context().get(), r, &o);
                   }});
-  int model = 0;
-  runs.push_back({"CreatePoseModel, 10 s of examples, k 2", [&] {
+  const auto model = std::make_shared<int>(0);
+  runs.push_back({"CreatePoseModel, 10 s of examples, k 2", [=] {
                     v1::CreatePoseModelRequest r;
-                    r.set_name("m" + std::to_string(model++));
+                    r.set_name("m" + std::to_string((*model)++));
                     r.set_space("body");
                     *r.add_examples() = ten;
                     v1::PoseModel o;
                     return edits->CreatePoseModel(Context().get(), r, &o);
                   }});
-  runs.push_back({"DetectPose over 10 s", [&] {
+  runs.push_back({"DetectPose over 10 s", [=] {
                     v1::DetectPoseRequest r;
                     r.set_model("m0");
                     *r.mutable_clip() = later;
                     v1::DetectPoseResponse o;
                     return edits->DetectPose(Context().get(), r, &o);
                   }});
+  return runs;
+}
+
+// Every operator on a 10 s range of `file` through a real server.
+absl::Status Speed(const std::string& file, int calls, double fps, const std::string& only) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("ops_speed_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  testing::ServerProcess server;
+  std::string error;
+  if (!server.Start({"--db", (dir / "db.sqlite").string(), "--quiet"}, &error)) {
+    return absl::InternalError(error);
+  }
+  const auto channel = testing::InsecureChannel(server.address());
+  testing::WaitUntilServing(channel, "");
+  auto clips = v1::ClipService::NewStub(channel);
+  auto spaces = v1::SpaceService::NewStub(channel);
+  auto edits = v1::EditService::NewStub(channel);
+  MOTIONDB_ASSIGN_OR_RETURN(const TenSeconds clip,
+                            IngestForSpeed(*clips, *spaces, file, calls, fps));
   std::printf("call | median ms | p95 ms\n");
-  for (const auto& [name, call] : runs) {
+  for (const auto& [name, call] : OperatorCalls(clips.get(), spaces.get(), edits.get(), clip)) {
     if (!absl::StrContains(name, only)) continue;
     MOTIONDB_ASSIGN_OR_RETURN(const auto times, Time(calls, call));
     std::printf("%s | %.2f | %.2f\n", name.c_str(), times.first, times.second);
