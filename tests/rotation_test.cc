@@ -128,6 +128,18 @@ TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
     }
     return best;
   };
+  const auto same_as_plain = [&](const Eigen::Vector3d& e,
+                                 const Eigen::Vector3d& near) -> ::testing::AssertionResult {
+    const Eigen::Vector3d got = NearestEulerTriple(e, near), want = plain(e, near);
+    for (int a = 0; a < 3; ++a) {
+      if (std::bit_cast<uint64_t>(got[a]) != std::bit_cast<uint64_t>(want[a])) {
+        return ::testing::AssertionFailure()
+               << "angle " << a << ": " << got[a] << " against " << want[a] << " for "
+               << e.transpose() << " near " << near.transpose();
+      }
+    }
+    return ::testing::AssertionSuccess();
+  };
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
   std::normal_distribution<double> step;
@@ -139,19 +151,8 @@ TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
     Eigen::Vector3d near = e + scale * Eigen::Vector3d(step(rng), step(rng), step(rng));
     if (n % 5 == 0) near += 2 * std::numbers::pi * Eigen::Vector3d(turns(rng), 0, turns(rng));
     if (n % 7 == 0) near = Eigen::Vector3d(angle(rng), angle(rng), angle(rng));
-    const Eigen::Vector3d got = NearestEulerTriple(e, near), want = plain(e, near);
-    for (int a = 0; a < 3; ++a) {
-      ASSERT_EQ(std::bit_cast<uint64_t>(got[a]), std::bit_cast<uint64_t>(want[a]))
-          << "e " << e.transpose() << " near " << near.transpose();
-    }
+    ASSERT_TRUE(same_as_plain(e, near));
   }
-  const auto expect_plain = [&](const Eigen::Vector3d& e, const Eigen::Vector3d& near) {
-    const Eigen::Vector3d got = NearestEulerTriple(e, near), want = plain(e, near);
-    for (int a = 0; a < 3; ++a) {
-      EXPECT_EQ(std::bit_cast<uint64_t>(got[a]), std::bit_cast<uint64_t>(want[a]))
-          << "angle " << a << " of " << e.transpose() << " near " << near.transpose();
-    }
-  };
   // Signed zeros and tiny values, each angle on its own: UnwrapNear adds a zero of the sign of
   // near - e, so -0 near +0 gives +0 and -0 near -0 gives -0.
   const double small[] = {0.0, -0.0, 1e-300, -1e-300};
@@ -161,14 +162,20 @@ TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
       e[a] = small[rest % 4];
       near[a] = small[rest / 4 % 4];
     }
-    expect_plain(e, near);
+    ASSERT_TRUE(same_as_plain(e, near));
   }
-  // Where the shortcut's test tips over and where the triples tie: near - e = s u with s around
-  // where |s u|^2 is 0.999 (1) times the other triple's distance, found by bisection.
+  // Around the shortcut's bound and around the two triples' tie: near - e = s u, s found by
+  // bisection where |s u|^2 is `share` times (pi - |s u_0|)^2 + (pi - |s u_2|)^2. That is the
+  // other triple's distance when its middle angle, pi - e_1, is near's: e_1 = pi / 2, u_1 = 0.
+  // Past the tie the plain rule takes the other triple; a shortcut whose bound let it answer
+  // there would differ.
+  int other_triples = 0;
   for (int n = 0; n < 4000; ++n) {
-    const double share = n % 2 == 0 ? 0.999 : 1.0;
-    const Eigen::Vector3d e(angle(rng), angle(rng) / 2, angle(rng));
-    const Eigen::Vector3d u = Eigen::Vector3d(step(rng), step(rng), step(rng)).normalized();
+    const bool at_tie = n % 2 == 1;
+    const double share = at_tie ? 1.0 : 0.999;
+    const Eigen::Vector3d e(angle(rng), at_tie ? std::numbers::pi / 2 : angle(rng) / 2, angle(rng));
+    const Eigen::Vector3d u =
+        Eigen::Vector3d(step(rng), at_tie ? 0.0 : step(rng), step(rng)).normalized();
     const auto margin = [&](double s) {
       const double pi = std::numbers::pi;
       const Eigen::Vector3d d = s * u;
@@ -177,12 +184,16 @@ TEST(NearestEulerTriple, IsThePlainRuleBitForBit) {
     };
     double low = 0, high = 3.09 / u.cwiseAbs().maxCoeff();
     if (margin(high) < 0) continue;  // no tie before the shortcut's 3.1 limit
-    for (int i = 0; i < 100; ++i)
+    for (int i = 0; i < 100; ++i) {
       (margin(0.5 * (low + high)) < 0 ? low : high) = 0.5 * (low + high);
+    }
     for (const double offset : {-1e-6, -1e-12, 0.0, 1e-12, 1e-6}) {
-      expect_plain(e, e + (low + offset) * u);
+      const Eigen::Vector3d near = e + (low + offset) * u;
+      ASSERT_TRUE(same_as_plain(e, near));
+      if (std::fabs(plain(e, near)[0] - e[0]) > 1) ++other_triples;
     }
   }
+  EXPECT_GT(other_triples, 1000);  // the far side of the tie was reached
 }
 
 TEST(EulerOrder, NamesAndAxesAgree) {

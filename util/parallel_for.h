@@ -15,11 +15,11 @@ namespace motiondb {
 int ThreadsFor(int requested);
 
 // Calls body(index, thread) once for every index in [0, count), on min(threads, count) threads
-// numbered 0 (the caller) to threads - 1; indices are handed out in increasing order, one at a
-// time, so that body may keep per-thread state in slots indexed by `thread`. After a call
-// fails, no further index is handed out; the calls under way finish. Returns the failure of
-// the lowest index that failed (so that the outcome does not depend on timing), or OK.
-// `body` must be safe to call from several threads at once.
+// (fewer when no more can be started) numbered 0 (the caller) to threads - 1; indices are handed
+// out in increasing order, one at a time, so that body may keep per-thread state in slots indexed
+// by `thread`. After a call fails, no further index is handed out; the calls under way finish.
+// Returns the failure of the lowest index that failed (so that the outcome does not depend on
+// timing), or OK. `body` must be safe to call from several threads at once.
 absl::Status ParallelFor(int64_t count, int threads,
                          const std::function<absl::Status(int64_t index, int thread)>& body);
 

@@ -122,7 +122,7 @@ class MotionWriter {
     ForEachPiece(block.size(), pieces,
                  [&](int, int64_t begin, int64_t end) { Decompose(frames(begin, end)); });
     MakeContinuous(block);
-    // The first piece goes straight into `out` (which has room for every row), the others into
+    // The first piece goes straight into `out` (reserved for the whole answer), the others into
     // texts of their own appended after.
     std::vector<std::string> texts(pieces);
     ForEachPiece(block.size(), pieces, [&](int piece, int64_t begin, int64_t end) {
