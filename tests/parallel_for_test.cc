@@ -2,8 +2,14 @@
 // on timing.
 #include "util/parallel_for.h"
 
+#include <sys/resource.h>
+
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -114,6 +120,66 @@ TEST(ForEachPiece, CoversTheRangeInOrderOnePieceAThread) {
     EXPECT_EQ(std::set<std::thread::id>(threads.begin(), threads.end()).size(),
               static_cast<size_t>(pieces));
   }
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+// Leaves the process no room for a thread's stack (glibc maps one of RLIMIT_STACK, 8 MiB by
+// default): the address space is capped at its size now plus 256 KiB for the heap.
+bool LimitAddressSpaceToCurrent() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmSize:", 0) != 0) continue;
+    const rlim_t bytes = std::strtoull(line.c_str() + 7, nullptr, 10) * 1024;
+    rlimit limit;
+    if (getrlimit(RLIMIT_AS, &limit) != 0) return false;
+    limit.rlim_cur = bytes + (256 << 10);
+    return setrlimit(RLIMIT_AS, &limit) == 0;
+  }
+  return false;
+}
+
+// With no thread to be had, the caller does all of the work itself, rather than failing or
+// dropping the items the threads would have taken. In a child process, whose address space the
+// test caps.
+TEST(ParallelForDeathTest, TheCallerDoesEverythingWhenNoThreadCanStart) {
+  if (kAddressSanitizer) GTEST_SKIP() << "ASan's shadow memory leaves no address space to cap";
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        if (!LimitAddressSpaceToCurrent()) {
+          std::fputs("cannot cap the address space\n", stderr);
+          std::_Exit(2);
+        }
+        constexpr int64_t kCount = 1000;
+        const std::thread::id caller = std::this_thread::get_id();
+        std::vector<std::atomic<int>> calls(kCount);
+        std::atomic<bool> elsewhere{false};
+        const absl::Status status = ParallelFor(kCount, 4, [&](int64_t i, int thread) {
+          ++calls[i];
+          if (thread != 0 || std::this_thread::get_id() != caller) elsewhere = true;
+          return absl::OkStatus();
+        });
+        std::vector<std::atomic<int>> covered(kCount);
+        ForEachPiece(kCount, 4, [&](int, int64_t begin, int64_t end) {
+          for (int64_t i = begin; i < end; ++i) ++covered[i];
+          if (std::this_thread::get_id() != caller) elsewhere = true;
+        });
+        for (int64_t i = 0; i < kCount; ++i) {
+          if (calls[i] != 1 || covered[i] != 1) {
+            std::fprintf(stderr, "index %lld ran %d / %d times\n", static_cast<long long>(i),
+                         calls[i].load(), covered[i].load());
+            std::_Exit(1);
+          }
+        }
+        if (elsewhere) std::fputs("a thread started: the cap did not hold\n", stderr);
+        std::_Exit(status.ok() && !elsewhere ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
 }
 
 }  // namespace

@@ -8,6 +8,23 @@
 #include <vector>
 
 namespace motiondb {
+namespace {
+
+// Starts run(1) .. run(wanted - 1) on threads of their own, added to `helpers`, until one cannot
+// be started (the process is out of threads or memory); returns how many run now, the caller
+// counted: from 1 to `wanted`.
+int StartHelpers(int wanted, const std::function<void(int)>& run,
+                 std::vector<std::jthread>& helpers) {
+  helpers.reserve(std::max(wanted - 1, 0));
+  int started = 1;
+  try {
+    for (; started < wanted; ++started) helpers.emplace_back(run, started);
+  } catch (const std::system_error&) {
+  }
+  return started;
+}
+
+}  // namespace
 
 int ThreadsFor(int requested) {
   if (requested > 0) return requested;
@@ -35,13 +52,9 @@ absl::Status ParallelFor(int64_t count, int threads,
     }
   };
   {
+    // Whatever threads started, they and the caller hand out every index between them.
     std::vector<std::jthread> helpers;
-    helpers.reserve(used - 1);
-    try {
-      for (int t = 1; t < used; ++t) helpers.emplace_back(run, t);
-    } catch (const std::system_error&) {
-      // Out of threads: the threads started and the caller hand out every index between them.
-    }
+    StartHelpers(used, run, helpers);
     run(0);
   }
   return failure;
@@ -58,13 +71,8 @@ void ForEachPiece(int64_t count, int pieces,
     body(piece, count * piece / pieces, count * (piece + 1) / pieces);
   };
   std::vector<std::jthread> helpers;
-  helpers.reserve(pieces - 1);
-  int started = 1;
-  try {
-    for (; started < pieces; ++started) helpers.emplace_back(run, started);
-  } catch (const std::system_error&) {
-    // Out of threads: the caller runs the pieces no thread took, after its own.
-  }
+  const int started = StartHelpers(pieces, run, helpers);
+  // The caller runs the pieces no thread took, after its own.
   run(0);
   for (int piece = started; piece < pieces; ++piece) run(piece);
 }

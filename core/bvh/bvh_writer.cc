@@ -132,12 +132,12 @@ class MotionWriter {
     for (int piece = 1; piece < pieces; ++piece) out += texts[piece];
   }
 
-  Eigen::Vector3d& Angles(int frame, int joint) {
-    return angles_[static_cast<size_t>(frame - first_) * skeleton_.joint_count() + joint];
+  // Where a frame's joint's angles sit in angles_.
+  size_t Slot(int frame, int joint) const {
+    return static_cast<size_t>(frame - first_) * skeleton_.joint_count() + joint;
   }
-  const Eigen::Vector3d& Angles(int frame, int joint) const {
-    return angles_[static_cast<size_t>(frame - first_) * skeleton_.joint_count() + joint];
-  }
+  Eigen::Vector3d& Angles(int frame, int joint) { return angles_[Slot(frame, joint)]; }
+  const Eigen::Vector3d& Angles(int frame, int joint) const { return angles_[Slot(frame, joint)]; }
 
   void Decompose(FrameRange frames) {
     for (int f = frames.first; f <= frames.last; ++f) {
