@@ -10,23 +10,24 @@
 //          [--weights mass|uniform] [--weight-floor F] [--weight JOINT=W]...
 //          [--rate HZ] [--neighbours K] [--ann-dims N] [--dtw-dims N] [--slope S]
 //          [--neutral mean|boundary|origin] [--exact-every N] [--yaw-weight W] [--keep-heading]
-//          [--no-refine] [--points K] [--second-anchor S] [--style-metric SHRINK]
+//          [--no-refine] [--points K] [--second-anchor S] [--learned-metric SHRINK]
+//          [--unseen-labels]
 //
-// `--style-metric` searches in a metric learned from the labels (bench/style_metric.h): with
+// `--learned-metric` searches in a metric learned from the labels (core/space/learned_metric.h,
+// testing/learned_metric_folds.h): with
 // `--split style`, fitted for each style left out on the other styles' clips only (one index a
 // fold, the folds' figures merged); with `dataset`, on the other folders'; with `one`, on the
 // other folders' too, the first folder's clips searched among themselves.
 #include <chrono>
 #include <cstdio>
-#include <set>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "absl/strings/str_join.h"
 #include "bench/measure.h"
-#include "bench/style_metric.h"
 #include "testing/labelled_index.h"
+#include "testing/learned_metric_folds.h"
 #include "testing/retrieval_evaluation.h"
 #include "util/cli_conventions.h"
 #include "util/status_macros.h"
@@ -43,8 +44,8 @@ struct QualityFlags {
   std::string neutral = "mean";
   bool keep_heading = false, no_refine = false, windows = false;
   int places = 0;
-  double style_metric = -1;    // the shrink of bench/style_metric.h; negative: the space's metric
-  bool unseen_labels = false;  // --style-metric fitted without the queries' labels
+  double learned_metric = -1;  // LearnedMetricOptions::shrink; negative: the space's metric
+  bool unseen_labels = false;  // --learned-metric fitted without the queries' labels
   std::vector<std::string> weight_overrides;  // JOINT=W
   double root_velocity = SpaceOptions().root_velocity_weight;
   SpaceOptions space;
@@ -113,13 +114,13 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
       ->type_name("S")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--style-metric", flags->style_metric,
+  app.add_option("--learned-metric", flags->learned_metric,
                  "search in a metric learned from the other styles' (or folders') labels, its "
                  "style differences whitened by this share (0-1)")
       ->type_name("SHRINK")
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--unseen-labels", flags->unseen_labels,
-               "--style-metric: each fold's metric fitted without its queries' label either (one "
+               "--learned-metric: each fold's metric fitted without its queries' label either (one "
                "fold a style and label)");
 }
 
@@ -132,126 +133,6 @@ void SetSplit(const testing::LabelledIndex& library, const std::string& split,
   for (const std::string& source : library.sources) {
     options->queries.push_back(source == library.sources.front());
   }
-}
-
-// Adds one fold's report to `all`: sums weighted by query counts, to be divided by
-// FinishFolds.
-void AddFold(const RetrievalReport& fold, RetrievalReport* all) {
-  all->queries += fold.queries;
-  all->skipped_queries += fold.skipped_queries;
-  all->precision += fold.precision * fold.queries;
-  all->exact_queries += fold.exact_queries;
-  all->exact_precision += fold.exact_precision * fold.exact_queries;
-  all->recall += fold.recall * fold.exact_queries;
-  all->latency_p50_ms += fold.latency_p50_ms * fold.queries;
-  all->latency_p99_ms = std::max(all->latency_p99_ms, fold.latency_p99_ms);
-  all->exact_latency_p50_ms += fold.exact_latency_p50_ms * fold.exact_queries;
-  for (const auto& [group, precision] : fold.precision_by_group) {
-    all->precision_by_group[group] = precision;
-  }
-  for (const auto& [label, found] : fold.confusion) {
-    for (const auto& [found_label, count] : found) all->confusion[label][found_label] += count;
-  }
-  for (const auto& [stage, ms] : fold.mean_stage_ms) all->mean_stage_ms[stage] += ms * fold.queries;
-}
-
-// The means of AddFold's sums; a label's precision from its confusion counts (its hits among
-// the results found).
-void FinishFolds(RetrievalReport* all) {
-  all->precision /= all->queries;
-  all->latency_p50_ms /= all->queries;
-  for (auto& [stage, ms] : all->mean_stage_ms) ms /= all->queries;
-  if (all->exact_queries > 0) {
-    all->exact_precision /= all->exact_queries;
-    all->recall /= all->exact_queries;
-    all->exact_latency_p50_ms /= all->exact_queries;
-  }
-  for (const auto& [label, found] : all->confusion) {
-    int results = 0;
-    for (const auto& [found_label, count] : found) results += count;
-    all->precision_by_label[label] = found.contains(label) ? 1.0 * found.at(label) / results : 0;
-  }
-}
-
-// `options` measured in the metric of bench/style_metric.h: for each group that holds queries
-// (and, with `unseen_labels`, each label of its queries), a metric fitted on the other groups'
-// clips (of other labels), every clip's coordinates in it indexed, and the fold's queries
-// searched.
-absl::StatusOr<RetrievalReport> EvaluateInStyleMetric(const testing::LabelledIndex& library,
-                                                      const RetrievalOptions& options,
-                                                      double shrink, bool unseen_labels) {
-  const int clips = library.index->clip_count();
-  std::vector<RowMatrixXf> coordinates;
-  std::set<std::pair<std::string, std::string>> folds;  // group, and label or ""
-  for (int c = 0; c < clips; ++c) {
-    coordinates.push_back(library.index->CopyClipCoordinates(c));
-    if (options.queries.empty() || options.queries[c]) {
-      folds.insert({options.groups[c], unseen_labels ? library.labels[c] : ""});
-    }
-  }
-  RetrievalReport all;
-  for (const auto& [group, label] : folds) {
-    std::vector<bool> fit(clips);
-    RetrievalOptions fold = options;
-    fold.queries.assign(clips, false);
-    for (int c = 0; c < clips; ++c) {
-      const bool in_fold =
-          options.groups[c] == group && (label.empty() || library.labels[c] == label);
-      fit[c] = options.groups[c] != group && (label.empty() || library.labels[c] != label);
-      fold.queries[c] = in_fold && (options.queries.empty() || options.queries[c]);
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const Eigen::MatrixXd transform,
-                              bench::FitStyleMetric(coordinates, library.labels, library.styles,
-                                                    fit, {.shrink = shrink}));
-    std::vector<LibraryClip> transformed;
-    for (int c = 0; c < clips; ++c) {
-      const LibraryIndex::ClipEntry& entry = library.index->clip(c);
-      transformed.push_back({entry.clip_id, entry.name, entry.tags,
-                             (coordinates[c].cast<double>() * transform).cast<float>()});
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(const std::unique_ptr<LibraryIndex> index,
-                              LibraryIndex::Build(std::move(transformed), library.index->rate(),
-                                                  {options.params.ann_dims}));
-    absl::StatusOr<RetrievalReport> report = EvaluateRetrieval(*index, library.labels, fold);
-    // A fold of one label may hold only queries with too few clips to find.
-    if (!report.ok() &&
-        !(unseen_labels && report.status().code() == absl::StatusCode::kInvalidArgument)) {
-      return report.status();
-    }
-    if (report.ok()) AddFold(*report, &all);
-  }
-  FinishFolds(&all);
-  return all;
-}
-
-// Leave-one-out among the first folder's clips (`--split one`) in the metric of
-// bench/style_metric.h fitted on the other folders' clips: within one style, in a metric learned
-// from other data.
-absl::StatusOr<RetrievalReport> EvaluateFirstFolderInStyleMetric(
-    const testing::LabelledIndex& library, const RetrievalOptions& options, double shrink) {
-  const int clips = library.index->clip_count();
-  std::vector<RowMatrixXf> coordinates;
-  std::vector<bool> fit(clips);
-  for (int c = 0; c < clips; ++c) {
-    coordinates.push_back(library.index->CopyClipCoordinates(c));
-    fit[c] = library.sources[c] != library.sources.front();
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const Eigen::MatrixXd transform,
-      bench::FitStyleMetric(coordinates, library.labels, library.styles, fit, {.shrink = shrink}));
-  std::vector<LibraryClip> transformed;
-  std::vector<std::string> labels;
-  for (int c = 0; c < clips; ++c) {
-    if (fit[c]) continue;
-    const LibraryIndex::ClipEntry& entry = library.index->clip(c);
-    transformed.push_back({static_cast<int64_t>(labels.size()), entry.name, entry.tags,
-                           (coordinates[c].cast<double>() * transform).cast<float>()});
-    labels.push_back(library.labels[c]);
-  }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::unique_ptr<LibraryIndex> index,
-                            LibraryIndex::Build(std::move(transformed), library.index->rate(),
-                                                {options.params.ann_dims}));
-  return EvaluateRetrieval(*index, labels, options);
 }
 
 absl::Status Run(QualityFlags& flags) {
@@ -296,10 +177,12 @@ absl::Status Run(QualityFlags& flags) {
   SetSplit(library, flags.split, &options);
   MOTIONDB_ASSIGN_OR_RETURN(
       const RetrievalReport report,
-      flags.style_metric < 0 ? EvaluateRetrieval(*library.index, library.labels, options)
+      flags.learned_metric < 0 ? EvaluateRetrieval(*library.index, library.labels, options)
       : flags.split == "one"
-          ? EvaluateFirstFolderInStyleMetric(library, options, flags.style_metric)
-          : EvaluateInStyleMetric(library, options, flags.style_metric, flags.unseen_labels));
+          ? testing::EvaluateFirstSourceInLearnedMetric(library, options,
+                                                        {.shrink = flags.learned_metric})
+          : testing::EvaluateInLearnedMetric(library, options, {.shrink = flags.learned_metric},
+                                             flags.unseen_labels));
 
   std::printf("%s: %d clips, %lld frames at %.0f Hz, %d dims; load+space+index %.1f s\n",
               absl::StrJoin(flags.folders, " + ").c_str(), library.index->clip_count(),
