@@ -11,6 +11,7 @@
 #include "client/commands.h"
 #include "client/server_connection.h"
 #include "client/space_flags.h"
+#include "core/space/learned_metric.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
@@ -24,6 +25,8 @@ struct CreateFlags {
   std::vector<std::string> train;  // CLIP_ID[:FROM-TO]
   std::optional<int64_t> skeleton;
   SpaceFlags space;
+  bool learned_metric = false;
+  std::optional<double> learned_metric_shrink;
 };
 
 absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
@@ -47,6 +50,10 @@ absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
   }
   request.set_metric(space.metric == "unit" ? v1::SPACE_METRIC_UNIT
                                             : v1::SPACE_METRIC_EIGENVALUE_SCALED);
+  if (flags.learned_metric) {
+    v1::LearnedMetric* learned = request.mutable_learned_metric();
+    if (flags.learned_metric_shrink) learned->set_shrink(*flags.learned_metric_shrink);
+  }
   return request;
 }
 
@@ -58,7 +65,9 @@ FlagNames CreateFlagNames(const CreateFlags& flags) {
                      {"root_velocity_weight", "--root-velocity-weight"},
                      {"weights_json", "--weights"},
                      {"weight_preset", "--weights"},
-                     {"metric", "--metric"}};
+                     {"metric", "--metric"},
+                     {"learned_metric.shrink", "--learned-metric-shrink"},
+                     {"learned_metric", "--learned-metric"}};
   for (size_t i = 0; i < flags.train.size(); ++i) {
     const std::string field = absl::StrCat("training[", i, "]");
     const std::string flag = absl::StrCat("--train ", flags.train[i]);
@@ -75,7 +84,7 @@ nlohmann::json SpaceJson(const v1::Space& space) {
   for (const v1::ReconstructionError& e : report.reconstruction_error()) {
     errors.push_back({{"dims", e.dims()}, {"mean_rad", e.mean_rad()}, {"max_rad", e.max_rad()}});
   }
-  return {{"name", space.name()},
+  nlohmann::json out = {{"name", space.name()},
           {"space_id", space.space_id()},
           {"skeleton_id", space.skeleton_id()},
           {"dims", report.dims()},
@@ -91,6 +100,12 @@ nlohmann::json SpaceJson(const v1::Space& space) {
           {"explained_variance", std::vector<double>(report.explained_variance().begin(),
                                                      report.explained_variance().end())},
           {"reconstruction_error", errors}};
+  if (report.has_learned_metric()) {
+    out["learned_metric"] = {{"shrink", report.learned_metric().shrink()},
+                             {"examples", report.learned_metric().examples()},
+                             {"descriptors", report.learned_metric().descriptors()}};
+  }
+  return out;
 }
 
 void PrintSpace(const v1::Space& space) {
@@ -102,6 +117,11 @@ void PrintSpace(const v1::Space& space) {
   absl::PrintF("  trained on %d ranges (%d frames); %d clips projected when built\n",
                report.training_size(), report.training_frames(), report.projected_clips());
   absl::PrintF("  index: %d clips, %d frames\n", space.index().clips(), space.index().frames());
+  if (report.has_learned_metric()) {
+    absl::PrintF("  search metric learned from %d labelled ranges of %d descriptors (shrink %g)\n",
+                 report.learned_metric().examples(), report.learned_metric().descriptors(),
+                 report.learned_metric().shrink());
+  }
   double cumulative = 0;
   absl::PrintF("  explained variance:");
   for (int i = 0; i < report.explained_variance_size() && i < 10; ++i) {
@@ -192,6 +212,17 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
       ->type_name("ID")
       ->check(WholeAtLeast(1));
   AddSpaceFlags(create_command, &create->space);
+  create_command->add_flag(
+      "--learned-metric", create->learned_metric,
+      "search in a metric learned from the stored manual labels: what differs between clips of "
+      "one descriptor (take, performer, style) counts less");
+  create_command
+      ->add_option("--learned-metric-shrink", create->learned_metric_shrink,
+                   "with --learned-metric: how far, in [0, 1)")
+      ->type_name("S")
+      ->default_str(absl::StrCat(LearnedMetricOptions().shrink))
+      ->check(CLI::Range(0.0, 1.0))
+      ->needs("--learned-metric");
 
   commands.AddServer(
       space, "list", "list the server's spaces",

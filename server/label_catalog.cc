@@ -157,6 +157,20 @@ absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
   return records;
 }
 
+absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,
+                                                               const std::string& descriptor) {
+  std::vector<storage::LabelRecord> labels;
+  storage::Page page{.page_size = storage::kMaxPageSize, .page_token = ""};
+  do {
+    MOTIONDB_ASSIGN_OR_RETURN(storage::LabelPage read,
+                              database.ListLabels(page, {.descriptor = descriptor,
+                                                         .origin = storage::LabelOrigin::kManual}));
+    labels.insert(labels.end(), read.labels.begin(), read.labels.end());
+    page.page_token = read.next_page_token;
+  } while (!page.page_token.empty());
+  return labels;
+}
+
 absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const PageRequest& page,
                                               const storage::LabelFilter& filter) {
   MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));

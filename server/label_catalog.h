@@ -50,6 +50,10 @@ absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const
 absl::StatusOr<storage::LabelPage> FindLabels(storage::Database& database, const PageRequest& page,
                                               const storage::LabelQuery& query);
 
+// Every manual label of `descriptor` (empty: of any), every page read.
+absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,
+                                                               const std::string& descriptor);
+
 // Labels named by id, or else those the filter takes.
 struct LabelDeletion {
   std::vector<int64_t> label_ids;

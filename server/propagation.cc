@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "server/label_catalog.h"
 #include "server/space_lookup.h"
 #include "util/parallel_for.h"
 #include "util/status_macros.h"
@@ -20,21 +21,6 @@ namespace motiondb::server {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-// The manual labels of `descriptor`, every page.
-absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,
-                                                               const std::string& descriptor) {
-  std::vector<storage::LabelRecord> labels;
-  storage::Page page{.page_size = 1000, .page_token = ""};
-  do {
-    MOTIONDB_ASSIGN_OR_RETURN(storage::LabelPage read,
-                              database.ListLabels(page, {.descriptor = descriptor,
-                                                         .origin = storage::LabelOrigin::kManual}));
-    labels.insert(labels.end(), read.labels.begin(), read.labels.end());
-    page.page_token = read.next_page_token;
-  } while (!page.page_token.empty());
-  return labels;
-}
 
 // The search parameters as the runner would resolve them, checked once before the job is
 // queued, so that a bad parameter fails the start rather than every query.

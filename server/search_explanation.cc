@@ -51,6 +51,12 @@ absl::StatusOr<SearchExplanation> ExplainHit(const MotionSpace& space, Coordinat
   }
   const int dims = std::min<int>(space.dims(), std::min(query.stride, clip.stride));
   const Eigen::MatrixXd basis = space.data().basis.leftCols(dims);
+  // A learned metric's coordinates are turned back into the space's, which split by joint.
+  const RowMatrixXd& learned_inverse = space.search_transform_inverse();
+  if (learned_inverse.size() > 0 && dims < space.dims()) {
+    return absl::InternalError(absl::StrCat("coordinates of ", dims, " dimensions in a space of ",
+                                            space.dims(), " with a learned metric"));
+  }
   const int joints = space.skeleton().joint_count();
   const std::vector<std::string> names = GroupNames(space);
   std::vector<double> squared(names.size(), 0.0);
@@ -61,6 +67,7 @@ absl::StatusOr<SearchExplanation> ExplainHit(const MotionSpace& space, Coordinat
       return absl::InternalError(absl::StrCat("path row ", i, " is outside the clip"));
     }
     for (int d = 0; d < dims; ++d) difference[d] = query.row(i)[d] - clip.row(path[i])[d];
+    if (learned_inverse.size() > 0) difference = learned_inverse.transpose() * difference;
     const Eigen::VectorXd pose = basis * difference;
     for (int k = 0; k < pose.size(); ++k) squared[GroupOf(k, joints)] += pose[k] * pose[k];
     total_squared += difference.squaredNorm();

@@ -35,7 +35,9 @@ struct SearchExplanation {
 // `query` and `clip`: search coordinates (core/space/search_coordinates.h) of `space` at its
 // rate; `path[i]` is the clip row matched to query row i. In the metric's coordinates m, the
 // basis B turns a difference into pose-vector numbers u = B m with |u| = |m| (B orthonormal),
-// so the squared distance splits exactly by joint. Thread-safe.
+// so the squared distance splits exactly by joint. In a space with a learned metric (whose
+// distance does not split by joint) the differences are turned back into the space's own metric
+// coordinates first: the split, and full_score, are of the space's own pose distance. Thread-safe.
 absl::StatusOr<SearchExplanation> ExplainHit(const MotionSpace& space, CoordinateView query,
                                              CoordinateView clip, const std::vector<int64_t>& path);
 

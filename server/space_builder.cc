@@ -6,6 +6,7 @@
 #include "core/motion/resample.h"
 #include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
+#include "server/learned_metric_fit.h"
 #include "server/listing.h"
 #include "server/space_report.h"
 #include "util/status_macros.h"
@@ -145,10 +146,17 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
     training_frames +=
         ResampledFrameCount(used[i].frames.size(), records[i].frame_time, built.sample_rate());
   }
-  auto space = std::make_shared<const MotionSpace>(std::move(built));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
-                            space->RepresentationalError(training, kErrorReportDims, should_stop));
+                            built.RepresentationalError(training, kErrorReportDims, should_stop));
   last.reset();
+  std::optional<FittedMetric> fitted;
+  if (request.learned_metric) {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        fitted,
+        FitMetricOnLabels(database, built, clip_ids, *request.learned_metric, should_stop));
+    MOTIONDB_ASSIGN_OR_RETURN(built, built.WithSearchTransform(fitted->transform));
+  }
+  auto space = std::make_shared<const MotionSpace>(std::move(built));
 
   BuiltSpace result;
   for (const int64_t id : clip_ids) {
@@ -165,6 +173,11 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   report.training_frames = training_frames;
   report.reconstruction_error = errors;
   report.projected_clips = static_cast<int64_t>(result.clips.size());
+  if (fitted) {
+    report.learned_metric_shrink = request.learned_metric->shrink;
+    report.learned_metric_examples = fitted->examples;
+    report.learned_metric_descriptors = fitted->descriptors;
+  }
   report.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/space/learned_metric.h"
 #include "core/space/motion_space.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
@@ -26,6 +27,9 @@ struct SpaceRequest {
   // Empty: every clip of the skeleton, whole.
   std::vector<ClipSelection> training;
   SpaceOptions options;
+  // Set: the space's search coordinates are in a metric learned from the database's manual
+  // labels (server/learned_metric_fit.h).
+  std::optional<LearnedMetricOptions> learned_metric;
 };
 
 struct BuiltSpace {

@@ -32,12 +32,21 @@ absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database
   const auto [first, last] = snapshot->Conversion(clip_id).ToSpace(curve.frames);
   const CoordinateView rows = snapshot->index->clip_coordinates(snapshot->index->FindClip(clip_id))
                                   .middle_rows(first, last - first + 1);
-  // The index holds coordinates multiplied by the metric's scales; a plot wants the projection.
+  // The index holds search coordinates: the projection multiplied by the metric's scales (then
+  // by a learned metric's transform, when the space has one); a plot wants the projection.
   MOTIONDB_ASSIGN_OR_RETURN(const Eigen::VectorXd scales, snapshot->space->MetricScales(dims));
+  const RowMatrixXd& learned_inverse = snapshot->space->search_transform_inverse();
   curve.coordinates.resize(rows.rows, dims);
+  Eigen::RowVectorXd scaled(dims);
   for (int64_t r = 0; r < rows.rows; ++r) {
+    if (learned_inverse.size() > 0) {
+      scaled = Eigen::Map<const Eigen::RowVectorXf>(rows.row(r), space_dims).cast<double>() *
+               learned_inverse.leftCols(dims);
+    } else {
+      scaled = Eigen::Map<const Eigen::RowVectorXf>(rows.row(r), dims).cast<double>();
+    }
     for (int d = 0; d < dims; ++d) {
-      curve.coordinates(r, d) = scales[d] > 0 ? static_cast<float>(rows.row(r)[d] / scales[d]) : 0;
+      curve.coordinates(r, d) = scales[d] > 0 ? static_cast<float>(scaled[d] / scales[d]) : 0;
     }
   }
   curve.sample_rate = snapshot->space->sample_rate();

@@ -108,6 +108,12 @@ bool ReadReport(const Json& json, SpaceReport& report) {
     out.max_rad = ReadDouble(error.value("max_rad", Json(0))).value_or(0);
   }
   number("projected_clips", report.projected_clips);
+  if (json.contains("learned_metric")) {  // reports before it have none
+    const Json& learned = json.at("learned_metric");
+    report.learned_metric_shrink = ReadDouble(learned.value("shrink", Json(0))).value_or(0);
+    report.learned_metric_examples = ReadInt(learned.value("examples", Json(0))).value_or(0);
+    report.learned_metric_descriptors = ReadInt(learned.value("descriptors", Json(0))).value_or(0);
+  }
   number("build_ms", report.build_ms);
   return ok;
 }
@@ -166,6 +172,11 @@ std::string ReportToJson(const SpaceReport& report) {
                                             {"max_rad", Double(error.max_rad)}});
   }
   json["projected_clips"] = Int64(report.projected_clips);
+  if (report.learned_metric_examples > 0) {
+    json["learned_metric"] = {{"shrink", Double(report.learned_metric_shrink)},
+                              {"examples", Int64(report.learned_metric_examples)},
+                              {"descriptors", Int64(report.learned_metric_descriptors)}};
+  }
   json["build_ms"] = Double(report.build_ms);
   return json.dump();
 }

@@ -43,6 +43,11 @@ struct SpaceReport {
   std::vector<double> explained_variance;  // per dimension; sums to 1
   std::vector<ReconstructionError> reconstruction_error;
   int64_t projected_clips = 0;
+  // With a learned metric (server/learned_metric_fit.h): its shrink and what it was fitted on;
+  // 0 examples without one.
+  double learned_metric_shrink = 0;
+  int64_t learned_metric_examples = 0;
+  int64_t learned_metric_descriptors = 0;
   double build_ms = 0;
 };
 

@@ -632,6 +632,40 @@ TEST_F(CliServerTest, SpaceListAndShowCountTheClipsIngestedSinceTheBuild) {
   EXPECT_EQ(nlohmann::json::parse(r.out)["clips"], 1);
 }
 
+// `space create --learned-metric`: refused while no descriptor labels two clips, in the flag's
+// name; built once one does, its report saying what it was fitted on; the shrink only with it.
+TEST_F(CliServerTest, SpaceCreateWithALearnedMetric) {
+  testing::CommandResult r =
+      Remote({"space", "create", "styles", "--learned-metric-shrink", "0.5"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--learned-metric-shrink requires --learned-metric"));
+  ASSERT_EQ(Remote({"label", "add", "walk54:0-20", "step"}).exit_code, 0);
+  r = Remote({"space", "create", "styles", "--learned-metric"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("FAILED_PRECONDITION: --learned-metric: needs one descriptor "
+                               "labelled (manual labels, value >= 0.5) on at least two clips of "
+                               "the space's skeleton; of its 1 such labels, no descriptor is on "
+                               "two clips"));
+
+  const std::string path = (dir_ / "walk54b.bvh").string();
+  ASSERT_TRUE(WriteBvhFile(path, testing::SyntheticClip(testing::HumanoidSkeleton(false),
+                                                        {.frames = kFrames, .fps = 30, .seed = 4}))
+                  .ok());
+  ASSERT_EQ(Remote({"ingest", path}).exit_code, 0);
+  ASSERT_EQ(Remote({"label", "add", "walk54b:10-30", "step"}).exit_code, 0);
+  r = Remote({"space", "create", "styles", "--learned-metric", "--learned-metric-shrink", "0.9",
+              "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json space = nlohmann::json::parse(r.out);
+  EXPECT_EQ(space["learned_metric"],
+            nlohmann::json({{"shrink", 0.9}, {"examples", 2}, {"descriptors", 1}}));
+  r = Remote({"space", "show", "styles"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(
+      r.out,
+      HasSubstr("search metric learned from 2 labelled ranges of 1 descriptors (shrink 0.9)"));
+}
+
 // A propagation on the fixture's clip: started and waited for, listed, shown, and the errors of
 // each job command in its own words.
 TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {

@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include "core/space/search_coordinates.h"
+#include "tests/synthetic_motion.h"
+
 namespace motiondb {
 namespace {
 
@@ -66,6 +69,10 @@ TEST(LearnedMetric, ShrinksWhatTheGroupsChange) {
   ASSERT_EQ(transform->cols(), 3);
   // In the learned one the label does, by a margin (0.55 of it measured).
   EXPECT_LT(MeanDistance(a1, a2, *transform), 0.75 * MeanDistance(a1, b1, *transform));
+  // Also when the 30-frame examples are aligned over every third frame only.
+  const Eigen::MatrixXd sparse = *FitLearnedMetric(library.examples, {.max_frames = 10});
+  EXPECT_LT(MeanDistance(a1, a2, sparse), 0.75 * MeanDistance(a1, b1, sparse));
+  EXPECT_FALSE(sparse.isApprox(*transform, 1e-6));
 }
 
 TEST(LearnedMetric, FirstDimensionsCarryTheMostVarianceAndTheTotalIsKept) {
@@ -102,6 +109,8 @@ TEST(LearnedMetric, RefusesWhatItCannotFitOn) {
             "shrink: -0.1 is outside [0, 1)");
   EXPECT_EQ(FitLearnedMetric(library.examples, {.partners = 0}).status().message(),
             "partners: 0 is below 1");
+  EXPECT_EQ(FitLearnedMetric(library.examples, {.max_frames = 1}).status().message(),
+            "max_frames: 1 is below 2");
   EXPECT_EQ(FitLearnedMetric({}).status().message(), "examples: none given");
 
   // One group only: nothing says what a group changes.
@@ -118,6 +127,27 @@ TEST(LearnedMetric, RefusesWhatItCannotFitOn) {
   library.curves[5](7, 1) = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(FitLearnedMetric(library.examples).status().message(),
             "examples[5]: its coordinates hold a non-finite number");
+}
+
+// A space with a search transform gives search coordinates that are its plain ones times the
+// transform, truncated after the product; its projections do not change.
+TEST(LearnedMetric, SearchCoordinatesAreThePlainOnesTimesTheTransform) {
+  const Clip clip = testing::SyntheticClip(testing::HumanoidSkeleton(/*still_root=*/true),
+                                           {.frames = 40, .turn_rate = 0.3});
+  const MotionSpace plain = *MotionSpace::Build({{"walk.bvh", clip, std::nullopt}});
+  RowMatrixXd transform = RowMatrixXd::Identity(plain.dims(), plain.dims());
+  transform(plain.dims() - 1, 0) = 2.0;  // the last dimension mixed into the first
+  transform(1, 1) = 0.5;
+  const MotionSpace learned = *plain.WithSearchTransform(transform);
+  const RowMatrixXf before = *SearchCoordinates(plain, clip);
+  const RowMatrixXf after = *SearchCoordinates(learned, clip);
+  const RowMatrixXf expected = (before.cast<double>() * transform).cast<float>();
+  ASSERT_EQ(after.rows(), expected.rows());
+  EXPECT_TRUE(after.isApprox(expected, 1e-5f));
+  const RowMatrixXf three = *SearchCoordinates(learned, clip, 3);
+  EXPECT_EQ(three, after.leftCols(3));
+  EXPECT_FALSE(SearchCoordinates(learned, clip, plain.dims() + 1).ok());
+  EXPECT_EQ(*learned.ProjectClip(clip), *plain.ProjectClip(clip));
 }
 
 }  // namespace

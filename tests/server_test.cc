@@ -1823,6 +1823,17 @@ TEST_F(ServerTest, DamagedDatabaseIsRefusedAtStart) {
   }
 }
 
+// The same results, place and score, in the same order.
+void ExpectSameResults(const v1::SearchResponse& after, const v1::SearchResponse& before) {
+  ASSERT_EQ(after.results_size(), before.results_size());
+  for (int i = 0; i < before.results_size(); ++i) {
+    EXPECT_EQ(after.results(i).clip_id(), before.results(i).clip_id()) << i;
+    EXPECT_EQ(after.results(i).start_frame(), before.results(i).start_frame()) << i;
+    EXPECT_EQ(after.results(i).end_frame(), before.results(i).end_frame()) << i;
+    EXPECT_EQ(after.results(i).score(), before.results(i).score()) << i;
+  }
+}
+
 TEST_F(ServerTest, RestartKeepsEverything) {
   ServerProcess* server = StartServer();
   ASSERT_NE(server, nullptr);
@@ -1861,13 +1872,7 @@ TEST_F(ServerTest, RestartKeepsEverything) {
     EXPECT_EQ(space_after.SerializeAsString(), space_before.SerializeAsString());
     v1::SearchResponse after;
     ASSERT_TRUE(client.Search(query, &after).ok());
-    ASSERT_EQ(after.results_size(), before.results_size());
-    for (int i = 0; i < before.results_size(); ++i) {
-      EXPECT_EQ(after.results(i).clip_id(), before.results(i).clip_id());
-      EXPECT_EQ(after.results(i).start_frame(), before.results(i).start_frame());
-      EXPECT_EQ(after.results(i).end_frame(), before.results(i).end_frame());
-      EXPECT_EQ(after.results(i).score(), before.results(i).score());
-    }
+    ExpectSameResults(after, before);
   }
   // Stopped with no client connected: an idle connection makes a graceful stop wait (up to
   // 5 s in gRPC 1.51) for the client to acknowledge the GOAWAY.
@@ -2351,6 +2356,101 @@ TEST_F(ServerTest, PropagationLabelsSimilarRangesAndReRunsReplaceItsOutput) {
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(refused.error_message(), HasSubstr("succeeded"));
   EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.JobService/StartPropagation OK "));
+}
+
+// A space whose search metric is learned from the manual labels: refused with a clear error
+// while no descriptor labels two clips or its shrink is out of range; then built, its report
+// saying what it was fitted on, its curves the projection as in a space without it, its
+// searches finding the labelled action again with explanations that add up, and all of it as
+// before after a restart (the transform stored with the space).
+TEST_F(ServerTest, ASpaceSearchesInAMetricLearnedFromTheLabels) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  v1::SearchRequest query;
+  v1::SearchResponse before;
+  v1::Space learned;
+  {
+    Client client(testing::InsecureChannel(server->address()));
+    const std::vector<int64_t> ids = IngestHumanoid(client);
+    CreateHumanoidSpace(client);
+    v1::CreateSpaceRequest request;
+    request.set_name("learned");
+    request.mutable_learned_metric();
+    grpc::Status status = client.CreateSpace(request, &learned);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    EXPECT_EQ(status.error_message(),
+              "learned_metric: needs one descriptor labelled (manual labels, value >= 0.5) on at "
+              "least two clips of the space's skeleton; of its 0 such labels, no descriptor is on "
+              "two clips");
+    request.mutable_learned_metric()->set_shrink(1);
+    status = client.CreateSpace(request, &learned);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(status.error_message(), "learned_metric: shrink: 1 is outside [0, 1)");
+
+    // Every action labelled by its kind (the script's kinds fall on several clips), and one weak
+    // label that is no example.
+    std::vector<v1::NewLabel> given;
+    for (const SyntheticSegment& segment : Humanoid().segments) {
+      given.push_back(FrameLabel(ids[segment.clip], segment.first_frame, segment.last_frame,
+                                 absl::StrCat("action-", static_cast<int>(segment.action))));
+    }
+    given.push_back(FrameLabel(ids[0], std::nullopt, std::nullopt, "action-0", 0.2));
+    AddLabelsOrFail(client, given);
+
+    request.mutable_learned_metric()->clear_shrink();
+    status = client.CreateSpace(request, &learned);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_TRUE(learned.report().has_learned_metric());
+    EXPECT_EQ(learned.report().learned_metric().examples(), static_cast<int64_t>(given.size()) - 1);
+    EXPECT_EQ(learned.report().learned_metric().descriptors(), 4);
+    EXPECT_EQ(learned.report().learned_metric().shrink(), 0.95);
+
+    // The curve is the projection, the same as the plain space's (one training set).
+    const SyntheticSegment& raise = FirstRaise();
+    v1::GetCurveRequest curve_request;
+    curve_request.mutable_clip()->set_clip_id(ids[raise.clip]);
+    curve_request.set_dims(5);
+    v1::GetCurveResponse plain_curve, learned_curve;
+    curve_request.set_space("body");
+    ASSERT_TRUE(client.spaces().GetCurve(client.Context().get(), curve_request, &plain_curve).ok());
+    curve_request.set_space("learned");
+    ASSERT_TRUE(
+        client.spaces().GetCurve(client.Context().get(), curve_request, &learned_curve).ok());
+    ASSERT_EQ(learned_curve.coordinates().size(), plain_curve.coordinates().size());
+    std::vector<float> plain(plain_curve.coordinates().size() / 4), in_learned(plain.size());
+    std::memcpy(plain.data(), plain_curve.coordinates().data(), 4 * plain.size());
+    std::memcpy(in_learned.data(), learned_curve.coordinates().data(), 4 * plain.size());
+    for (size_t i = 0; i < plain.size(); ++i) ASSERT_NEAR(in_learned[i], plain[i], 1e-4) << i;
+
+    query = ClipQuery("learned", ids[raise.clip], raise.first_frame, raise.last_frame);
+    query.set_explain(true);
+    status = client.Search(query, &before);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_GE(before.results_size(), 3);
+    EXPECT_EQ(before.results(0).clip_id(), ids[raise.clip]);  // itself
+    for (const v1::SearchResult& r : before.results()) {
+      double shares = 0, parts = 0;
+      for (const v1::JointShare& joint : r.explanation().joints()) {
+        shares += joint.share();
+        parts += joint.score();
+      }
+      EXPECT_NEAR(shares, r.explanation().full_score() > 0 ? 1.0 : 0.0, 1e-9);
+      EXPECT_NEAR(parts, r.explanation().full_score(), 1e-9);
+    }
+  }
+  EXPECT_EQ(server->Stop(SIGTERM), 0);
+
+  server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  v1::GetSpaceRequest get;
+  get.set_name("learned");
+  v1::Space after_restart;
+  ASSERT_TRUE(client.spaces().GetSpace(client.Context().get(), get, &after_restart).ok());
+  EXPECT_EQ(after_restart.report().SerializeAsString(), learned.report().SerializeAsString());
+  v1::SearchResponse after;
+  ASSERT_TRUE(client.Search(query, &after).ok());
+  ExpectSameResults(after, before);
 }
 
 TEST_F(ServerTest, BadPropagationsGetTheirStatusCodes) {

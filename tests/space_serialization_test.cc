@@ -75,7 +75,7 @@ TEST_F(SpaceSerializationTest, RoundTripIsExact) {
 
 TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
   EXPECT_EQ(bytes_.substr(0, 8), "MDBSPACE");
-  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x02\x00\x00\x00", 4));
+  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x03\x00\x00\x00", 4));
   uint64_t payload = 0;
   for (int i = 0; i < 8; ++i) payload |= uint64_t{static_cast<uint8_t>(bytes_[12 + i])} << (8 * i);
   EXPECT_EQ(payload, bytes_.size() - kHeaderSize - 4);
@@ -83,11 +83,21 @@ TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
   EXPECT_EQ(Crc32(""), 0u);
 }
 
+// `bytes` of the current version as version 2 wrote them: without the search-transform flag at
+// the end of the payload.
+std::string AsVersionTwo(std::string bytes) {
+  bytes.erase(bytes.size() - 4 - 1, 1);
+  bytes[8] = 2;
+  const uint64_t payload = bytes.size() - kHeaderSize - 4;
+  for (int i = 0; i < 8; ++i) bytes[12 + i] = static_cast<char>(payload >> (8 * i));
+  return bytes;
+}
+
 // A file of format 1 (written before the root velocity) reads as a space without it.
 TEST_F(SpaceSerializationTest, VersionOneReadsAsWithoutRootVelocity) {
   const MotionSpace plain = *MotionSpace::Build({{"walk.bvh", clip_, FrameRange{5, 50}}},
                                                 {.pose = {.root_velocity = false}});
-  std::string bytes = SerializeSpace(plain);
+  std::string bytes = AsVersionTwo(SerializeSpace(plain));
   // Version 1 lacks the root-velocity flag and weight that follow the metric.
   ByteWriter skeleton;
   WriteSkeleton(plain.skeleton(), skeleton);
@@ -106,6 +116,35 @@ TEST_F(SpaceSerializationTest, VersionOneReadsAsWithoutRootVelocity) {
   EXPECT_FALSE(ParseSpace(Resealed(bytes)).ok());
 }
 
+// A learned metric's search transform (core/space/learned_metric.h) survives exactly; a file of
+// format 2 reads as a space without one; a transform that cannot be inverted is refused.
+TEST_F(SpaceSerializationTest, SearchTransformRoundTripsAndVersionTwoHasNone) {
+  RowMatrixXd transform = RowMatrixXd::Identity(space_.dims(), space_.dims());
+  transform(0, 1) = 0.25;
+  transform(2, 2) = 1.0 / 3;
+  const absl::StatusOr<MotionSpace> learned = space_.WithSearchTransform(transform);
+  ASSERT_TRUE(learned.ok()) << learned.status();
+  const std::string bytes = SerializeSpace(*learned);
+  const absl::StatusOr<MotionSpace> parsed = ParseSpace(bytes);
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  EXPECT_EQ(parsed->data().search_transform, transform);
+  EXPECT_TRUE((parsed->search_transform_inverse() * transform)
+                  .isApprox(RowMatrixXd::Identity(space_.dims(), space_.dims()), 1e-12));
+  EXPECT_EQ(SerializeSpace(*parsed), bytes);
+
+  const absl::StatusOr<MotionSpace> old = ParseSpace(Resealed(AsVersionTwo(bytes_)));
+  ASSERT_TRUE(old.ok()) << old.status();
+  EXPECT_EQ(old->data().search_transform.size(), 0);
+  EXPECT_EQ(old->search_transform_inverse().size(), 0);
+  EXPECT_EQ(old->data().basis, space_.data().basis);
+
+  transform.row(1) = transform.row(0);
+  EXPECT_EQ(space_.WithSearchTransform(transform).status().message(),
+            "space search transform must be finite and invertible");
+  EXPECT_THAT(space_.WithSearchTransform(RowMatrixXd::Identity(2, 2)).status().message(),
+              HasSubstr("search transform"));
+}
+
 TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
   std::string magic = bytes_;
   magic[0] = 'X';
@@ -114,9 +153,9 @@ TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
   EXPECT_THAT(ParseSpace("BVH HIERARCHY").status().message(), HasSubstr("bad magic"));
 
   std::string version = bytes_;
-  version[8] = 3;
+  version[8] = 4;
   EXPECT_EQ(ParseSpace(version).status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 3 is not supported"));
+  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 4 is not supported"));
 
   for (const size_t at : {kHeaderSize, bytes_.size() / 2, bytes_.size() - 5, bytes_.size() - 1}) {
     std::string flipped = bytes_;
@@ -137,7 +176,8 @@ TEST_F(SpaceSerializationTest, RejectsEveryTruncationAndTrailingBytes) {
 TEST_F(SpaceSerializationTest, RejectsSealedButInconsistentContents) {
   // A basis entry scaled: the checksum is right, the space is not.
   std::string scaled = bytes_;
-  const size_t basis_end = scaled.size() - 4 - (4 + 4 + 8 + 4 + 4);  // training range, checksum
+  // Checksum, search-transform flag, training range.
+  const size_t basis_end = scaled.size() - 4 - 1 - (4 + 4 + 8 + 4 + 4);
   scaled[basis_end - 1] ^= 0x40;  // an exponent bit of the last basis entry
   EXPECT_THAT(ParseSpace(Resealed(scaled)).status().message(), HasSubstr("orthonormal"));
 

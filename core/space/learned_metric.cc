@@ -9,19 +9,14 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
 
 namespace motiondb {
 namespace {
 
 absl::Status CheckExamples(absl::Span<const LabelledCurve> examples,
                            const LearnedMetricOptions& options) {
-  if (!(options.shrink >= 0 && options.shrink < 1)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("shrink: ", options.shrink, " is outside [0, 1)"));
-  }
-  if (options.partners < 1) {
-    return absl::InvalidArgumentError(absl::StrCat("partners: ", options.partners, " is below 1"));
-  }
+  MOTIONDB_RETURN_IF_ERROR(ValidateLearnedMetricOptions(options));
   if (examples.empty()) return absl::InvalidArgumentError("examples: none given");
   const Eigen::Index dims = examples.front().coordinates->cols();
   for (size_t e = 0; e < examples.size(); ++e) {
@@ -87,12 +82,31 @@ Eigen::MatrixXd AlignedDifferenceScatter(const Eigen::MatrixXd& a, const Eigen::
 
 }  // namespace
 
+absl::Status ValidateLearnedMetricOptions(const LearnedMetricOptions& options) {
+  if (!(options.shrink >= 0 && options.shrink < 1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("shrink: ", options.shrink, " is outside [0, 1)"));
+  }
+  if (options.partners < 1) {
+    return absl::InvalidArgumentError(absl::StrCat("partners: ", options.partners, " is below 1"));
+  }
+  if (options.max_frames < 2) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_frames: ", options.max_frames, " is below 2"));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<Eigen::MatrixXd> FitLearnedMetric(absl::Span<const LabelledCurve> examples,
                                                  const LearnedMetricOptions& options) {
-  if (absl::Status checked = CheckExamples(examples, options); !checked.ok()) return checked;
+  MOTIONDB_RETURN_IF_ERROR(CheckExamples(examples, options));
   const Eigen::Index dims = examples.front().coordinates->cols();
   std::vector<Eigen::MatrixXd> curves(examples.size());
-  for (size_t e = 0; e < examples.size(); ++e) curves[e] = examples[e].coordinates->cast<double>();
+  for (size_t e = 0; e < examples.size(); ++e) {
+    const RowMatrixXf& rows = *examples[e].coordinates;
+    const Eigen::Index step = (rows.rows() + options.max_frames - 1) / options.max_frames;
+    curves[e] = rows(Eigen::seq(0, Eigen::last, step), Eigen::all).cast<double>();
+  }
 
   // The examples' frames' covariance, and the groups' aligned differences, one share a pair.
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(dims);

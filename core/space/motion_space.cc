@@ -5,6 +5,7 @@
 #include <utility>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -103,6 +104,14 @@ absl::Status CheckData(const SpaceData& data) {
   const RowMatrixXd gram = data.basis.transpose() * data.basis;
   if (!gram.isIdentity(kStoredTolerance)) {
     return absl::InvalidArgumentError("space basis is not orthonormal");
+  }
+  if (data.search_transform.size() > 0) {
+    MOTIONDB_RETURN_IF_ERROR(CheckShape("search transform", data.search_transform.rows(),
+                                        data.search_transform.cols(), dims, dims));
+    if (!data.search_transform.allFinite() ||
+        Eigen::FullPivLU<RowMatrixXd>(data.search_transform).rank() < dims) {
+      return absl::InvalidArgumentError("space search transform must be finite and invertible");
+    }
   }
   for (const TrainingSource& source : data.training) {
     if (source.frames.first < 0 || source.frames.last < source.frames.first) {
@@ -311,6 +320,13 @@ MotionSpace::MotionSpace(SpaceData data)
   project_offset_ = -data_.mean.transpose() * data_.basis;
   unproject_ = data_.basis.transpose() * pose_weights_.cwiseInverse().asDiagonal();
   unproject_offset_ = data_.mean.cwiseQuotient(pose_weights_).transpose();
+  if (data_.search_transform.size() > 0) search_transform_inverse_ = data_.search_transform.inverse();
+}
+
+absl::StatusOr<MotionSpace> MotionSpace::WithSearchTransform(RowMatrixXd transform) const {
+  SpaceData data = data_;
+  data.search_transform = std::move(transform);
+  return FromData(std::move(data));
 }
 
 Eigen::VectorXd MotionSpace::ExplainedVariance() const {

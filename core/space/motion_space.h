@@ -112,6 +112,9 @@ struct SpaceData {
   RowMatrixXd basis;              // dims x dims, orthonormal; column i is dimension i
   Eigen::VectorXd eigenvalues;    // dims, decreasing: the weighted variance along each column
   std::vector<TrainingSource> training;
+  // dims x dims, invertible, or empty: a learned metric (core/space/learned_metric.h) that search
+  // coordinates are multiplied by (core/space/search_coordinates.h).
+  RowMatrixXd search_transform;
 };
 
 // Joint-angle error (radians, over every joint of every frame) of a reconstruction from the
@@ -142,6 +145,9 @@ class MotionSpace {
   // Checks that the parts are consistent (shapes, finite values, positive weights, orthonormal
   // basis), e.g. after reading them from storage.
   static absl::StatusOr<MotionSpace> FromData(SpaceData data);
+  // This space with its search coordinates multiplied by `transform` (dims() x dims(), finite,
+  // invertible): a learned metric, core/space/learned_metric.h. Projections are unchanged.
+  absl::StatusOr<MotionSpace> WithSearchTransform(RowMatrixXd transform) const;
 
   const SpaceData& data() const { return data_; }
   const Skeleton& skeleton() const { return *data_.skeleton; }
@@ -149,6 +155,9 @@ class MotionSpace {
   int dims() const { return static_cast<int>(data_.mean.size()); }
   // The weight of each pose-vector number: joint weights repeated 3 times, then the yaw rate's.
   const Eigen::VectorXd& pose_weights() const { return pose_weights_; }
+  // The inverse of data().search_transform (empty without one): search coordinates times it are
+  // the metric-scaled projection.
+  const RowMatrixXd& search_transform_inverse() const { return search_transform_inverse_; }
   // Fraction of the training variance along each dimension; sums to 1.
   Eigen::VectorXd ExplainedVariance() const;
 
@@ -198,6 +207,7 @@ class MotionSpace {
   Eigen::RowVectorXd project_offset_;
   RowMatrixXd unproject_;
   Eigen::RowVectorXd unproject_offset_;
+  RowMatrixXd search_transform_inverse_;
 };
 
 }  // namespace motiondb

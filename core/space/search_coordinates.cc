@@ -6,10 +6,16 @@ namespace motiondb {
 
 absl::StatusOr<RowMatrixXf> SearchCoordinates(const MotionSpace& space, const Clip& clip,
                                               int dims) {
-  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd curve, space.ProjectClip(clip, dims));
+  const RowMatrixXd& transform = space.data().search_transform;
+  // A learned metric mixes every dimension into each of its own: all are projected then.
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd curve,
+                            space.ProjectClip(clip, transform.size() > 0 ? -1 : dims));
   MOTIONDB_ASSIGN_OR_RETURN(const Eigen::VectorXd scales,
                             space.MetricScales(static_cast<int>(curve.cols())));
-  return (curve.array().rowwise() * scales.transpose().array()).cast<float>().matrix();
+  const RowMatrixXd scaled = curve.array().rowwise() * scales.transpose().array();
+  if (transform.size() == 0) return scaled.cast<float>();
+  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::VectorXd kept, space.MetricScales(dims));  // checks dims
+  return (scaled * transform.leftCols(kept.size())).cast<float>();
 }
 
 }  // namespace motiondb

@@ -1,6 +1,7 @@
-// A clip's coordinates for searching in a space: its motion curve at the space rate, truncated
-// to `dims` dimensions and multiplied by the space's metric scales, as float32, so that plain
-// Euclidean distance between rows is the space's pose metric.
+// A clip's coordinates for searching in a space: its motion curve at the space rate, multiplied by
+// the space's metric scales (and by its search transform, a learned metric, when it has one),
+// truncated to `dims` dimensions, as float32, so that plain Euclidean distance between rows is
+// the space's search metric.
 #ifndef MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_
 #define MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_
 

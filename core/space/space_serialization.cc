@@ -20,6 +20,7 @@
 //   joints f64 joint weights, joints x 4 f64 references (w, x, y, z)
 //   u32 dims, dims f64 mean, dims f64 eigenvalues, dims x dims f64 basis (row-major)
 //   u32 training ranges; per range: str source, i32 first frame, i32 last frame
+//   [version 3 on: u8 search transform, [dims x dims f64 search transform (row-major)]]
 
 namespace motiondb {
 namespace {
@@ -76,6 +77,14 @@ absl::StatusOr<SpaceData> ReadPayload(ByteReader& in, uint32_t version) {
     MOTIONDB_ASSIGN_OR_RETURN(source.frames.first, in.I32("training first frame"));
     MOTIONDB_ASSIGN_OR_RETURN(source.frames.last, in.I32("training last frame"));
   }
+  if (version >= 3) {
+    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t has_transform, in.U8("search-transform flag"));
+    if (has_transform != 0) {
+      data.search_transform.resize(dims, dims);
+      MOTIONDB_RETURN_IF_ERROR(in.F64s("search transform", data.search_transform.data(),
+                                       data.search_transform.size()));
+    }
+  }
   return data;
 }
 
@@ -104,6 +113,8 @@ std::string SerializeSpace(const MotionSpace& space) {
     payload.I32(source.frames.first);
     payload.I32(source.frames.last);
   }
+  payload.U8(data.search_transform.size() > 0 ? 1 : 0);
+  payload.F64s(data.search_transform.data(), data.search_transform.size());
 
   ByteWriter file;
   file.bytes().append(kMagic.data(), kMagic.size());

@@ -22,8 +22,9 @@
 
 namespace motiondb {
 
-// 2 added the root velocity (flag and weight after the metric); 1 is read as without it.
-inline constexpr uint32_t kSpaceFormatVersion = 2;
+// 2 added the root velocity (flag and weight after the metric); 1 is read as without it. 3 added
+// the search transform (a learned metric, after the training ranges); 1 and 2 are read as without.
+inline constexpr uint32_t kSpaceFormatVersion = 3;
 
 std::string SerializeSpace(const MotionSpace& space);
 // Errors are DATA_LOSS for damaged bytes (magic, checksum, truncation) and INVALID_ARGUMENT for

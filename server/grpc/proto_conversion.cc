@@ -277,6 +277,11 @@ absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request) {
     if (options.pose.root_velocity) options.root_velocity_weight = request.root_velocity_weight();
   }
   MOTIONDB_ASSIGN_OR_RETURN(options.metric, FromProto(request.metric()));
+  if (request.has_learned_metric()) {
+    LearnedMetricOptions& learned = out.learned_metric.emplace();
+    if (request.learned_metric().has_shrink()) learned.shrink = request.learned_metric().shrink();
+    MOTIONDB_RETURN_IF_ERROR(Prefixed("learned_metric", ValidateLearnedMetricOptions(learned)));
+  }
   return out;
 }
 
@@ -478,6 +483,12 @@ void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out) {
     measured->set_max_rad(error.max_rad);
   }
   out->set_projected_clips(report.projected_clips);
+  if (report.learned_metric_examples > 0) {
+    v1::LearnedMetricReport* learned = out->mutable_learned_metric();
+    learned->set_shrink(report.learned_metric_shrink);
+    learned->set_examples(report.learned_metric_examples);
+    learned->set_descriptors(report.learned_metric_descriptors);
+  }
   out->set_build_ms(report.build_ms);
 }
 
