@@ -3,8 +3,8 @@
 // shrunk, and the coordinates are rotated again so that their first dimensions, the ones the
 // search's seeds and warps use, carry the most variance in the new metric: an LDA-like ratio of
 // the examples' spread to the groups' spread. Measured on bandai1's 15 styles (each style's
-// queries in a metric fitted on the other 14): leave-style-out precision@5 0.648 -> 0.779 at 5
-// warp dimensions and 0.804 at 10 (bench/RESULTS.md "A metric learned from the labels").
+// queries in a metric fitted on the other 14): leave-style-out precision@5 0.648 -> 0.806 at 5
+// warp dimensions and 0.828 at 10 (bench/RESULTS.md "A metric learned from the labels").
 #ifndef MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 #define MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 
@@ -21,7 +21,7 @@ namespace motiondb {
 struct LearnedMetricOptions {
   // How far the groups' differences are whitened, in [0, 1): 0 keeps the coordinates' own metric
   // (the result is a rotation); towards 1 a direction counts the less the more groups differ
-  // along it. Of 0.25-0.99 on bandai1, 0.95 was best (0.9 and 0.99 within 0.01 of it); 1 would
+  // along it. Of 0.5-0.99 on bandai1, 0.95 was best (0.9 and 0.99 within 0.015 of it); 1 would
   // make directions in which no two groups differ infinitely long.
   double shrink = 0.95;
   // Each example is aligned with at most this many later examples of its label in other groups:
