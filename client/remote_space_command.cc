@@ -84,22 +84,23 @@ nlohmann::json SpaceJson(const v1::Space& space) {
   for (const v1::ReconstructionError& e : report.reconstruction_error()) {
     errors.push_back({{"dims", e.dims()}, {"mean_rad", e.mean_rad()}, {"max_rad", e.max_rad()}});
   }
-  nlohmann::json out = {{"name", space.name()},
-          {"space_id", space.space_id()},
-          {"skeleton_id", space.skeleton_id()},
-          {"dims", report.dims()},
-          {"sample_rate", report.sample_rate()},
-          {"heading_removed", report.heading_removed()},
-          {"root_velocity_weight", report.root_velocity_weight()},
-          {"training_frames", report.training_frames()},
-          {"projected_clips", report.projected_clips()},
-          // The resident index, current after later ingests and deletes; the report is the
-          // build's.
-          {"clips", space.index().clips()},
-          {"frames", space.index().frames()},
-          {"explained_variance", std::vector<double>(report.explained_variance().begin(),
-                                                     report.explained_variance().end())},
-          {"reconstruction_error", errors}};
+  nlohmann::json out = {
+      {"name", space.name()},
+      {"space_id", space.space_id()},
+      {"skeleton_id", space.skeleton_id()},
+      {"dims", report.dims()},
+      {"sample_rate", report.sample_rate()},
+      {"heading_removed", report.heading_removed()},
+      {"root_velocity_weight", report.root_velocity_weight()},
+      {"training_frames", report.training_frames()},
+      {"projected_clips", report.projected_clips()},
+      // The resident index, current after later ingests and deletes; the report is the
+      // build's.
+      {"clips", space.index().clips()},
+      {"frames", space.index().frames()},
+      {"explained_variance",
+       std::vector<double>(report.explained_variance().begin(), report.explained_variance().end())},
+      {"reconstruction_error", errors}};
   if (report.has_learned_metric()) {
     out["learned_metric"] = {{"shrink", report.learned_metric().shrink()},
                              {"examples", report.learned_metric().examples()},
@@ -221,7 +222,7 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
                    "with --learned-metric: how far, in [0, 1)")
       ->type_name("S")
       ->default_str(absl::StrCat(LearnedMetricOptions().shrink))
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(NumberAtLeast(0))  // and below 1, which the server checks
       ->needs("--learned-metric");
 
   commands.AddServer(

@@ -31,7 +31,8 @@ absl::StatusOr<FittedMetric> FitMetricOnLabels(storage::Database& database,
     }
   }
 
-  std::deque<RowMatrixXf> ranges;  // stable addresses for the examples
+  // The labelled ranges' aligned frames only (a label may cover a long take), at stable addresses.
+  std::deque<RowMatrixXf> ranges;
   std::vector<LabelledCurve> examples;
   for (const auto& [clip_id, clip_labels] : by_clip) {
     if (should_stop && should_stop()) {
@@ -45,7 +46,8 @@ absl::StatusOr<FittedMetric> FitMetricOnLabels(storage::Database& database,
     for (const storage::LabelRecord* label : clip_labels) {
       const auto [first, last] = conversion.ToSpace(
           {static_cast<int>(label->first_frame), static_cast<int>(label->last_frame)});
-      ranges.push_back(coordinates.middleRows(first, last - first + 1));
+      ranges.push_back(
+          AlignedFrames(coordinates.middleRows(first, last - first + 1), options.max_frames));
       examples.push_back({&ranges.back(), label->descriptor, absl::StrCat(clip_id)});
     }
   }
@@ -58,8 +60,9 @@ absl::StatusOr<FittedMetric> FitMetricOnLabels(storage::Database& database,
         ") on at least two clips of the space's skeleton; of its ", examples.size(),
         " such labels, no descriptor is on two clips"));
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const Eigen::MatrixXd transform,
-                            Prefixed("learned_metric", FitLearnedMetric(examples, options)));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const Eigen::MatrixXd transform,
+      Prefixed("learned_metric", FitLearnedMetric(examples, options, should_stop)));
   return FittedMetric{transform, static_cast<int64_t>(examples.size()),
                       static_cast<int64_t>(clips_of.size())};
 }

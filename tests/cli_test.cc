@@ -639,6 +639,9 @@ TEST_F(CliServerTest, SpaceCreateWithALearnedMetric) {
       Remote({"space", "create", "styles", "--learned-metric-shrink", "0.5"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("--learned-metric-shrink requires --learned-metric"));
+  r = Remote({"space", "create", "styles", "--learned-metric", "--learned-metric-shrink", "1"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("INVALID_ARGUMENT: --learned-metric-shrink: 1 is outside [0, 1)"));
   ASSERT_EQ(Remote({"label", "add", "walk54:0-20", "step"}).exit_code, 0);
   r = Remote({"space", "create", "styles", "--learned-metric"});
   EXPECT_EQ(r.exit_code, 1);

@@ -124,9 +124,23 @@ TEST(LearnedMetric, RefusesWhatItCannotFitOn) {
   EXPECT_EQ(FitLearnedMetric(mixed).status().message(),
             "examples[3]: 5 x 2 coordinates; every example needs frames of 3 dimensions");
 
+  EXPECT_EQ(FitLearnedMetric(library.examples, {}, [] { return true; }).status().code(),
+            absl::StatusCode::kCancelled);
+
   library.curves[5](7, 1) = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(FitLearnedMetric(library.examples).status().message(),
             "examples[5]: its coordinates hold a non-finite number");
+}
+
+// Every k-th frame, at most the number asked for, from the first.
+TEST(LearnedMetric, AlignedFramesAreEveryKthAtMostTheNumberAsked) {
+  RowMatrixXf rows(31, 2);
+  for (int r = 0; r < 31; ++r) rows.row(r) << static_cast<float>(r), 0.0f;
+  const RowMatrixXf every_fourth = AlignedFrames(rows, 10);
+  ASSERT_EQ(every_fourth.rows(), 8);
+  for (int r = 0; r < 8; ++r) EXPECT_EQ(every_fourth(r, 0), 4.0f * r);
+  EXPECT_EQ(AlignedFrames(rows.topRows(30), 10).rows(), 10);
+  EXPECT_EQ(AlignedFrames(rows, 300), rows);
 }
 
 // A space with a search transform gives search coordinates that are its plain ones times the

@@ -76,6 +76,37 @@ TEST_F(SearchExplanationTest, SplitsTheDistanceAsTheWeightedPosesDiffer) {
   EXPECT_DOUBLE_EQ(explained->max_speed, 1.0);
 }
 
+// In a space with a learned metric (search coordinates = the plain ones x a transform that is not
+// orthogonal), the explanation is of the space's own distance: the same as the plain space's.
+TEST_F(SearchExplanationTest, ALearnedMetricIsTurnedBackIntoTheSpacesOwn) {
+  RowMatrixXd transform = RowMatrixXd::Identity(space_.dims(), space_.dims());
+  for (int d = 0; d < space_.dims(); ++d) {
+    transform(d, d) = 0.5 + 0.1 * d;
+    transform((d + 3) % space_.dims(), d) = 0.4;  // a row mixed into a column: not symmetric
+  }
+  const MotionSpace learned = *space_.WithSearchTransform(transform);
+  const RowMatrixXf query = *SearchCoordinates(learned, a_);
+  const RowMatrixXf clip = *SearchCoordinates(learned, b_);
+  std::vector<int64_t> path(40);
+  std::iota(path.begin(), path.end(), 20);
+  const SearchExplanation plain = *ExplainHit(
+      space_, CoordinateView::Of(query_).middle_rows(10, 40), CoordinateView::Of(clip_), path);
+  const SearchExplanation turned_back = *ExplainHit(
+      learned, CoordinateView::Of(query).middle_rows(10, 40), CoordinateView::Of(clip), path);
+  EXPECT_NEAR(turned_back.full_score, plain.full_score, 1e-4 * plain.full_score);
+  ASSERT_EQ(turned_back.joints.size(), plain.joints.size());
+  for (size_t g = 0; g < plain.joints.size(); ++g) {
+    EXPECT_EQ(turned_back.joints[g].name, plain.joints[g].name) << g;
+    EXPECT_NEAR(turned_back.joints[g].share, plain.joints[g].share, 1e-4) << g;
+  }
+  // Coordinates cut short cannot be turned back.
+  EXPECT_EQ(ExplainHit(learned, CoordinateView{query.data(), 5, 3}, CoordinateView::Of(clip),
+                       {0, 1, 2, 3, 4})
+                .status()
+                .code(),
+            absl::StatusCode::kInternal);
+}
+
 TEST_F(SearchExplanationTest, SpeedsFollowThePath) {
   // The first half at the query's speed, the second twice as fast.
   const CoordinateView query = CoordinateView::Of(query_).middle_rows(0, 21);

@@ -75,7 +75,7 @@ TEST_F(SpaceSerializationTest, RoundTripIsExact) {
 
 TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
   EXPECT_EQ(bytes_.substr(0, 8), "MDBSPACE");
-  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x03\x00\x00\x00", 4));
+  EXPECT_EQ(bytes_.substr(8, 4), std::string("\x02\x00\x00\x00", 4));  // no search transform
   uint64_t payload = 0;
   for (int i = 0; i < 8; ++i) payload |= uint64_t{static_cast<uint8_t>(bytes_[12 + i])} << (8 * i);
   EXPECT_EQ(payload, bytes_.size() - kHeaderSize - 4);
@@ -83,21 +83,11 @@ TEST_F(SpaceSerializationTest, LayoutIsLittleEndianWithMagicAndVersion) {
   EXPECT_EQ(Crc32(""), 0u);
 }
 
-// `bytes` of the current version as version 2 wrote them: without the search-transform flag at
-// the end of the payload.
-std::string AsVersionTwo(std::string bytes) {
-  bytes.erase(bytes.size() - 4 - 1, 1);
-  bytes[8] = 2;
-  const uint64_t payload = bytes.size() - kHeaderSize - 4;
-  for (int i = 0; i < 8; ++i) bytes[12 + i] = static_cast<char>(payload >> (8 * i));
-  return bytes;
-}
-
 // A file of format 1 (written before the root velocity) reads as a space without it.
 TEST_F(SpaceSerializationTest, VersionOneReadsAsWithoutRootVelocity) {
   const MotionSpace plain = *MotionSpace::Build({{"walk.bvh", clip_, FrameRange{5, 50}}},
                                                 {.pose = {.root_velocity = false}});
-  std::string bytes = AsVersionTwo(SerializeSpace(plain));
+  std::string bytes = SerializeSpace(plain);
   // Version 1 lacks the root-velocity flag and weight that follow the metric.
   ByteWriter skeleton;
   WriteSkeleton(plain.skeleton(), skeleton);
@@ -116,9 +106,9 @@ TEST_F(SpaceSerializationTest, VersionOneReadsAsWithoutRootVelocity) {
   EXPECT_FALSE(ParseSpace(Resealed(bytes)).ok());
 }
 
-// A learned metric's search transform (core/space/learned_metric.h) survives exactly; a file of
-// format 2 reads as a space without one; a transform that cannot be inverted is refused.
-TEST_F(SpaceSerializationTest, SearchTransformRoundTripsAndVersionTwoHasNone) {
+// A learned metric's search transform (core/space/learned_metric.h) survives exactly, in format
+// 3; a space without one is written in format 2; a transform that cannot be inverted is refused.
+TEST_F(SpaceSerializationTest, SearchTransformRoundTripsAndPlainSpacesStayVersionTwo) {
   RowMatrixXd transform = RowMatrixXd::Identity(space_.dims(), space_.dims());
   transform(0, 1) = 0.25;
   transform(2, 2) = 1.0 / 3;
@@ -132,11 +122,22 @@ TEST_F(SpaceSerializationTest, SearchTransformRoundTripsAndVersionTwoHasNone) {
                   .isApprox(RowMatrixXd::Identity(space_.dims(), space_.dims()), 1e-12));
   EXPECT_EQ(SerializeSpace(*parsed), bytes);
 
-  const absl::StatusOr<MotionSpace> old = ParseSpace(Resealed(AsVersionTwo(bytes_)));
-  ASSERT_TRUE(old.ok()) << old.status();
-  EXPECT_EQ(old->data().search_transform.size(), 0);
-  EXPECT_EQ(old->search_transform_inverse().size(), 0);
-  EXPECT_EQ(old->data().basis, space_.data().basis);
+  EXPECT_EQ(bytes.substr(8, 4), std::string("\x03\x00\x00\x00", 4));
+  // A space without one is written as version 2 (above), and reads back without one.
+  const absl::StatusOr<MotionSpace> plain = ParseSpace(bytes_);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+  EXPECT_EQ(plain->data().search_transform.size(), 0);
+  EXPECT_EQ(plain->search_transform_inverse().size(), 0);
+  // Version 3 with the flag at 0 reads as without one too.
+  std::string flagged = bytes_;
+  flagged.insert(flagged.size() - 4, 1, '\0');
+  flagged[8] = 3;
+  const uint64_t payload = flagged.size() - kHeaderSize - 4;
+  for (int i = 0; i < 8; ++i) flagged[12 + i] = static_cast<char>(payload >> (8 * i));
+  const absl::StatusOr<MotionSpace> unflagged = ParseSpace(Resealed(flagged));
+  ASSERT_TRUE(unflagged.ok()) << unflagged.status();
+  EXPECT_EQ(unflagged->data().search_transform.size(), 0);
+  EXPECT_EQ(unflagged->data().basis, space_.data().basis);
 
   transform.row(1) = transform.row(0);
   EXPECT_EQ(space_.WithSearchTransform(transform).status().message(),
@@ -176,8 +177,7 @@ TEST_F(SpaceSerializationTest, RejectsEveryTruncationAndTrailingBytes) {
 TEST_F(SpaceSerializationTest, RejectsSealedButInconsistentContents) {
   // A basis entry scaled: the checksum is right, the space is not.
   std::string scaled = bytes_;
-  // Checksum, search-transform flag, training range.
-  const size_t basis_end = scaled.size() - 4 - 1 - (4 + 4 + 8 + 4 + 4);
+  const size_t basis_end = scaled.size() - 4 - (4 + 4 + 8 + 4 + 4);  // training range, checksum
   scaled[basis_end - 1] ^= 0x40;  // an exponent bit of the last basis entry
   EXPECT_THAT(ParseSpace(Resealed(scaled)).status().message(), HasSubstr("orthonormal"));
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -97,15 +99,21 @@ absl::Status ValidateLearnedMetricOptions(const LearnedMetricOptions& options) {
   return absl::OkStatus();
 }
 
+RowMatrixXf AlignedFrames(const Eigen::Ref<const RowMatrixXf>& rows, int max_frames) {
+  const Eigen::Index step = (rows.rows() + max_frames - 1) / std::max(max_frames, 1);
+  return rows(Eigen::seq(0, Eigen::last, std::max<Eigen::Index>(step, 1)), Eigen::all);
+}
+
 absl::StatusOr<Eigen::MatrixXd> FitLearnedMetric(absl::Span<const LabelledCurve> examples,
-                                                 const LearnedMetricOptions& options) {
+                                                 const LearnedMetricOptions& options,
+                                                 const std::function<bool()>& should_stop) {
   MOTIONDB_RETURN_IF_ERROR(CheckExamples(examples, options));
   const Eigen::Index dims = examples.front().coordinates->cols();
   std::vector<Eigen::MatrixXd> curves(examples.size());
+  std::map<std::string, std::vector<size_t>> of_label;  // in increasing order
   for (size_t e = 0; e < examples.size(); ++e) {
-    const RowMatrixXf& rows = *examples[e].coordinates;
-    const Eigen::Index step = (rows.rows() + options.max_frames - 1) / options.max_frames;
-    curves[e] = rows(Eigen::seq(0, Eigen::last, step), Eigen::all).cast<double>();
+    curves[e] = AlignedFrames(*examples[e].coordinates, options.max_frames).cast<double>();
+    of_label[examples[e].label].push_back(e);
   }
 
   // The examples' frames' covariance, and the groups' aligned differences, one share a pair.
@@ -115,16 +123,18 @@ absl::StatusOr<Eigen::MatrixXd> FitLearnedMetric(absl::Span<const LabelledCurve>
   double frames = 0;
   int pairs = 0;
   for (size_t e = 0; e < curves.size(); ++e) {
+    if (should_stop && should_stop()) {
+      return absl::CancelledError("stopped by its caller while fitting the learned metric");
+    }
     sum += curves[e].colwise().sum().transpose();
     outer.noalias() += curves[e].transpose() * curves[e];
     frames += static_cast<double>(curves[e].rows());
+    const std::vector<size_t>& same = of_label[examples[e].label];
     int partners = 0;
-    for (size_t other = e + 1; other < curves.size() && partners < options.partners; ++other) {
-      if (examples[other].label != examples[e].label ||
-          examples[other].group == examples[e].group) {
-        continue;
-      }
-      groups += AlignedDifferenceScatter(curves[e], curves[other]);
+    for (auto other = std::upper_bound(same.begin(), same.end(), e);
+         other != same.end() && partners < options.partners; ++other) {
+      if (examples[*other].group == examples[e].group) continue;
+      groups += AlignedDifferenceScatter(curves[e], curves[*other]);
       ++pairs;
       ++partners;
     }

@@ -8,6 +8,7 @@
 #ifndef MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 #define MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 
+#include <functional>
 #include <string>
 
 #include <Eigen/Core>
@@ -46,9 +47,15 @@ struct LabelledCurve {
 // D x D, D the examples' dimensions: search coordinates (rows) times it are the learned metric's
 // coordinates, ordered by decreasing variance over the examples' frames and scaled so that their
 // total variance is the original's. An error when the examples disagree on D, hold a non-finite
-// number, or include no two of one label in two groups.
+// number, or include no two of one label in two groups; CANCELLED when `should_stop`, asked
+// between examples, says so.
 absl::StatusOr<Eigen::MatrixXd> FitLearnedMetric(absl::Span<const LabelledCurve> examples,
-                                                 const LearnedMetricOptions& options = {});
+                                                 const LearnedMetricOptions& options = {},
+                                                 const std::function<bool()>& should_stop = {});
+
+// The frames of `rows` an example is aligned over: every k-th, at most `max_frames` (at least 1).
+// A caller holding many long examples may keep only these (the fit takes them as they are).
+RowMatrixXf AlignedFrames(const Eigen::Ref<const RowMatrixXf>& rows, int max_frames);
 
 }  // namespace motiondb
 

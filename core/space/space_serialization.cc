@@ -20,7 +20,8 @@
 //   joints f64 joint weights, joints x 4 f64 references (w, x, y, z)
 //   u32 dims, dims f64 mean, dims f64 eigenvalues, dims x dims f64 basis (row-major)
 //   u32 training ranges; per range: str source, i32 first frame, i32 last frame
-//   [version 3 on: u8 search transform, [dims x dims f64 search transform (row-major)]]
+//   [version 3 on: u8 search transform, [dims x dims f64 search transform (row-major)]]; a space
+//   without a search transform is written as version 2
 
 namespace motiondb {
 namespace {
@@ -81,8 +82,8 @@ absl::StatusOr<SpaceData> ReadPayload(ByteReader& in, uint32_t version) {
     MOTIONDB_ASSIGN_OR_RETURN(const uint8_t has_transform, in.U8("search-transform flag"));
     if (has_transform != 0) {
       data.search_transform.resize(dims, dims);
-      MOTIONDB_RETURN_IF_ERROR(in.F64s("search transform", data.search_transform.data(),
-                                       data.search_transform.size()));
+      MOTIONDB_RETURN_IF_ERROR(
+          in.F64s("search transform", data.search_transform.data(), data.search_transform.size()));
     }
   }
   return data;
@@ -113,12 +114,16 @@ std::string SerializeSpace(const MotionSpace& space) {
     payload.I32(source.frames.first);
     payload.I32(source.frames.last);
   }
-  payload.U8(data.search_transform.size() > 0 ? 1 : 0);
-  payload.F64s(data.search_transform.data(), data.search_transform.size());
+  // A space without a transform is written as version 2, which builds before 3 still read.
+  const bool transformed = data.search_transform.size() > 0;
+  if (transformed) {
+    payload.U8(1);
+    payload.F64s(data.search_transform.data(), data.search_transform.size());
+  }
 
   ByteWriter file;
   file.bytes().append(kMagic.data(), kMagic.size());
-  file.U32(kSpaceFormatVersion);
+  file.U32(transformed ? kSpaceFormatVersion : 2);
   file.U64(payload.bytes().size());
   file.bytes() += payload.bytes();
   file.U32(Crc32(file.bytes()));

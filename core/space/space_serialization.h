@@ -23,7 +23,8 @@
 namespace motiondb {
 
 // 2 added the root velocity (flag and weight after the metric); 1 is read as without it. 3 added
-// the search transform (a learned metric, after the training ranges); 1 and 2 are read as without.
+// the search transform (a learned metric, after the training ranges); 1 and 2 are read as without,
+// and a space without one is still written as 2, so that earlier builds read it.
 inline constexpr uint32_t kSpaceFormatVersion = 3;
 
 std::string SerializeSpace(const MotionSpace& space);

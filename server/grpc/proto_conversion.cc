@@ -280,7 +280,10 @@ absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request) {
   if (request.has_learned_metric()) {
     LearnedMetricOptions& learned = out.learned_metric.emplace();
     if (request.learned_metric().has_shrink()) learned.shrink = request.learned_metric().shrink();
-    MOTIONDB_RETURN_IF_ERROR(Prefixed("learned_metric", ValidateLearnedMetricOptions(learned)));
+    // "learned_metric.shrink: ...", the field's path, as the CLI names its flag by it.
+    if (const absl::Status valid = ValidateLearnedMetricOptions(learned); !valid.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("learned_metric.", valid.message()));
+    }
   }
   return out;
 }
