@@ -214,6 +214,7 @@ struct VariantFlags {
   std::vector<int> places;
   std::vector<int> neighbours;
   std::vector<int> windows;           // seeds by window (SeedSelection::kNearestWindows)
+  std::vector<double> window_epsilon;  // the default window seeds' approximate tree search
   std::vector<int> points;            // characteristic points (0: by the query's length)
   std::vector<double> second_anchor;  // SearchParams::second_anchor_scatter values
 };
@@ -237,6 +238,12 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     params.neighbours = count;
     variants.emplace_back(
         count == 0 ? "fast, window seeds" : absl::StrCat("fast, ", count, " window seeds"), params);
+  }
+  for (double epsilon : flags.window_epsilon) {
+    SearchParams params;
+    params.seed_selection = SeedSelection::kNearestWindows;
+    params.epsilon = static_cast<float>(epsilon);
+    variants.emplace_back(absl::StrCat("fast, window seeds, epsilon ", epsilon), params);
   }
   for (int count : flags.points) {
     SearchParams params;
@@ -420,6 +427,11 @@ int main(int argc, char** argv) {
                  "default)")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(0));
+  app.add_option("--window-epsilon", variants.window_epsilon,
+                 "also measure the fast search with the default window seeds found by an "
+                 "approximate tree search of these epsilons (SearchParams::epsilon)")
+      ->type_name("E ...")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--points", variants.points,
                  "also measure the fast search with these numbers of characteristic points (0: "
                  "one per action of the query)")
