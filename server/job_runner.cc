@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "util/parallel_for.h"
 #include "util/status_macros.h"
 
@@ -20,12 +21,6 @@ namespace {
 // crash to show roughly how far it got, rarely enough that the writes (each synced to disk)
 // cost the job nothing to speak of. Watchers and GetJob see every change at once, from memory.
 constexpr std::chrono::seconds kProgressWriteInterval{1};
-
-int64_t NowUnixMs() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // See the class comment: the worker yields the cores to the threads serving calls.
 void LowerThisThreadsPriority() {
@@ -157,7 +152,7 @@ absl::StatusOr<storage::JobRecord> JobRunner::Cancel(const std::string& job_id) 
     queue_.erase(queued);
     storage::JobRecord record = live->second.record;
     record.state = storage::JobState::kCancelled;
-    record.finished_unix_ms = NowUnixMs();
+    record.finished_unix_ms = absl::ToUnixMillis(absl::Now());
     EndLocked(record);
     lock.unlock();
     WriteRow(database_, record);
@@ -196,7 +191,7 @@ void JobRunner::RequestStop() {
       storage::JobRecord record = live_.at(job_id).record;
       record.state = storage::JobState::kInterrupted;
       record.error = "the server stopped before the job ran";
-      record.finished_unix_ms = NowUnixMs();
+      record.finished_unix_ms = absl::ToUnixMillis(absl::Now());
       queued.push_back(record);
     }
     queue_.clear();
@@ -244,7 +239,7 @@ void JobRunner::Run(const std::string& job_id) {
     std::lock_guard<std::mutex> lock(mutex_);
     Live& live = live_.at(job_id);
     live.record.state = storage::JobState::kRunning;
-    live.record.started_unix_ms = NowUnixMs();
+    live.record.started_unix_ms = absl::ToUnixMillis(absl::Now());
     record = live.record;
     request = live.request;
     changed_.notify_all();
@@ -276,7 +271,7 @@ void JobRunner::Run(const std::string& job_id) {
   absl::StatusOr<storage::PropagationOutput> output = RunPropagation(
       database_, registry_, runner_, scales_, request, job_id, ThreadsFor(options_.threads),
       [this] { return stop_running_.load(std::memory_order_relaxed); }, on_progress);
-  record.finished_unix_ms = NowUnixMs();
+  record.finished_unix_ms = absl::ToUnixMillis(absl::Now());
   if (stop_running_) {
     std::lock_guard<std::mutex> lock(mutex_);
     record.state = stopping_ ? storage::JobState::kInterrupted : storage::JobState::kCancelled;

@@ -1,12 +1,12 @@
 #include "server/label_catalog.h"
 
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <utility>
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -118,12 +118,6 @@ absl::Status ResolveRange(const NewLabel& label, const storage::ClipRecord& clip
   return absl::OkStatus();
 }
 
-int64_t NowUnixMs() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 }  // namespace
 
 absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
@@ -134,7 +128,7 @@ absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
         absl::StrCat("labels: at most ", kMaxLabelsPerBatch, " a call, got ", labels.size()));
   }
   // One time for the batch, so that what is returned is what was stored.
-  const int64_t now = NowUnixMs();
+  const int64_t now = absl::ToUnixMillis(absl::Now());
   ClipResolver clips(database);
   std::vector<storage::LabelRecord> records;
   records.reserve(labels.size());

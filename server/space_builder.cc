@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 #include "core/motion/resample.h"
 #include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
@@ -13,12 +14,6 @@
 
 namespace motiondb::server {
 namespace {
-
-int64_t NowUnixMs() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 absl::StatusOr<storage::ClipRecord> TrainingRecord(storage::Database& database, size_t index,
                                                    int64_t clip_id) {
@@ -152,8 +147,7 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   std::optional<FittedMetric> fitted;
   if (request.learned_metric) {
     MOTIONDB_ASSIGN_OR_RETURN(
-        fitted,
-        FitMetricOnLabels(database, built, clip_ids, *request.learned_metric, should_stop));
+        fitted, FitMetricOnLabels(database, built, clip_ids, *request.learned_metric, should_stop));
     MOTIONDB_ASSIGN_OR_RETURN(built, built.WithSearchTransform(fitted->transform));
   }
   auto space = std::make_shared<const MotionSpace>(std::move(built));
@@ -184,7 +178,7 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   result.record.name = request.name;
   result.record.skeleton_id = skeleton_id;
   result.record.version = 1;
-  result.record.created_unix_ms = NowUnixMs();
+  result.record.created_unix_ms = absl::ToUnixMillis(absl::Now());
   result.record.build_report_json = ReportToJson(report);
   result.space = std::move(space);
   return result;
