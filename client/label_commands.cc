@@ -258,7 +258,7 @@ absl::Status AddLabel(const AddFlags& flags, bool json, const ServerConnection& 
   return absl::OkStatus();
 }
 
-struct ListFlags {
+struct LabelListFlags {
   int64_t clip = 0;
   std::string descriptor;
   std::string origin;
@@ -266,7 +266,8 @@ struct ListFlags {
   PageFlags page;
 };
 
-absl::Status ListLabels(const ListFlags& flags, bool json, const ServerConnection& connection) {
+absl::Status ListLabels(const LabelListFlags& flags, bool json,
+                        const ServerConnection& connection) {
   v1::ListLabelsRequest request;
   request.set_clip_id(flags.clip);
   request.set_descriptor_name(flags.descriptor);
@@ -354,7 +355,7 @@ absl::Status ImportLabels(const std::string& path, bool json, const ServerConnec
   return absl::OkStatus();
 }
 
-struct ExportFlags {
+struct LabelExportFlags {
   std::string out;     // empty: stdout
   std::string format;  // empty: the extension of `out`, else csv
   int64_t clip = 0;
@@ -364,7 +365,8 @@ struct ExportFlags {
   std::string origin = "manual";
 };
 
-absl::Status ExportLabels(const ExportFlags& flags, bool json, const ServerConnection& connection) {
+absl::Status ExportLabels(const LabelExportFlags& flags, bool json,
+                          const ServerConnection& connection) {
   LabelFileFormat format = LabelFileFormat::kCsv;
   if (!flags.format.empty()) {
     format = flags.format == "json" ? LabelFileFormat::kJson : LabelFileFormat::kCsv;
@@ -432,7 +434,7 @@ void AddLabelAdd(Commands& commands) {
 
 void AddListAndFind(Commands& commands, CLI::App* labels) {
   const GlobalOptions& global = commands.global();
-  auto list = std::make_shared<ListFlags>();
+  auto list = std::make_shared<LabelListFlags>();
   CLI::App* lister = commands.AddServer(labels, "list", "list labels, in id order",
                                         [list, &global](const ServerConnection& connection) {
                                           return ListLabels(*list, global.json, connection);
@@ -489,7 +491,7 @@ void AddDeleteImportExport(Commands& commands, CLI::App* labels) {
       ->check(ExistingFile());
   importer->footer(kLabelFileHelp);
 
-  auto out = std::make_shared<ExportFlags>();
+  auto out = std::make_shared<LabelExportFlags>();
   CLI::App* exporter =
       commands.AddServer(labels, "export", "write labels as a file `labels import` reads",
                          [out, &global](const ServerConnection& connection) {

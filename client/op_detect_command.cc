@@ -159,7 +159,8 @@ absl::Status List(const std::string& space, bool json, const ServerConnection& c
   return absl::OkStatus();
 }
 
-absl::Status Delete(const std::string& name, bool json, const ServerConnection& connection) {
+absl::Status DeletePoseModel(const std::string& name, bool json,
+                             const ServerConnection& connection) {
   v1::DeletePoseModelRequest request;
   request.set_name(name);
   MOTIONDB_RETURN_IF_ERROR(CallUnary(connection, &Stub::DeletePoseModel, request).status());
@@ -230,9 +231,10 @@ void AddOpDetect(Commands& commands, CLI::App* op) {
   list->add_option("--space", *space, "only this space's")->type_name("NAME");
   auto name = std::make_shared<std::string>();
   commands
-      .AddServer(
-          detect, "delete", "delete a pose model",
-          [name, &global](const ServerConnection& c) { return Delete(*name, global.json, c); })
+      .AddServer(detect, "delete", "delete a pose model",
+                 [name, &global](const ServerConnection& c) {
+                   return DeletePoseModel(*name, global.json, c);
+                 })
       ->add_option("NAME", *name, "the model's name")
       ->required();
 }

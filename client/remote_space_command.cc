@@ -180,7 +180,7 @@ absl::Status Show(const std::string& name, bool json, const ServerConnection& co
   return absl::OkStatus();
 }
 
-absl::Status Delete(const std::string& name, bool json, const ServerConnection& connection) {
+absl::Status DeleteSpace(const std::string& name, bool json, const ServerConnection& connection) {
   v1::DeleteSpaceRequest request;
   request.set_name(name);
   MOTIONDB_RETURN_IF_ERROR(
@@ -240,7 +240,7 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
   commands
       .AddServer(space, "delete", "delete a space and its projections",
                  [name, &global](const ServerConnection& connection) {
-                   return Delete(*name, global.json, connection);
+                   return DeleteSpace(*name, global.json, connection);
                  })
       ->add_option("NAME", *name, "the space")
       ->required();
