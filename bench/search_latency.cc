@@ -213,10 +213,10 @@ double RecallAtTen(const Run& fast, const Run& exact) {
 struct VariantFlags {
   std::vector<int> places;
   std::vector<int> neighbours;
-  std::vector<int> windows;           // seeds by window (SeedSelection::kNearestWindows)
+  std::vector<int> windows;            // seeds by window (SeedSelection::kNearestWindows)
   std::vector<double> window_epsilon;  // the default window seeds' approximate tree search
-  std::vector<int> points;            // characteristic points (0: by the query's length)
-  std::vector<double> second_anchor;  // SearchParams::second_anchor_scatter values
+  std::vector<int> points;             // characteristic points (0: by the query's length)
+  std::vector<double> second_anchor;   // SearchParams::second_anchor_scatter values
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without

@@ -30,7 +30,7 @@ nlohmann::json Describe(const std::string& path, const BvhReadResult& result) {
   };
 }
 
-void PrintText(const std::string& path, const BvhReadResult& result) {
+void PrintClipSummary(const std::string& path, const BvhReadResult& result) {
   const Clip& clip = result.clip;
   std::vector<std::string> names;
   for (const Joint& joint : clip.skeleton().joints()) names.push_back(joint.name);
@@ -61,7 +61,7 @@ void AddInspect(Commands& commands) {
           } else if (global.json) {
             std::cout << Describe(path, *result).dump() << "\n";
           } else {
-            PrintText(path, *result);
+            PrintClipSummary(path, *result);
           }
         }
         return failures == 0 ? absl::OkStatus() : ReportedFailure();

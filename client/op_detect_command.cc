@@ -144,7 +144,8 @@ absl::Status Run(const RunFlags& flags, bool json, const ServerConnection& conne
   return absl::OkStatus();
 }
 
-absl::Status List(const std::string& space, bool json, const ServerConnection& connection) {
+absl::Status ListPoseModels(const std::string& space, bool json,
+                            const ServerConnection& connection) {
   v1::ListPoseModelsRequest request;
   request.set_space(space);
   MOTIONDB_ASSIGN_OR_RETURN(const v1::ListPoseModelsResponse response,
@@ -225,9 +226,10 @@ void AddOpDetect(Commands& commands, CLI::App* op) {
   AddRun(commands, detect);
   const GlobalOptions& global = commands.global();
   auto space = std::make_shared<std::string>();
-  CLI::App* list = commands.AddServer(
-      detect, "list", "the pose models",
-      [space, &global](const ServerConnection& c) { return List(*space, global.json, c); });
+  CLI::App* list = commands.AddServer(detect, "list", "the pose models",
+                                      [space, &global](const ServerConnection& c) {
+                                        return ListPoseModels(*space, global.json, c);
+                                      });
   list->add_option("--space", *space, "only this space's")->type_name("NAME");
   auto name = std::make_shared<std::string>();
   commands

@@ -142,7 +142,7 @@ CLI::App* AddCurveCommand(Commands& commands, CLI::App* op, const std::string& n
   return command;
 }
 
-absl::Status Report(const v1::EditResponse& response, const CurveFlags& flags, bool json) {
+absl::Status ReportEdit(const v1::EditResponse& response, const CurveFlags& flags, bool json) {
   return ReportResult(response.result(), flags.output, json, nlohmann::json::object(), [] {});
 }
 
@@ -170,7 +170,7 @@ absl::Status Scale(const ScaleFlags& flags, bool json, const ServerConnection& c
                              {"sigmoid.threshold", "--sigmoid THRESHOLD"},
                              {"sigmoid.width", "--sigmoid WIDTH"}},
                             {{"clip", flags.curve.clip}}, &flags.curve.scope)));
-  return Report(response, flags.curve, json);
+  return ReportEdit(response, flags.curve, json);
 }
 
 struct TranslateFlags {
@@ -203,7 +203,7 @@ absl::Status Translate(const TranslateFlags& flags, bool json, const ServerConne
                                                    {"axis_from", flags.axis_from},
                                                    {"axis_to", flags.axis_to}},
                                                   &flags.curve.scope)));
-  return Report(response, flags.curve, json);
+  return ReportEdit(response, flags.curve, json);
 }
 
 struct SmoothFlags {
@@ -220,7 +220,7 @@ absl::Status Smooth(const SmoothFlags& flags, bool json, const ServerConnection&
       CallUnary(
           connection, &Stub::Smooth, request,
           OpFlagNames({{"level", "--level"}}, {{"clip", flags.curve.clip}}, &flags.curve.scope)));
-  return Report(response, flags.curve, json);
+  return ReportEdit(response, flags.curve, json);
 }
 
 }  // namespace

@@ -153,7 +153,7 @@ absl::Status Create(const CreateFlags& flags, bool json, const ServerConnection&
   return absl::OkStatus();
 }
 
-absl::Status List(bool json, const ServerConnection& connection) {
+absl::Status ListSpaces(bool json, const ServerConnection& connection) {
   MOTIONDB_ASSIGN_OR_RETURN(
       const v1::ListSpacesResponse response,
       CallUnary(connection, &v1::SpaceService::Stub::ListSpaces, v1::ListSpacesRequest()));
@@ -225,9 +225,10 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
       ->check(NumberAtLeast(0))  // and below 1, which the server checks
       ->needs("--learned-metric");
 
-  commands.AddServer(
-      space, "list", "list the server's spaces",
-      [&global](const ServerConnection& connection) { return List(global.json, connection); });
+  commands.AddServer(space, "list", "list the server's spaces",
+                     [&global](const ServerConnection& connection) {
+                       return ListSpaces(global.json, connection);
+                     });
   // `show` and `delete` take the same NAME; one of them runs.
   auto name = std::make_shared<std::string>();
   commands

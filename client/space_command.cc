@@ -83,8 +83,8 @@ absl::StatusOr<SpaceOptions> ParseOptions(const SpaceFlags& flags) {
   return options;
 }
 
-nlohmann::json Report(const std::string& out, const MotionSpace& space,
-                      const std::vector<ReconstructionError>& errors) {
+nlohmann::json SpaceFileReport(const std::string& out, const MotionSpace& space,
+                               const std::vector<ReconstructionError>& errors) {
   const SpaceData& data = space.data();
   nlohmann::json weights = nlohmann::json::object();
   for (int j = 0; j < space.skeleton().joint_count(); ++j) {
@@ -114,8 +114,8 @@ nlohmann::json Report(const std::string& out, const MotionSpace& space,
   };
 }
 
-void PrintText(const std::string& out, const MotionSpace& space,
-               const std::vector<ReconstructionError>& errors) {
+void PrintSpaceSummary(const std::string& out, const MotionSpace& space,
+                       const std::vector<ReconstructionError>& errors) {
   const SpaceData& data = space.data();
   absl::PrintF("wrote %s\n", out);
   absl::PrintF("  skeleton: %d joints, pelvis %s\n", space.skeleton().joint_count(),
@@ -159,9 +159,9 @@ absl::Status Build(const BuildFlags& flags, bool json) {
                             space.RepresentationalError(training));
   MOTIONDB_RETURN_IF_ERROR(WriteSpaceFile(flags.out, space));
   if (json) {
-    std::cout << Report(flags.out, space, errors).dump() << "\n";
+    std::cout << SpaceFileReport(flags.out, space, errors).dump() << "\n";
   } else {
-    PrintText(flags.out, space, errors);
+    PrintSpaceSummary(flags.out, space, errors);
   }
   return absl::OkStatus();
 }

@@ -11,9 +11,16 @@
 # whose every file includes the same heavy headers: CLI11 alone costs about 10 s a file at -O3
 # (its header defines global validators, so each file compiles its whole parser), the generated
 # gRPC service headers about 5 s. A layer so built keeps its files' names distinct inside its
-# anonymous namespaces.
+# anonymous namespaces. -DMOTIONDB_UNITY_BUILD=OFF compiles every file alone (for tools that
+# read compile_commands.json file by file, or to check that each file includes what it uses).
 function(motiondb_layer target)
   cmake_parse_arguments(ARG "" "UNITY_BATCH" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  if(ARG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "motiondb_layer(${target}): unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
+  endif()
+  if("UNITY_BATCH" IN_LIST ARG_KEYWORDS_MISSING_VALUES)
+    message(FATAL_ERROR "motiondb_layer(${target}): UNITY_BATCH needs a count of files a unit")
+  endif()
   file(RELATIVE_PATH folder "${PROJECT_SOURCE_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}")
   set(public_root "${CMAKE_BINARY_DIR}/include/${target}")
   set(private_root "${CMAKE_BINARY_DIR}/include/${target}.internal")
@@ -23,7 +30,7 @@ function(motiondb_layer target)
     add_library(${target} STATIC ${ARG_SOURCES})
     target_include_directories(${target} PUBLIC "${public_root}" PRIVATE "${private_root}")
     target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
-    if(ARG_UNITY_BATCH)
+    if(ARG_UNITY_BATCH AND MOTIONDB_UNITY_BUILD)
       set_target_properties(${target} PROPERTIES UNITY_BUILD ON
                                                  UNITY_BUILD_BATCH_SIZE ${ARG_UNITY_BATCH})
     endif()

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "core/motion/resample.h"
 #include "core/space/search_coordinates.h"
 #include "server/frame_conversion.h"
