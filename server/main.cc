@@ -27,6 +27,7 @@
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
 #include "server/http/http_server.h"
+#include "server/net/descriptor_limit.h"
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
@@ -41,13 +42,15 @@ constexpr std::chrono::seconds kShutdownGrace(10);
 
 // What the flags name: the secret files read, the sizes converted.
 struct ServerFlags {
+  int http_request_timeout_s = 10;
+  int min_upload_kbps = 64;
   int max_bvh_mb = 0;
   int max_upload_buffer_mb = 0;
   std::string auth_token_file, tls_cert, tls_key;
   bool quiet = false;
 };
 
-void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http) {
+void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http, ServerFlags* flags) {
   app.add_option("--http", http->listen,
                  "serve the JSON API, /metrics and the web UI over HTTP here (off: not at all; "
                  "the token and TLS of gRPC apply)")
@@ -61,6 +64,28 @@ void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http) {
       ->type_name("S")
       ->capture_default_str()
       ->check(motiondb::cli::NumberAbove(0));
+  http->loop.threads =
+      std::max(http->loop.threads, 2 * static_cast<int>(std::thread::hardware_concurrency()));
+  app.add_option("--http-threads", http->loop.threads,
+                 "HTTP requests answered at once (each arrived whole)")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096).description(""));
+  app.add_option("--http-max-waiting", http->loop.max_waiting,
+                 "HTTP requests waiting for --http-threads; beyond, 503")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 16).description(""));
+  app.add_option("--http-max-connections", http->connections.max_connections,
+                 "HTTP connections held at once; beyond, new ones get 503")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20).description(""));
+  app.add_option("--http-request-timeout-s", flags->http_request_timeout_s,
+                 "an HTTP request's head must arrive within this of its first byte (408)")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 3600).description(""));
 }
 
 void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFlags* flags) {
@@ -82,6 +107,16 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   number("--threads", options->threads, "most calls run at once (0: no limit)", "N", 0, 1 << 16);
   number("--max-waiting", options->max_waiting_calls,
          "with --threads: most calls waiting their turn", "N", 0, 1 << 16);
+  number("--max-connections", options->connections.max_connections,
+         "gRPC connections held at once; beyond, new ones are closed", "N", 1, 1 << 20);
+  number("--max-connections-per-peer", options->connections.max_per_peer,
+         "connections one client address holds at once, on each port", "N", 1, 1 << 20);
+  number("--connection-idle-timeout-s", options->connection_idle_timeout_s,
+         "close a gRPC connection without a call for this long (0: never)", "S", 0, 1 << 20);
+  number("--min-upload-kbps", flags->min_upload_kbps,
+         "an upload (a stream's chunks, an HTTP body) slower than this on average, after its "
+         "first --http-request-timeout-s, is ended",
+         "KIB_S", 1, 1 << 20);
   number("--max-message-mb", options->max_message_mb, "largest request message, in MiB", "MB", 1,
          2047);
   flags->max_bvh_mb = static_cast<int>(options->uploads.max_bvh_bytes >> 20);
@@ -98,7 +133,8 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   number("--stream-idle-timeout-s", options->stream_idle_timeout_s,
          "end a client stream silent for this long (0: never)", "S", 0, 1 << 20);
   app.add_option("--auth-token-file", flags->auth_token_file,
-                 "require 'authorization: Bearer <FILE's contents>'")
+                 "require 'authorization: Bearer <token>' of a token in FILE: one bare token "
+                 "(every right), or lines 'SCOPE TOKEN' with SCOPE read, write or admin")
       ->type_name("FILE")
       ->check(existing_file);
   CLI::Option* cert = app.add_option("--tls-cert", flags->tls_cert, "serve TLS: certificate chain")
@@ -120,12 +156,49 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
       "file's surrounding whitespace is ignored.");
 }
 
+// Lowers the ports' connection limits, when the open-file limit cannot hold them both beside
+// what the process needs otherwise, and says so; limits given on the command line are kept
+// (with a warning: the ports then survive running out of descriptors, refusing meanwhile).
+void FitConnectionsToDescriptors(const CLI::App& app, motiondb::server::ConnectionLimits& grpc,
+                                 motiondb::server::ConnectionLimits* http) {
+  const int descriptors = motiondb::server::RaiseOpenFileLimit();
+  const int64_t wanted = int64_t{grpc.max_connections} + (http ? http->max_connections : 0);
+  const int64_t room = std::max(descriptors - motiondb::server::kReservedDescriptors, 2);
+  if (wanted <= room) return;
+  if (app.count("--max-connections") > 0 || app.count("--http-max-connections") > 0) {
+    motiondb::server::LogLine(absl::StrCat(
+        "the open-file limit (", descriptors, ") holds about ", room,
+        " connections beside the server's own files, fewer than the ", wanted,
+        " the connection limits allow: past it, new connections are refused until descriptors "
+        "free up (raise `ulimit -n`)"));
+    return;
+  }
+  grpc.max_connections =
+      static_cast<int>(std::max<int64_t>(1, grpc.max_connections * room / wanted));
+  if (http) {
+    http->max_connections =
+        static_cast<int>(std::max<int64_t>(1, http->max_connections * room / wanted));
+  }
+  for (auto* limits : {&grpc, http}) {
+    if (limits) limits->max_per_peer = std::min(limits->max_per_peer, limits->max_connections);
+  }
+  motiondb::server::LogLine(
+      absl::StrCat("the open-file limit (", descriptors, ") holds ", room,
+                   " connections beside the server's own files: --max-connections lowered to ",
+                   grpc.max_connections,
+                   http ? absl::StrCat(", --http-max-connections to ", http->max_connections) : "",
+                   " (raise `ulimit -n` to keep them)"));
+}
+
 // Reads the files the flags name into `options`.
 absl::Status ReadFlagFiles(const ServerFlags& flags, motiondb::server::ServerOptions* options) {
   options->uploads.max_bvh_bytes = int64_t{flags.max_bvh_mb} << 20;
   options->uploads.max_buffered_bytes = int64_t{flags.max_upload_buffer_mb} << 20;
+  options->uploads.min_bytes_per_s = flags.min_upload_kbps * 1024.0;
+  options->uploads.rate_grace = std::chrono::seconds(flags.http_request_timeout_s);
   if (!flags.auth_token_file.empty()) {
-    MOTIONDB_ASSIGN_OR_RETURN(options->auth_token, motiondb::ReadTokenFile(flags.auth_token_file));
+    MOTIONDB_ASSIGN_OR_RETURN(options->auth_tokens,
+                              motiondb::ReadScopedTokenFile(flags.auth_token_file));
   }
   if (!flags.tls_cert.empty()) {
     MOTIONDB_ASSIGN_OR_RETURN(options->tls_cert_pem,
@@ -174,13 +247,18 @@ int main(int argc, char** argv) {
   ServerFlags flags;
   AddFlags(app, &options, &flags);
   motiondb::server::HttpOptions http_options;
-  AddHttpFlags(app, &http_options);
+  AddHttpFlags(app, &http_options, &flags);
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
   if (const absl::Status status = ReadFlagFiles(flags, &options); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
   }
+  http_options.loop.head_timeout = std::chrono::seconds(flags.http_request_timeout_s);
+  http_options.loop.min_body_rate = options.uploads.min_bytes_per_s;
+  http_options.connections.max_per_peer = options.connections.max_per_peer;
+  FitConnectionsToDescriptors(app, options.connections,
+                              http_options.listen != "off" ? &http_options.connections : nullptr);
   absl::StatusOr<std::unique_ptr<motiondb::server::MotionDbServer>> server =
       motiondb::server::MotionDbServer::Start(options);
   if (!server.ok()) {
@@ -201,10 +279,13 @@ int main(int argc, char** argv) {
   sigwait(&stop_signals, &signal_number);
   motiondb::server::LogLine(absl::StrCat(
       "received ", signal_number == SIGTERM ? "SIGTERM" : "SIGINT", "; shutting down"));
-  // gRPC first: the HTTP face's calls in progress finish with it, and later ones are refused
-  // (UNAVAILABLE, 503) until the HTTP listener stops.
+  // The HTTP face stops reading first (slow clients' half-sent requests closed), then gRPC lets
+  // the calls under way, the HTTP face's among them, finish within the grace; what the HTTP
+  // face still writes then is cut at the same deadline.
+  const auto steady_deadline = std::chrono::steady_clock::now() + kShutdownGrace;
+  if (http) http->BeginStop();
   (*server)->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
-  if (http) http->Stop();
+  if (http) http->Stop(steady_deadline);
   http.reset();
   (*server)->Wait();
   server->reset();

@@ -84,10 +84,12 @@ ServerMetrics::ServerMetrics(const IndexRegistry& indices, storage::Database& da
                      [&indices] { return SpaceSamples(indices, /*frames=*/true); });
   registry_.AddGauge("motiondb_jobs", "Background jobs in each state.", {"state"},
                      [&database] { return JobSamples(database); });
-  registry_.AddGauge("motiondb_uploads_in_progress", "Ingests in progress (at most --max-uploads).",
-                     {}, [&uploads] {
-                       return Samples{{{}, static_cast<double>(uploads.uploads())}};
-                     });
+  registry_.AddGauge(
+      "motiondb_uploads_in_progress",
+      "Uploads in progress: ingests, and HTTP bodies arriving (at most --max-uploads).", {},
+      [&uploads] {
+        return Samples{{{}, static_cast<double>(uploads.uploads())}};
+      });
   registry_.AddGauge(
       "motiondb_upload_buffered_bytes",
       "Bytes the ingests in progress hold together (at most --max-upload-buffer-mb).", {},
@@ -97,6 +99,26 @@ ServerMetrics::ServerMetrics(const IndexRegistry& indices, storage::Database& da
   registry_.AddGauge("process_resident_memory_bytes", "Resident memory size in bytes.", {}, [] {
     return Samples{{{}, ResidentBytes()}};
   });
+  registry_.AddGauge("motiondb_connections",
+                     "Connections open on each port (at most --max-connections, "
+                     "--http-max-connections).",
+                     {"face"}, [this] {
+                       std::lock_guard<std::mutex> lock(connection_sources_mutex_);
+                       Samples samples;
+                       for (const auto& [face, open] : connection_sources_) {
+                         samples.push_back({{face}, static_cast<double>(open())});
+                       }
+                       return samples;
+                     });
+}
+
+void ServerMetrics::SetConnectionSource(absl::string_view face, std::function<int()> open) {
+  std::lock_guard<std::mutex> lock(connection_sources_mutex_);
+  if (open) {
+    connection_sources_[std::string(face)] = std::move(open);
+  } else {
+    connection_sources_.erase(std::string(face));
+  }
 }
 
 void ServerMetrics::CountCall(absl::string_view face, absl::string_view method,

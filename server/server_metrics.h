@@ -9,6 +9,9 @@
 #ifndef MOTIONDB_SERVER_SERVER_METRICS_H_
 #define MOTIONDB_SERVER_SERVER_METRICS_H_
 
+#include <functional>
+#include <map>
+#include <mutex>
 #include <string>
 
 #include "absl/strings/string_view.h"
@@ -41,6 +44,10 @@ class ServerMetrics {
   // Frames stored by an ingest (none when it was skipped).
   void CountIngest(const IngestOutcome& outcome);
 
+  // Where the connections open on `face` ("grpc", "http") are counted, read at each scrape
+  // (motiondb_connections); `open` must stay callable until this is destroyed or replaced.
+  void SetConnectionSource(absl::string_view face, std::function<int()> open);
+
   // Every metric in Prometheus' text format 0.0.4.
   std::string Render() const;
 
@@ -52,6 +59,8 @@ class ServerMetrics {
   MetricsRegistry::Histogram& http_seconds_;
   MetricsRegistry::Histogram& search_stage_seconds_;
   MetricsRegistry::Counter& ingested_frames_;
+  mutable std::mutex connection_sources_mutex_;
+  std::map<std::string, std::function<int()>> connection_sources_;  // guarded by the mutex
 };
 
 }  // namespace motiondb::server

@@ -4,6 +4,7 @@
 #ifndef MOTIONDB_SERVER_UPLOAD_H_
 #define MOTIONDB_SERVER_UPLOAD_H_
 
+#include <chrono>
 #include <cstdint>
 
 #include "absl/status/statusor.h"
@@ -24,6 +25,10 @@ struct UploadLimits {
   // text (the parsed clip and its stored copy; bench/RESULTS.md), and no one upload's clip may
   // take more than this either, so this is what bounds the server's memory under many uploads.
   int64_t max_buffered_bytes = int64_t{2} << 30;
+  // An upload arriving slower than this on average, once `rate_grace` has passed, is ended
+  // (--min-upload-kbps): 32 streams sending a byte every 20 s once kept every ingest out.
+  double min_bytes_per_s = 64 << 10;
+  std::chrono::milliseconds rate_grace{10'000};
 };
 
 // RESOURCE_EXHAUSTED when `bytes` (an upload's size, or a stream's so far) exceeds the limit;

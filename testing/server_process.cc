@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -67,6 +68,11 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
     ::dup2(null, STDIN_FILENO);
     ::dup2(null, STDOUT_FILENO);
     ::dup2(log, STDERR_FILENO);
+    if (max_open_files_ > 0) {
+      const rlimit files{static_cast<rlim_t>(max_open_files_),
+                         static_cast<rlim_t>(max_open_files_)};
+      if (::setrlimit(RLIMIT_NOFILE, &files) != 0) ::_exit(125);
+    }
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }

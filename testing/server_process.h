@@ -33,6 +33,10 @@ class ServerProcess {
   // killed it, or -1 when it did not stop within `timeout` (it is then killed).
   int Stop(int signal, std::chrono::seconds timeout = std::chrono::seconds(30));
 
+  // The open-file limit (soft and hard) the next Start() gives the server, as `prlimit
+  // --nofile=N:N` would; 0: the test's own.
+  void LimitOpenFiles(int files) { max_open_files_ = files; }
+
   bool running() const { return pid_ > 0; }
   pid_t pid() const { return pid_; }
   int port() const { return port_; }
@@ -46,6 +50,7 @@ class ServerProcess {
   pid_t pid_ = -1;
   int port_ = 0;
   int http_port_ = 0;
+  int max_open_files_ = 0;
   std::string log_path_;
 };
 

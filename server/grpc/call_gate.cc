@@ -15,8 +15,13 @@ constexpr std::chrono::milliseconds kCancelPoll{20};
 
 }  // namespace
 
+grpc::Status CallGate::Allowed(const grpc::ServerContext* context) const {
+  return access_ == nullptr ? grpc::Status::OK : access_->VerdictOf(context).status;
+}
+
 grpc::Status CallGate::Run(const grpc::ServerContext* context,
                            const std::function<grpc::Status()>& call) {
+  if (grpc::Status allowed = Allowed(context); !allowed.ok()) return allowed;
   if (max_running_ <= 0) return call();
   grpc::Status refusal;
   if (!Enter(context, &refusal)) return refusal;

@@ -1,6 +1,7 @@
-// Admission of calls when the server runs at most N at once (--threads): a call beyond N waits
-// in line (first come, first served) until a slot frees, its deadline passes or the client
-// cancels; only past `max_waiting` waiting calls is it refused with RESOURCE_EXHAUSTED.
+// Admission of calls: the caller's right to make it (server/grpc/access_control.h), then, when
+// the server runs at most N at once (--threads), a place: a call beyond N waits in line (first
+// come, first served) until a slot frees, its deadline passes or the client cancels; only past
+// `max_waiting` waiting calls is it refused with RESOURCE_EXHAUSTED.
 //
 // Why not gRPC's own thread quota (ResourceQuota::SetMaxThreads): it refuses calls even below
 // its limit, because its poller accounting races with finishing calls (grpc/grpc#32680; seen
@@ -20,17 +21,24 @@
 #include <grpcpp/server_context.h>
 #include <grpcpp/support/status.h>
 
+#include "server/grpc/access_control.h"
+
 namespace motiondb::server {
 
 class CallGate {
  public:
   // `max_running` 0: no limit (every call runs at once, as gRPC's thread pool allows).
-  CallGate(int max_running, int max_waiting)
-      : max_running_(max_running), max_waiting_(max_waiting) {}
+  // `access` null: every call may run (tests of admission alone); it must outlive the gate.
+  CallGate(int max_running, int max_waiting, const AccessControl* access = nullptr)
+      : max_running_(max_running), max_waiting_(max_waiting), access_(access) {}
 
-  // Runs `call` once admitted; the call's own status otherwise: RESOURCE_EXHAUSTED when the
-  // line is full, DEADLINE_EXCEEDED or CANCELLED when the call ends while waiting.
+  // Runs `call` once allowed and admitted; otherwise the refusal: the access check's
+  // (UNAUTHENTICATED, PERMISSION_DENIED, RESOURCE_EXHAUSTED), RESOURCE_EXHAUSTED when the line
+  // is full, DEADLINE_EXCEEDED or CANCELLED when the call ends while waiting.
   grpc::Status Run(const grpc::ServerContext* context, const std::function<grpc::Status()>& call);
+  // The access check alone, for what must be refused before it reads its client's stream (an
+  // upload, which reads before it takes a place: waiting for bytes holds no place).
+  grpc::Status Allowed(const grpc::ServerContext* context) const;
 
   int max_running() const { return max_running_; }
   // Calls waiting now (for the request log and tests).
@@ -43,6 +51,7 @@ class CallGate {
 
   const int max_running_;
   const int max_waiting_;
+  const AccessControl* const access_;
   mutable std::mutex mutex_;
   std::condition_variable freed_;
   int running_ = 0;

@@ -37,11 +37,10 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
   });
 }
 
-absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
-                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
-                                         v1::IngestClipResponse* response) {
+absl::StatusOr<ClipServiceImpl::ReadUpload> ClipServiceImpl::ReadStream(
+    grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader) {
   // Admitted before the first message, which an idle client may never send: the watchdog ends
-  // such a stream and frees its place.
+  // such a stream, and one that crawls, and frees its place.
   MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
   absl::StatusOr<ReceivedUpload> received;
   {
@@ -50,14 +49,19 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
     received = ReceiveUpload(*reader, watch, limits_, ticket);
   }
   MOTIONDB_ASSIGN_OR_RETURN(ReceivedUpload upload, std::move(received));
+  return ReadUpload{std::move(ticket), std::move(upload)};
+}
+
+absl::Status ClipServiceImpl::IngestStreamed(grpc::ServerContext* context, ReadUpload read,
+                                             v1::IngestClipResponse* response) {
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
   const std::function<bool()> should_stop = StopWhenCallEnds(context);
   if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
-  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, upload.bvh.Finish());
+  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult parsed, read.upload.bvh.Finish());
   MOTIONDB_ASSIGN_OR_RETURN(
       const IngestOutcome outcome,
-      IngestParsedUpload(catalog_, upload.request, std::move(read), should_stop));
+      IngestParsedUpload(catalog_, read.upload.request, std::move(parsed), should_stop));
   metrics_.CountIngest(outcome);
   ToProto(outcome, response);
   return absl::OkStatus();
@@ -66,8 +70,14 @@ absl::Status ClipServiceImpl::ReadStream(grpc::ServerContext* context,
 grpc::Status ClipServiceImpl::IngestClipStream(
     grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
     v1::IngestClipResponse* response) {
+  // The caller's right first: nothing is read for one who may not ingest. The stream is then
+  // read without a place among --threads (a client slow to send must not keep other calls
+  // out: 8 idle streams once locked a --threads 4 server out); the ingest takes one.
+  if (grpc::Status allowed = gate_.Allowed(context); !allowed.ok()) return allowed;
+  absl::StatusOr<ReadUpload> read = ReadStream(context, reader);
+  if (!read.ok()) return ToGrpcStatus(ExplainStop(read.status(), context));
   return gate_.Run(context, [&]() -> grpc::Status {
-    return ToGrpcStatus(ExplainStop(ReadStream(context, reader, response), context));
+    return ToGrpcStatus(ExplainStop(IngestStreamed(context, *std::move(read), response), context));
   });
 }
 

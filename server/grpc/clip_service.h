@@ -10,6 +10,7 @@
 #include "server/catalog.h"
 #include "server/clip_ingest.h"
 #include "server/grpc/call_gate.h"
+#include "server/grpc/stream_upload.h"
 #include "server/grpc/stream_watchdog.h"
 #include "server/server_metrics.h"
 #include "server/upload.h"
@@ -54,9 +55,15 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                              v1::ListSkeletonsResponse* response) override;
 
  private:
-  absl::Status ReadStream(grpc::ServerContext* context,
-                          grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
-                          v1::IngestClipResponse* response);
+  // An IngestClipStream's file as it arrived, with its share of the upload budget.
+  struct ReadUpload {
+    UploadBudget::Ticket ticket;
+    ReceivedUpload upload;
+  };
+  absl::StatusOr<ReadUpload> ReadStream(grpc::ServerContext* context,
+                                        grpc::ServerReader<v1::IngestClipStreamRequest>* reader);
+  absl::Status IngestStreamed(grpc::ServerContext* context, ReadUpload read,
+                              v1::IngestClipResponse* response);
 
   storage::Database& database_;
   Catalog& catalog_;

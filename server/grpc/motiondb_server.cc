@@ -8,6 +8,7 @@
 #include "absl/strings/str_format.h"
 #include "grpc/health/v1/health.pb.h"
 #include "server/catalog.h"
+#include "server/grpc/access_control.h"
 #include "server/grpc/call_gate.h"
 #include "server/grpc/clip_service.h"
 #include "server/grpc/credentials.h"
@@ -20,6 +21,8 @@
 #include "server/grpc/space_service.h"
 #include "server/index_registry.h"
 #include "server/job_runner.h"
+#include "server/net/handed_off_sockets.h"
+#include "server/net/listener.h"
 #include "server/search_runner.h"
 #include "storage/database.h"
 #include "util/status_macros.h"
@@ -39,6 +42,7 @@ struct MotionDbServer::State {
   std::unique_ptr<UploadBudget> uploads;
   std::unique_ptr<ServerMetrics> metrics;
   std::unique_ptr<RequestLog> request_log;
+  std::unique_ptr<AccessControl> access;
   std::unique_ptr<CallGate> gate;
   std::unique_ptr<StreamWatchdog> watchdog;
   std::unique_ptr<ClipServiceImpl> clips;
@@ -48,12 +52,18 @@ struct MotionDbServer::State {
   std::unique_ptr<JobServiceImpl> job_service;
   std::unique_ptr<ServerInfoServiceImpl> info;
   std::unique_ptr<EditServiceImpl> edits;
+  // The port: accepted here, handed to gRPC (see StartListening).
+  std::unique_ptr<Listener> listener;
+  HandedOffSockets handed_off;
+  std::unique_ptr<grpc::experimental::ExternalConnectionAcceptor> acceptor;
   std::unique_ptr<grpc::Server> server;
 };
 
 MotionDbServer::MotionDbServer(std::unique_ptr<State> state) : state_(std::move(state)) {}
 
 MotionDbServer::~MotionDbServer() {
+  if (state_->listener) state_->listener->Stop();
+  if (state_->metrics) state_->metrics->SetConnectionSource(kGrpcFace, nullptr);
   if (state_->server) {
     state_->server->Shutdown(std::chrono::system_clock::now());
     state_->server->Wait();
@@ -92,22 +102,26 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database, *s.uploads);
   s.request_log = std::make_unique<RequestLog>(options.log_requests, *s.metrics);
-  s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls);
-  s.watchdog =
-      std::make_unique<StreamWatchdog>(std::chrono::seconds(options.stream_idle_timeout_s));
+  s.access = std::make_unique<AccessControl>(AccessOptions{.tokens = options.auth_tokens});
+  s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls, s.access.get());
+  s.watchdog = std::make_unique<StreamWatchdog>(
+      StreamLimits{.idle_timeout = std::chrono::seconds(options.stream_idle_timeout_s),
+                   .min_bytes_per_s = options.uploads.min_bytes_per_s,
+                   .rate_grace = options.uploads.rate_grace});
   s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.uploads,
                                               *s.watchdog, *s.metrics, *s.gate);
   s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.metrics, *s.gate);
   s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
   s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
-  s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.gate);
+  s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.access,
+                                                   *s.gate);
   s.edits =
       std::make_unique<EditServiceImpl>(EditContext{*s.database, *s.catalog, s.registry}, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,
-      MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem, options.auth_token,
+      MakeServerCredentials(options.tls_cert_pem, options.tls_key_pem, *s.access,
                             options.health_needs_token, *s.request_log));
   // Reflection describes services from the generated descriptor pool, which holds health.proto
   // only if its generated code is linked in; naming a message of it makes sure it is.
@@ -115,9 +129,24 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
+  // The port is ours (server/net/listener.h: connection limits, accept errors survived);
+  // gRPC is handed each connection, with the port's credentials (TLS, the token check).
+  MOTIONDB_ASSIGN_OR_RETURN(s.listener, Listener::Bind(ListenerOptions{
+                                            .listen = options.listen,
+                                            .face = "gRPC",
+                                            .flag = "--listen",
+                                            .limits = options.connections,
+                                            .log = [](absl::string_view line) { LogLine(line); }}));
   grpc::ServerBuilder builder;
-  int port = 0;
-  builder.AddListeningPort(options.listen, credentials, &port);
+  s.acceptor = builder.experimental().AddExternalConnectionAcceptor(
+      grpc::ServerBuilder::experimental_type::ExternalConnectionType::FROM_FD, credentials);
+  // A connection that has not finished its handshake (TLS, HTTP/2 preface) by then is closed:
+  // a silent socket must not hold its place for gRPC's default two minutes.
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, 10'000);
+  if (options.connection_idle_timeout_s > 0) {
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS,
+                               options.connection_idle_timeout_s * 1000);
+  }
   builder.RegisterService(s.clips.get());
   builder.RegisterService(s.spaces.get());
   builder.RegisterService(s.search.get());
@@ -129,23 +158,35 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   // Always: the metrics count every call, whether or not lines are written.
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;
   loggers.push_back(std::make_unique<RequestLoggerFactory>(*s.request_log));
+  loggers.push_back(std::make_unique<AccessInterceptorFactory>(*s.access));
   builder.experimental().SetInterceptorCreators(std::move(loggers));
   s.server = builder.BuildAndStart();
-  if (s.server == nullptr || port == 0) {
-    return absl::UnavailableError(
-        absl::StrCat("cannot listen on ", options.listen,
-                     " (address in use or not local, or an unusable TLS certificate or key)"));
+  if (s.server == nullptr) {
+    return absl::UnavailableError(absl::StrCat("cannot serve gRPC on ", options.listen,
+                                               " (an unusable TLS certificate or key?)"));
   }
+  const int port = s.listener->port();
+  s.listener->Start(
+      [&s](AcceptedConnection connection) {
+        grpc::experimental::ExternalConnectionAcceptor::NewConnectionParameters handed;
+        handed.fd = connection.socket.get();
+        s.handed_off.Add(handed.fd, std::move(connection.slot));
+        connection.socket.Release();  // gRPC closes it
+        s.acceptor->HandleNewConnection(&handed);
+      },
+      /*refuse=*/nullptr, [&s] { s.handed_off.Sweep(); });
+  s.metrics->SetConnectionSource(kGrpcFace, [&s] { return s.listener->connections().open(); });
   LogLine(absl::StrCat("motiondb-server ", MOTIONDB_VERSION, " listening on ", options.listen,
                        port != 0 ? absl::StrCat(" (port ", port, ")") : "",
                        options.tls_cert_pem.empty() ? ", plain text" : ", TLS",
-                       options.auth_token.empty() ? "" : ", bearer token required"));
+                       options.auth_tokens.empty() ? "" : ", bearer token required"));
   auto server = std::unique_ptr<MotionDbServer>(new MotionDbServer(std::move(state)));
   server->port_ = port;
   return server;
 }
 
 void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
+  state_->listener->Stop();
   // Health turns NOT_SERVING first, so load balancers and waiting clients look elsewhere.
   if (grpc::HealthCheckServiceInterface* health = state_->server->GetHealthCheckService()) {
     health->SetServingStatus(false);
@@ -168,7 +209,13 @@ std::shared_ptr<grpc::Channel> MotionDbServer::InProcessChannel() const {
   return state_->server->InProcessChannel(arguments);
 }
 
+bool MotionDbServer::accepting() const { return state_->listener->accepting(); }
+
 ServerMetrics& MotionDbServer::metrics() const { return *state_->metrics; }
+
+UploadBudget& MotionDbServer::upload_budget() const { return *state_->uploads; }
+
+AccessControl& MotionDbServer::access() const { return *state_->access; }
 
 RequestLog& MotionDbServer::request_log() const { return *state_->request_log; }
 

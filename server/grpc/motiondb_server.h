@@ -11,9 +11,11 @@
 #include <grpcpp/server.h>
 
 #include "absl/status/statusor.h"
+#include "server/grpc/access_control.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
 #include "server/server_metrics.h"
+#include "server/upload_budget.h"
 
 namespace motiondb::server {
 
@@ -36,7 +38,14 @@ class MotionDbServer {
   // the caller's x-motiondb-http-peer metadata as their peer. Calls fail with UNAVAILABLE once
   // Shutdown() has begun.
   std::shared_ptr<grpc::Channel> InProcessChannel() const;
+  // Whether the port takes a new connection now (server/net/listener.h): false while the
+  // process is out of descriptors or every connection place is taken; readiness says so.
+  bool accepting() const;
   ServerMetrics& metrics() const;
+  // What the uploads in progress hold: gRPC ingests and the HTTP face's request bodies share it.
+  UploadBudget& upload_budget() const;
+  // Who may call what; the HTTP face decides with it too.
+  AccessControl& access() const;
   RequestLog& request_log() const;
   const ServerOptions& options() const;
 

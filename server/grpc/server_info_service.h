@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "motiondb/v1/server_service.grpc.pb.h"
+#include "server/grpc/access_control.h"
 #include "server/grpc/call_gate.h"
 #include "server/grpc/server_options.h"
 #include "server/index_registry.h"
@@ -16,10 +17,11 @@ namespace motiondb::server {
 class ServerInfoServiceImpl final : public v1::ServerService::Service {
  public:
   ServerInfoServiceImpl(storage::Database& database, const IndexRegistry& registry,
-                        const ServerOptions& options, CallGate& gate)
+                        const ServerOptions& options, const AccessControl& access, CallGate& gate)
       : database_(database),
         registry_(registry),
         options_(options),
+        access_(access),
         gate_(gate),
         start_(std::chrono::steady_clock::now()) {}
 
@@ -32,6 +34,7 @@ class ServerInfoServiceImpl final : public v1::ServerService::Service {
   storage::Database& database_;
   const IndexRegistry& registry_;
   const ServerOptions& options_;
+  const AccessControl& access_;
   CallGate& gate_;
   std::chrono::steady_clock::time_point start_;
 };

@@ -4,8 +4,11 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "server/net/connection_counter.h"
 #include "server/upload.h"
+#include "util/token_file.h"
 
 namespace motiondb::server {
 
@@ -20,6 +23,13 @@ struct ServerOptions {
   int threads = 0;
   // With `threads`, the most calls waiting; beyond, calls are refused with RESOURCE_EXHAUSTED.
   int max_waiting_calls = 64;
+  // Connections the gRPC port holds at once, in all (--max-connections) and from one client
+  // address (--max-connections-per-peer); beyond, a new connection is closed on arrival. Both
+  // are lowered at start when the open-file limit cannot hold them (server/net/).
+  ConnectionLimits connections;
+  // A gRPC connection without a call for this long is closed; clients reconnect when they next
+  // call (--connection-idle-timeout-s; 0: never).
+  int connection_idle_timeout_s = 300;
   // Largest request message, in MiB: gRPC itself refuses larger ones with RESOURCE_EXHAUSTED
   // before any handler runs (--max-message-mb).
   int max_message_mb = 256;
@@ -29,9 +39,9 @@ struct ServerOptions {
   // A client stream (IngestClipStream) that sends nothing for this long is ended, releasing
   // its thread (--stream-idle-timeout-s); 0: never.
   int stream_idle_timeout_s = 30;
-  // When non-empty, every call must carry the metadata "authorization: Bearer <token>"
-  // (read from --auth-token-file).
-  std::string auth_token;
+  // When non-empty, every call must carry the metadata "authorization: Bearer <token>" of one
+  // of them, whose scope the method needs (read from --auth-token-file).
+  std::vector<ScopedToken> auth_tokens;
   // With a token: the health service needs it too (--health-needs-token); by default probes
   // answer without one.
   bool health_needs_token = false;

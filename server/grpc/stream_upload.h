@@ -4,7 +4,7 @@
 // malformed file is refused at the chunk that shows it.
 //
 // `Reader`: anything with bool Read(v1::IngestClipStreamRequest*) (grpc::ServerReader, or a
-// fuzzer's messages). `Activity`: Touch() as each message arrives and Status() once reading
+// fuzzer's messages). `Activity`: Touch(bytes) as each message arrives and Status() once reading
 // stops (StreamWatchdog::Watch, whose status says when the watchdog ended the stream).
 #ifndef MOTIONDB_SERVER_GRPC_STREAM_UPLOAD_H_
 #define MOTIONDB_SERVER_GRPC_STREAM_UPLOAD_H_
@@ -44,7 +44,7 @@ absl::StatusOr<ReceivedUpload> ReceiveUpload(Reader& reader, Activity& activity,
   StreamedUpload bvh(request.file_name, limits);
   ReceivedUpload upload{std::move(request), std::move(bvh)};
   do {
-    activity.Touch();
+    activity.Touch(message.chunk().size());
     MOTIONDB_RETURN_IF_ERROR(upload.bvh.Append(message.chunk(), ticket));
   } while (reader.Read(&message));
   MOTIONDB_RETURN_IF_ERROR(activity.Status());

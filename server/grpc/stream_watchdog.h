@@ -1,8 +1,9 @@
-// Ends client streams that have gone quiet. A synchronous handler blocked in Read() holds its
-// server thread (and, with --threads, a call slot) for as long as its client keeps the stream
-// open without sending: 8 idle IngestClipStream calls locked a --threads 4 server out, and 300
-// made 311 threads. One thread looks at the watched calls a few times per timeout and cancels
-// (ServerContext::TryCancel) those idle for longer; their Read() then fails, and the handler
+// Ends client streams that have gone quiet or crawl. A synchronous handler blocked in Read()
+// holds its server thread for as long as its client keeps the stream open without sending: 300
+// idle IngestClipStream calls made 311 threads, and 32 streams sending a byte every 20 s kept
+// every ingest out. One thread looks at the watched calls a few times a second and ends those
+// idle for longer than the idle timeout, or slower on average than the least rate once its grace
+// has passed, with DEADLINE_EXCEEDED and the reason; their Read() then fails, and the handler
 // asks its Watch whether the watchdog is why.
 //
 // Thread-safe.
@@ -23,10 +24,19 @@
 
 namespace motiondb::server {
 
+struct StreamLimits {
+  // A stream that sends nothing for this long is ended; zero: never (--stream-idle-timeout-s).
+  std::chrono::milliseconds idle_timeout{30'000};
+  // A stream slower on average than this, once `rate_grace` has passed since it started, is
+  // ended; zero: never (--min-upload-kbps).
+  double min_bytes_per_s = 0;
+  std::chrono::milliseconds rate_grace{10'000};
+};
+
 class StreamWatchdog {
  public:
-  // `idle_timeout` zero: streams are never ended (and no thread runs).
-  explicit StreamWatchdog(std::chrono::milliseconds idle_timeout);
+  // With neither limit set, streams are never ended (and no thread runs).
+  explicit StreamWatchdog(const StreamLimits& limits);
   ~StreamWatchdog();
   StreamWatchdog(const StreamWatchdog&) = delete;
   StreamWatchdog& operator=(const StreamWatchdog&) = delete;
@@ -38,9 +48,9 @@ class StreamWatchdog {
     Watch(Watch&& other) noexcept;
     Watch& operator=(Watch&&) = delete;
     ~Watch();
-    // Something arrived: the idle time starts again.
-    void Touch();
-    // DEADLINE_EXCEEDED saying how long the stream was idle once the watchdog ended it; OK
+    // `bytes` arrived: the idle time starts again.
+    void Touch(size_t bytes);
+    // DEADLINE_EXCEEDED saying which limit the stream broke once the watchdog ended it; OK
     // otherwise.
     absl::Status Status() const;
 
@@ -58,7 +68,7 @@ class StreamWatchdog {
  private:
   void Run();
 
-  const std::chrono::milliseconds idle_timeout_;
+  const StreamLimits limits_;
   std::mutex mutex_;
   std::condition_variable stop_;
   bool stopping_ = false;                        // guarded by mutex_

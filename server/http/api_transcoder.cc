@@ -10,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "grpc/health/v1/health.pb.h"
 #include "motiondb/v1/clip_service.pb.h"
+#include "server/grpc/access_control.h"
 #include "server/grpc/request_logger.h"
 #include "server/http/http_status.h"
 #include "server/http/json_transcoding.h"
@@ -76,12 +77,14 @@ absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
 }
 
 grpc::Status ApiTranscoder::Invoke(const MethodDescriptor& method, const Message& request,
-                                   Message* response, absl::string_view peer) const {
+                                   Message* response, absl::string_view peer,
+                                   absl::string_view scope) const {
   grpc::ClientContext context;
   context.set_deadline(
       std::chrono::system_clock::now() +
       std::chrono::duration_cast<std::chrono::system_clock::duration>(call_timeout_));
   context.AddMetadata(kHttpPeerMetadata, std::string(peer));
+  if (!scope.empty()) context.AddMetadata(kHttpScopeMetadata, std::string(scope));
   std::promise<grpc::Status> done;
   stub_.UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),
                   grpc::StubOptions(), &request, response,
@@ -126,7 +129,7 @@ HttpReply ApiTranscoder::Call(const ApiRoute& route, const HttpCall& call) const
     return ErrorReply(grpc::StatusCode::INVALID_ARGUMENT, filled.message());
   }
   const std::unique_ptr<Message> response = NewMessage(method.output_type());
-  const grpc::Status status = Invoke(method, *request, response.get(), call.peer);
+  const grpc::Status status = Invoke(method, *request, response.get(), call.peer, call.scope);
   if (!status.ok()) return ErrorReply(status.error_code(), status.error_message());
   if (route.bvh_file) return FileReply(*response);
   HttpReply reply;
@@ -141,7 +144,7 @@ bool ApiTranscoder::Ready(absl::string_view peer) const {
                                       ->FindMethodByName("Check");
   grpc::health::v1::HealthCheckRequest request;  // "": the server as a whole
   grpc::health::v1::HealthCheckResponse response;
-  return Invoke(*check, request, &response, peer).ok() &&
+  return Invoke(*check, request, &response, peer, "").ok() &&
          response.status() == grpc::health::v1::HealthCheckResponse::SERVING;
 }
 

@@ -37,7 +37,8 @@ struct HttpCall {
   std::vector<std::string> path_values;           // one per placeholder of the route, decoded
   std::multimap<std::string, std::string> query;  // GET and DELETE routes
   std::string body;
-  std::string peer;  // the client's address, for the request log
+  std::string peer;   // the client's address, for the request log
+  std::string scope;  // what the caller's token holds ("read", ...), for GetServerInfo
 };
 
 class ApiTranscoder {
@@ -63,7 +64,7 @@ class ApiTranscoder {
   // Calls `method` in-process and waits for its answer.
   grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
                       const google::protobuf::Message& request, google::protobuf::Message* response,
-                      absl::string_view peer) const;
+                      absl::string_view peer, absl::string_view scope) const;
   absl::Status FillRequest(const ApiRoute& route, const HttpCall& call,
                            google::protobuf::Message* request) const;
 

@@ -1,11 +1,11 @@
 #include "server/http/http_server.h"
 
+#include <openssl/ssl.h>
 #include <sys/socket.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <future>
 #include <optional>
 #include <regex>
 #include <thread>
@@ -13,14 +13,18 @@
 #include <httplib.h>
 
 #include "absl/strings/match.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "server/grpc/credentials.h"
+#include "server/grpc/request_logger.h"
+#include "server/grpc/status_conversion.h"
 #include "server/http/api_routes.h"
 #include "server/http/api_transcoder.h"
+#include "server/http/head_checks.h"
+#include "server/http/http_exchange.h"
 #include "server/http/http_status.h"
 #include "server/http/json_transcoding.h"
 #include "server/http/tls_context.h"
+#include "server/net/listener.h"
 #include "util/status_macros.h"
 
 #ifndef MOTIONDB_WEB_DIST
@@ -31,34 +35,15 @@ namespace motiondb::server {
 namespace {
 
 constexpr char kJson[] = "application/json";
-// Enough for a browser's few connections and the tools beside it; each connection holds a
-// thread while it is kept alive.
-constexpr size_t kMinThreads = 16;
-// Requests a connection may carry before it is closed (httplib's default is 5).
-constexpr size_t kKeepAliveRequests = 1000;
 
 // The exchange a worker thread serves, from the pre-routing handler (which runs first for
 // every request that parsed) to the logger (which runs once it is answered): for its metrics.
 struct Exchange {
   std::chrono::steady_clock::time_point start{};
-  std::string route;  // as metrics label it
+  std::string route;                      // as metrics label it
+  TokenScope scope = TokenScope::kAdmin;  // what the caller's token holds
 };
 thread_local Exchange exchange;
-
-absl::StatusOr<std::pair<std::string, int>> SplitHostPort(const std::string& listen) {
-  const size_t colon = listen.rfind(':');
-  int port = -1;
-  if (colon == std::string::npos || !absl::SimpleAtoi(listen.substr(colon + 1), &port) ||
-      port < 0 || port > 65535) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--http: '", listen, "' is not HOST:PORT (port 0..65535) or off"));
-  }
-  std::string host = listen.substr(0, colon);
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
-    host = host.substr(1, host.size() - 2);  // [::1]
-  }
-  return std::make_pair(host, port);
-}
 
 std::string Peer(const httplib::Request& request) {
   return absl::StrCat(request.remote_addr, ":", request.remote_port);
@@ -75,127 +60,110 @@ void SendError(grpc::StatusCode code, absl::string_view message, httplib::Respon
   response.set_content(ErrorJson(code, message), kJson);
 }
 
-bool IsApiPath(const std::string& path) { return path == "/v1" || absl::StartsWith(path, "/v1/"); }
-
-// Whether the path needs the token: the API and the metrics hold data; health as the gRPC
-// health service; the web UI's files never.
-bool NeedsToken(const ServerOptions& options, const std::string& path) {
-  if (options.auth_token.empty()) return false;
-  if (path == "/healthz" || path == "/readyz") {
-    return MethodNeedsToken("/grpc.health.v1.Health/Check", options.health_needs_token);
-  }
-  return path == "/metrics" || IsApiPath(path);
+std::vector<absl::string_view> AuthorizationHeaders(const httplib::Request& request) {
+  std::vector<absl::string_view> headers;
+  const auto [first, last] = request.headers.equal_range("Authorization");
+  for (auto it = first; it != last; ++it) headers.push_back(it->second);
+  return headers;
 }
 
-bool Authorized(const ServerOptions& options, const httplib::Request& request) {
-  bool authorized = false;
-  // Every header is looked at, so that the time does not depend on which one matches.
-  for (size_t i = 0; i < request.get_header_value_count("Authorization"); ++i) {
-    authorized |=
-        BearerTokenMatches(request.get_header_value("Authorization", i), options.auth_token);
+// The caller's right to `method` `path`, from its Authorization headers; nullopt when allowed,
+// with `scope` set to what its token holds.
+std::optional<HttpRefusal> CheckAccess(MotionDbServer& server, absl::string_view method,
+                                       absl::string_view path, absl::string_view address,
+                                       const std::vector<absl::string_view>& authorization,
+                                       TokenScope* scope) {
+  const std::optional<TokenScope> needed =
+      NeededScope(method, path, server.options().health_needs_token);
+  *scope = TokenScope::kAdmin;
+  if (!needed) return std::nullopt;
+  const AccessControl::Verdict verdict =
+      server.access().Decide(absl::StrCat(method, " ", path), *needed, address, authorization,
+                             "send the header 'Authorization: Bearer <token>'");
+  *scope = verdict.scope;
+  if (verdict.status.ok()) return std::nullopt;
+  HttpRefusal refusal{HttpStatusOf(verdict.status.error_code()), verdict.status.error_message()};
+  if (verdict.status.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
+    refusal.headers.emplace_back("WWW-Authenticate", "Bearer");
   }
-  return authorized;
-}
-
-// The routes that take a request body, as regular expressions of their paths.
-std::vector<std::regex> BodyRoutes() {
-  std::vector<std::regex> paths;
-  for (const ApiRoute& route : ApiRoutes()) {
-    if (route.json_body) paths.emplace_back(route.PathRegex());
-  }
-  return paths;
-}
-
-struct Refusal {
-  int status = 0;
-  std::string message;
-};
-
-// A request whose body is refused before it is read: httplib 0.11 checks its payload limit only
-// against Content-Length, reads a chunked body and inflates a compressed one whole before any
-// handler runs, and reads a POST without a length until the connection ends. So a body comes
-// uncompressed with its Content-Length, within `max_body`, and only to a POST route that takes
-// one.
-std::optional<Refusal> RefuseBody(const httplib::Request& request, size_t max_body,
-                                  const std::vector<std::regex>& body_routes) {
-  if (request.has_header("Transfer-Encoding")) {
-    return Refusal{411, "send the request body with a Content-Length, not a Transfer-Encoding"};
-  }
-  if (request.has_header("Content-Encoding")) {
-    return Refusal{415, "send the request body uncompressed, without a Content-Encoding"};
-  }
-  const bool takes_body =
-      request.method == "POST" &&
-      std::any_of(body_routes.begin(), body_routes.end(), [&request](const std::regex& path) {
-        return std::regex_match(request.path, path);
-      });
-  size_t length = 0;
-  if (!request.has_header("Content-Length")) {
-    if (request.method != "POST") return std::nullopt;
-    return Refusal{411, "a POST needs a Content-Length (curl: -d '' for an empty body)"};
-  }
-  if (!absl::SimpleAtoi(request.get_header_value("Content-Length"), &length)) {
-    return Refusal{400, "the Content-Length is not a number"};
-  }
-  if (length > 0 && !takes_body) {
-    return Refusal{413, absl::StrCat(request.method, " ", request.path, " takes no request body")};
-  }
-  if (length > max_body) {
-    return Refusal{413, absl::StrCat("the request body is larger than the ", max_body,
-                                     " bytes the server takes (--max-message-mb, base64-encoded)")};
-  }
-  return std::nullopt;
+  return refusal;
 }
 
 }  // namespace
 
 std::string DefaultWebRoot() { return MOTIONDB_WEB_DIST; }
 
+struct SslContextFree {
+  void operator()(SSL_CTX* context) const { SSL_CTX_free(context); }
+};
+
+// Declared in the order they are needed, so that destruction runs the other way: the loop (and
+// its workers, which use the router and the transcoder) goes before them.
 struct HttpServer::State {
   explicit State(MotionDbServer& server) : server(server) {}
 
   MotionDbServer& server;
   std::unique_ptr<ApiTranscoder> api;
-  std::unique_ptr<httplib::Server> http;
-  std::thread listener;
+  HttpRouter router;
+  std::unique_ptr<SSL_CTX, SslContextFree> tls;  // null: plain HTTP
+  std::unique_ptr<Listener> listener;
+  std::unique_ptr<ConnectionLoop> loop;
 };
 
 HttpServer::HttpServer(std::unique_ptr<State> state) : state_(std::move(state)) {}
 
-HttpServer::~HttpServer() { Stop(); }
-
-void HttpServer::Stop() {
-  if (state_->http) state_->http->stop();
-  if (state_->listener.joinable()) state_->listener.join();
+HttpServer::~HttpServer() {
+  state_->server.metrics().SetConnectionSource(kHttpFace, nullptr);
+  Stop(std::chrono::steady_clock::now());
 }
+
+void HttpServer::BeginStop() {
+  state_->listener->Stop();
+  state_->loop->BeginStop();
+}
+
+void HttpServer::Stop(std::chrono::steady_clock::time_point deadline) {
+  BeginStop();
+  state_->router.StopStreaming();
+  state_->loop->Stop(deadline);
+}
+
+int HttpServer::port() const { return state_->listener->port(); }
 
 namespace {
 
-// The body and token checks, the metrics' bookkeeping and JSON bodies for the library's own
-// errors. The pre-routing handler runs once the headers are read, before httplib reads a body.
-void AddHooks(MotionDbServer& server, size_t max_body, httplib::Server& http) {
-  http.set_pre_routing_handler([&server, max_body, body_routes = BodyRoutes()](
-                                   const httplib::Request& request, httplib::Response& response) {
+// The checks of a request's head, before its body is read (the connection loop's hook).
+std::optional<HttpRefusal> CheckHead(MotionDbServer& server, size_t max_body,
+                                     const std::vector<std::regex>& body_routes,
+                                     const RequestHead& head, const HttpConnection& connection) {
+  TokenScope scope;
+  if (std::optional<HttpRefusal> refusal =
+          CheckAccess(server, head.method, head.path, connection.peer_address(),
+                      head.Values("authorization"), &scope)) {
+    return refusal;
+  }
+  return RefuseBody(head, max_body, body_routes);
+}
+
+// The access check again on httplib's own reading of the path (the loop's came first, on its
+// own), the scope granted for the call, the metrics' bookkeeping and JSON bodies for the
+// library's own errors.
+void AddHooks(MotionDbServer& server, httplib::Server& http) {
+  http.set_pre_routing_handler([&server](const httplib::Request& request,
+                                         httplib::Response& response) {
     // Until a route's handler names itself.
     exchange = {std::chrono::steady_clock::now(), IsApiPath(request.path) ? "unmatched" : "static"};
-    if (const std::optional<Refusal> refusal = RefuseBody(request, max_body, body_routes)) {
-      exchange.route = "refused";
-      response.status = refusal->status;
-      // The body is left unread, so the connection cannot carry another request.
-      response.set_header("Connection", "close");
-      response.set_content(ErrorJson(CodeOfHttpStatus(refusal->status), refusal->message), kJson);
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (!NeedsToken(server.options(), request.path) || Authorized(server.options(), request)) {
-      return httplib::Server::HandlerResponse::Unhandled;
-    }
+    const std::optional<HttpRefusal> refusal =
+        CheckAccess(server, request.method, request.path, request.remote_addr,
+                    AuthorizationHeaders(request), &exchange.scope);
+    if (!refusal) return httplib::Server::HandlerResponse::Unhandled;
     exchange.route = "refused";
-    response.set_header("WWW-Authenticate", "Bearer");
-    SendError(grpc::StatusCode::UNAUTHENTICATED,
-              "missing or wrong bearer token: send the header 'Authorization: Bearer <token>'",
-              response);
+    response.status = refusal->status;
+    for (const auto& [name, value] : refusal->headers) response.set_header(name, value);
+    response.set_content(ErrorJson(CodeOfHttpStatus(refusal->status), refusal->message), kJson);
     server.request_log().WriteLine(absl::StrCat(request.method, " ", request.path),
-                                   "UNAUTHENTICATED", 0.0, absl::StrCat("http:", Peer(request)));
+                                   StatusCodeName(CodeOfHttpStatus(refusal->status)), 0.0,
+                                   absl::StrCat("http:", Peer(request)), refusal->message);
     return httplib::Server::HandlerResponse::Handled;
   });
   http.set_error_handler(httplib::Server::HandlerWithResponse(
@@ -236,6 +204,7 @@ void AddApiRoutes(const ApiTranscoder& api, httplib::Server& http) {
       if (!route.json_body) call.query.insert(request.params.begin(), request.params.end());
       call.body = request.body;
       call.peer = Peer(request);
+      call.scope = std::string(TokenScopeName(exchange.scope));
       Send(api.Call(route, call), response);
     };
     const std::string pattern = route.PathRegex();
@@ -254,12 +223,15 @@ void AddOperationsRoutes(const ApiTranscoder& api, MotionDbServer& server, httpl
     exchange.route = "GET /healthz";
     response.set_content("ok", "text/plain");
   });
-  http.Get("/readyz", [&api](const httplib::Request& request, httplib::Response& response) {
-    exchange.route = "GET /readyz";
-    const bool ready = api.Ready(Peer(request));
-    response.status = ready ? 200 : 503;
-    response.set_content(ready ? "ready" : "not ready", "text/plain");
-  });
+  http.Get("/readyz",
+           [&api, &server](const httplib::Request& request, httplib::Response& response) {
+             exchange.route = "GET /readyz";
+             // Not ready while the gRPC port cannot take a connection (out of descriptors, or
+             // full).
+             const bool ready = server.accepting() && api.Ready(Peer(request));
+             response.status = ready ? 200 : 503;
+             response.set_content(ready ? "ready" : "not ready", "text/plain");
+           });
 }
 
 // A web root counts as built when it holds the page: an image built without the npm registry
@@ -288,73 +260,91 @@ void AddWebRoot(const std::string& root, httplib::Server& http) {
   });
 }
 
-absl::StatusOr<std::unique_ptr<httplib::Server>> NewHttpServer(const ServerOptions& options) {
-  if (options.tls_cert_pem.empty()) return std::make_unique<httplib::Server>();
-  absl::Status loaded;
-  auto https = std::make_unique<httplib::SSLServer>([&](SSL_CTX& context) {
-    loaded = LoadPemIntoContext(options.tls_cert_pem, options.tls_key_pem, context);
-    return loaded.ok();
-  });
-  if (!loaded.ok()) return loaded;
-  if (!https->is_valid()) return absl::InvalidArgumentError("HTTPS could not be set up");
-  return https;
+absl::StatusOr<std::unique_ptr<SSL_CTX, SslContextFree>> NewTlsContext(
+    const ServerOptions& options) {
+  if (options.tls_cert_pem.empty()) return nullptr;
+  std::unique_ptr<SSL_CTX, SslContextFree> context(SSL_CTX_new(TLS_server_method()));
+  if (context == nullptr) return absl::InternalError("HTTPS could not be set up (SSL_CTX_new)");
+  SSL_CTX_set_min_proto_version(context.get(), TLS1_2_VERSION);
+  MOTIONDB_RETURN_IF_ERROR(LoadPemIntoContext(options.tls_cert_pem, options.tls_key_pem, *context));
+  return context;
+}
+
+// A refusal written to a connection the port will not take (plain HTTP only: a TLS client would
+// read it as garbage). Best effort: the socket is new, its buffer empty.
+void RefuseConnection(int socket, absl::string_view reason) {
+  const std::string body =
+      ErrorJson(grpc::StatusCode::UNAVAILABLE,
+                absl::StrCat("the server takes no more connections: ", reason, "; retry later"));
+  const std::string response = absl::StrCat(
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nContent-Length: ",
+      body.size(), "\r\nRetry-After: 1\r\nConnection: close\r\n\r\n", body);
+  const ssize_t written =
+      ::send(socket, response.data(), response.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  (void)written;
 }
 
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions& options,
                                                               MotionDbServer& server) {
-  MOTIONDB_ASSIGN_OR_RETURN(const auto host_port, SplitHostPort(options.listen));
   auto state = std::make_unique<State>(server);
   MOTIONDB_ASSIGN_OR_RETURN(
       state->api, ApiTranscoder::Create(server.InProcessChannel(), options.call_timeout_s));
-  MOTIONDB_ASSIGN_OR_RETURN(state->http, NewHttpServer(server.options()));
-  httplib::Server& http = *state->http;
-  const size_t threads = std::max<size_t>(kMinThreads, 2 * std::thread::hardware_concurrency());
-  http.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  // SO_REUSEADDR alone: httplib's default adds SO_REUSEPORT, which would let a second server
-  // share a port in use instead of failing to start.
-  http.set_socket_options([](int socket) {
-    const int yes = 1;
-    setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
-  });
-  // httplib writes a response's headers and body apart; with Nagle's algorithm the body waits
-  // for the client's delayed ACK, 40 ms on Linux (measured: every search and scrape took 44 ms
-  // more).
-  http.set_tcp_nodelay(true);
-  http.set_keep_alive_max_count(kKeepAliveRequests);
+  MOTIONDB_ASSIGN_OR_RETURN(state->tls, NewTlsContext(server.options()));
+  HttpRouter& router = state->router;
+  router.set_keep_alive_max_count(options.loop.max_requests_per_connection);
+  router.set_keep_alive_timeout(
+      std::chrono::duration_cast<std::chrono::seconds>(options.loop.idle_timeout).count());
   // A JSON body carries a BVH file in base64: 4/3 of the largest message, and room for the rest.
   const size_t max_body =
       (static_cast<size_t>(server.options().max_message_mb) << 20) / 3 * 4 + (size_t{1} << 20);
-  http.set_payload_max_length(max_body);
-  AddHooks(server, max_body, http);
-  AddApiRoutes(*state->api, http);
-  AddOperationsRoutes(*state->api, server, http);
+  router.set_payload_max_length(max_body);
+  AddHooks(server, router);
+  AddApiRoutes(*state->api, router);
+  AddOperationsRoutes(*state->api, server, router);
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
-  AddWebRoot(web_root, http);
+  AddWebRoot(web_root, router);
 
-  const auto& [host, port] = host_port;
-  const int bound =
-      port == 0 ? http.bind_to_any_port(host) : (http.bind_to_port(host, port) ? port : -1);
-  if (bound <= 0) {
-    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen,
-                                               " for HTTP (address in use or not local)"));
-  }
-  std::promise<void> listened;
-  std::future<void> ended = listened.get_future();
-  state->listener = std::thread([&http, listened = std::move(listened)]() mutable {
-    http.listen_after_bind();
-    listened.set_value();
-  });
-  // stop() does nothing until the loop runs; wait for it, so that Stop() always ends it. A
-  // loop that ended by itself (its socket failed) is joined: no thread outlives the error.
-  while (!http.is_running()) {
-    if (ended.wait_for(std::chrono::milliseconds(1)) == std::future_status::ready) {
-      state->listener.join();
-      return absl::UnavailableError(absl::StrCat("HTTP on ", options.listen, " did not start"));
-    }
-  }
-  LogLine(absl::StrCat("HTTP on ", options.listen, " (http port ", bound, ")",
+  MOTIONDB_ASSIGN_OR_RETURN(
+      state->listener,
+      Listener::Bind(ListenerOptions{.listen = options.listen,
+                                     .face = "HTTP",
+                                     .flag = "--http",
+                                     .limits = options.connections,
+                                     .log = [](absl::string_view line) { LogLine(line); }}));
+  ConnectionLoop::Hooks hooks;
+  hooks.check_head = [&server, max_body, body_routes = BodyRoutePaths()](
+                         const RequestHead& head, const HttpConnection& connection) {
+    return CheckHead(server, max_body, body_routes, head, connection);
+  };
+  const std::chrono::milliseconds stall = options.loop.write_stall_timeout;
+  hooks.answer = [&router, stall](HttpConnection& connection, absl::string_view request,
+                                  bool last) {
+    return router.Answer(connection, request, last, stall);
+  };
+  hooks.refused = [&server](const HttpConnection& connection, const RequestHead* head,
+                            const HttpRefusal& refusal) {
+    server.metrics().CountHttp("refused", refusal.status, 0.0);
+    server.request_log().WriteLine(
+        head != nullptr ? absl::StrCat(head->method, " ", head->path) : "HTTP request",
+        StatusCodeName(CodeOfHttpStatus(refusal.status)), 0.0,
+        absl::StrCat("http:", connection.peer()), refusal.message);
+  };
+  hooks.error_body = [](const HttpRefusal& refusal) {
+    return ErrorJson(CodeOfHttpStatus(refusal.status), refusal.message);
+  };
+  state->loop = std::make_unique<ConnectionLoop>(options.loop, state->tls.get(),
+                                                 server.upload_budget(), std::move(hooks));
+  ConnectionLoop& loop = *state->loop;
+  state->listener->Start(
+      [&loop](AcceptedConnection connection) { loop.Add(std::move(connection)); },
+      state->tls ? Listener::Refuser() : Listener::Refuser(&RefuseConnection),
+      /*reclaim=*/nullptr);
+  Listener& listener = *state->listener;
+  server.metrics().SetConnectionSource(kHttpFace,
+                                       [&listener] { return listener.connections().open(); });
+  LogLine(absl::StrCat("HTTP on ", options.listen, " (http port ", state->listener->port(), ")",
                        server.options().tls_cert_pem.empty() ? ", plain text" : ", HTTPS",
                        "; web UI from ", web_root, WebRootIsBuilt(web_root) ? "" : " (not built)"));
   return std::unique_ptr<HttpServer>(new HttpServer(std::move(state)));

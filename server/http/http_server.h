@@ -3,18 +3,22 @@
 // (Prometheus), /healthz and /readyz, and the web UI's built files at /. HTTPS with the gRPC
 // port's certificate and key when TLS is on; the API and the metrics need the gRPC token
 // (Authorization: Bearer), the health routes as the gRPC health service does, the web UI's
-// files never (they hold no data). cpp-httplib parses the requests and runs them on its own
-// thread pool.
+// files never (they hold no data). The port and its connections are motiondb's
+// (server/net/listener.h, server/http/connection_loop.h); cpp-httplib parses and routes each
+// request once it has arrived whole (server/http/http_exchange.h).
 //
 // Thread-safe.
 #ifndef MOTIONDB_SERVER_HTTP_HTTP_SERVER_H_
 #define MOTIONDB_SERVER_HTTP_HTTP_SERVER_H_
 
+#include <chrono>
 #include <memory>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "server/grpc/motiondb_server.h"
+#include "server/http/connection_loop.h"
+#include "server/net/connection_counter.h"
 
 namespace motiondb::server {
 
@@ -27,6 +31,12 @@ struct HttpOptions {
   // work stopped as a gRPC call's deadline stops it; HTTP clients send no deadline of their own
   // (--http-timeout-s).
   double call_timeout_s = 600;
+  // Connections the HTTP port holds at once, in all (--http-max-connections) and from one
+  // client address (--max-connections-per-peer).
+  ConnectionLimits connections;
+  // Timeouts, workers and their line (--http-threads, --http-max-waiting,
+  // --http-request-timeout-s, --min-upload-kbps).
+  HttpLoopOptions loop;
 };
 
 // The web/dist folder of the source tree this binary was built from.
@@ -41,8 +51,14 @@ class HttpServer {
                                                            MotionDbServer& server);
   ~HttpServer();  // Stop()
 
-  // Stops listening, lets requests in progress finish, and returns (idempotent).
-  void Stop();
+  // Stops listening and reading requests: connections between requests close now (a slow
+  // client's half-sent request with them); answers under way go on.
+  void BeginStop();
+  // BeginStop(), then lets answers under way finish until `deadline`, cuts the connections of
+  // those still writing, and returns (idempotent).
+  void Stop(std::chrono::steady_clock::time_point deadline);
+  // The port listened on (useful with port 0).
+  int port() const;
 
  private:
   struct State;

@@ -289,7 +289,7 @@ test("a server with a token asks for it once, however many calls it refused", as
       }),
     );
     await page.goto(guarded.baseUrl + "/");
-    // The page's first three calls (spaces, skeletons, clips) are refused before it answers.
+    // The page's first calls (spaces, skeletons, info, clips) are refused before it answers.
     await allRefused;
     await page.fill("[data-testid=token]", "web-token", WAIT);
     await page.click(".token-dialog button[value=ok]");
@@ -298,6 +298,38 @@ test("a server with a token asks for it once, however many calls it refused", as
     assert.equal(await page.evaluate(() => window.tokenPrompts), 1);
     assert.equal(await page.locator("dialog").count(), 0);
     await page.close();
+  } finally {
+    await own.close();
+    await guarded.stop();
+  }
+});
+
+test("a read-only token sees labelling turned off, and the server refuses it too", async () => {
+  const tokenFile = join(work, "scoped-tokens");
+  writeFileSync(tokenFile, "read reader-token\nwrite writer-token\n");
+  const guarded = await ServerProcess.start(SERVER, ["--auth-token-file", tokenFile]);
+  const own = await Browser.launch();
+  try {
+    for (const [token, writable] of [
+      ["reader-token", false],
+      ["writer-token", true],
+    ]) {
+      const page = await own.page();
+      await page.addInitScript((t) => sessionStorage.setItem("motiondb.token", t), token);
+      await page.goto(guarded.baseUrl + "/");
+      await page.waitForSelector("body[data-ready=true]", WAIT);
+      assert.equal(await page.locator("[data-testid=read-only]").isVisible(), !writable, token);
+      assert.equal(await page.locator("[data-testid=propagate]").isDisabled(), !writable, token);
+      if (!writable) await page.screenshot({ path: join(OUT, "read_only_token.png") });
+      await page.close();
+    }
+    const refused = await fetch(`${guarded.baseUrl}/v1/labels`, {
+      method: "POST",
+      headers: { "Content-Type": "application/json", Authorization: "Bearer reader-token" },
+      body: JSON.stringify({ labels: [] }),
+    });
+    assert.equal(refused.status, 403);
+    assert.match((await refused.json()).message, /needs 'write'/);
   } finally {
     await own.close();
     await guarded.stop();

@@ -45,12 +45,15 @@ export class App {
 
   /** Loads the library and follows the page's address (a deep link). */
   async start(): Promise<void> {
-    const [spaces, skeletons] = await Promise.all([
+    const [spaces, skeletons, info] = await Promise.all([
       api.spaces(),
       api.skeletons(),
+      api.info(),
       this.library.reload(),
     ]);
     this.spaces = spaces;
+    // What the token cannot do is not offered (the server refuses it all the same).
+    this.labels.setWritable(info.scope !== "read");
     fill(
       this.spaceSelect,
       ...spaces.map((s) => h("option", { value: s.name }, `${s.name} · skeleton ${s.skeleton_id}`)),

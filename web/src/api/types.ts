@@ -115,4 +115,6 @@ export interface ServerInfo {
   version: string;
   counts?: { clips: Int64; spaces: Int64; labels: Int64 };
   auth_required: boolean;
+  /** What the caller's token holds: "read", "write" or "admin". */
+  scope: string;
 }

@@ -30,6 +30,13 @@ export class LabelPanel {
   private readonly propagate = h("button", { "data-testid": "propagate" }, "Propagate");
   private readonly progress = h("progress", { max: 1, value: 0 });
   private readonly state = h("span", { class: "job-state", "data-testid": "job-state" });
+  private readonly readOnly = h(
+    "p",
+    { class: "hint", "data-testid": "read-only", hidden: true },
+    "This token can only read: labels and propagation need a token of scope write.",
+  );
+  private writable = true;
+  private hasSelection = false;
 
   constructor(element: HTMLElement) {
     fill(
@@ -45,6 +52,7 @@ export class LabelPanel {
         this.propagate,
       ),
       h("div", { class: "row job" }, this.progress, this.state),
+      this.readOnly,
     );
     this.add.addEventListener("click", () => {
       if (this.text()) this.onLabel(this.text(), Number(this.value.value));
@@ -56,8 +64,17 @@ export class LabelPanel {
   }
 
   setSelection(hasSelection: boolean): void {
-    this.add.disabled = !hasSelection;
+    this.hasSelection = hasSelection;
+    this.add.disabled = !hasSelection || !this.writable;
     this.add.title = hasSelection ? "" : "Select a range on the timeline first";
+  }
+
+  /** Whether the token may write: a read-only one sees the controls off and says why. */
+  setWritable(writable: boolean): void {
+    this.writable = writable;
+    this.propagate.disabled = !writable;
+    this.readOnly.hidden = writable;
+    this.setSelection(this.hasSelection);
   }
 
   showJob(job: Job): void {

@@ -1,0 +1,27 @@
+// The scope (util/token_file.h) each motiondb.v1 method needs: read for what only reads
+// (search, lists, exports, curves), write for what adds or changes (ingest, labels, jobs,
+// spaces, edits), admin for deletes and backups. The HTTP face asks the same table for the
+// route's method.
+#ifndef MOTIONDB_SERVER_GRPC_METHOD_SCOPES_H_
+#define MOTIONDB_SERVER_GRPC_METHOD_SCOPES_H_
+
+#include "absl/strings/string_view.h"
+#include "util/token_file.h"
+
+namespace motiondb::server {
+
+// Whether `method` ("/pkg.Service/Method") is one of motiondb.v1's, which the service-side
+// check guards (server/grpc/access_control.h); gRPC's own services (health, reflection) are
+// guarded by the port's credentials.
+bool IsMotionDbMethod(absl::string_view method);
+
+// The scope `method` needs; admin for a method the table does not name (a new one must be
+// added to it: tests/access_control_test.cc checks that every method is).
+TokenScope RequiredScope(absl::string_view method);
+
+// Whether the table names `method` (for that test).
+bool HasScopeEntry(absl::string_view method);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_GRPC_METHOD_SCOPES_H_
