@@ -1,11 +1,17 @@
 // A soak of the real server (issue 15, item 7): N clients, each on its own connection, run a mix
 // of reads and writes for S seconds against a library that stays the same size (each client
-// keeps at most a few clips of its own: it deletes its oldest when it ingests another). Reports
-// the calls and their errors by method and status code, and the server's resident memory every
-// few seconds; fails (exit 1) on any error or when memory at the end exceeds 1.5x its highest
-// level in the second fifth of the run (once warm).
+// keeps at most a few clips of its own: it deletes its oldest when it ingests another). Beside
+// them (issue 37, unless --no-hostile): HTTP clients calling the JSON API on new connections,
+// slow HTTP clients, idle upload streams and floods of idle connections to both ports, with the
+// server run under a low open-file limit (--max-open-files) and connection limits above what it
+// holds, so that the floods run it out of descriptors. Reports the calls and their errors by
+// method and status code, and the server's resident memory every few seconds; fails (exit 1) on
+// any error of the mix (an HTTP refusal, 503, during a flood is none), when memory at the end
+// exceeds 1.5x its highest level in the second fifth of the run (once warm), when a new gRPC
+// connection is not served at the end, or on an unclean stop.
 //
-// usage: soak [--seconds 600] [--clients 16] [--sample-s 30]
+// usage: soak [--seconds 600] [--clients 16] [--sample-s 30] [--no-hostile]
+//             [--max-open-files 1024]
 #include <signal.h>
 
 #include <algorithm>
@@ -24,6 +30,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/strings/str_cat.h"
+#include "bench/hostile_clients.h"
 #include "bench/measure.h"
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
@@ -34,6 +41,9 @@
 #include "testing/synthetic_corpus.h"
 #include "util/cli_conventions.h"
 #include "util/status_macros.h"
+
+// Last: httplib.h includes <resolv.h>, whose macro _res breaks Eigen's headers.
+#include <httplib.h>
 
 namespace motiondb {
 namespace {
@@ -46,6 +56,8 @@ struct Flags {
   double seconds = 600;
   int clients = 16;
   double sample_s = 30;
+  bool hostile = true;
+  int max_open_files = 1024;
 };
 
 // Clips of its own a client keeps; ingesting another deletes the oldest.
@@ -186,6 +198,28 @@ void RunClient(const std::string& address, int index, const Library& library,
   }
 }
 
+// The JSON API on a new connection each call, as a script would: a refusal (503) while a flood
+// holds every place is counted apart, any other failure as an error.
+void RunHttpClient(int port, Clock::time_point stop_at, CallTally& tally) {
+  for (int call = 0; Clock::now() < stop_at; ++call) {
+    httplib::Client http("127.0.0.1", port);
+    http.set_connection_timeout(10);
+    http.set_read_timeout(60);
+    const httplib::Result result =
+        call % 2 == 0 ? http.Get("/v1/clips?page_size=20") : http.Get("/v1/spaces/body");
+    const std::string method = call % 2 == 0 ? "HTTP clips" : "HTTP space";
+    if (result && result->status == 200) {
+      tally.Add(method, grpc::StatusCode::OK, "");
+    } else if (!result || result->status == 503) {
+      tally.Add(method + " refused", grpc::StatusCode::OK, "");
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    } else {
+      tally.Add(method, grpc::StatusCode::UNKNOWN,
+                absl::StrCat("HTTP ", result->status, ": ", result->body));
+    }
+  }
+}
+
 absl::Status Run(const Flags& flags) {
   const std::filesystem::path work =
       std::filesystem::temp_directory_path() / ("motiondb_soak_" + std::to_string(::getpid()));
@@ -206,8 +240,13 @@ absl::Status Run(const Flags& flags) {
   }
 
   testing::ServerProcess server;
+  std::vector<std::string> args = {"--db", db, "--quiet"};
+  if (flags.hostile) {
+    server.LimitOpenFiles(flags.max_open_files);
+    args.insert(args.end(), {"--max-connections", "4096", "--http-max-connections", "4096"});
+  }
   std::string error;
-  if (!server.Start({"--db", db, "--quiet"}, &error, std::chrono::seconds(600)) ||
+  if (!server.Start(args, &error, std::chrono::seconds(600)) ||
       !testing::WaitUntilServing(testing::InsecureChannel(server.address()), "")) {
     return absl::InternalError(absl::StrCat("the server did not start: ", error));
   }
@@ -240,6 +279,14 @@ absl::Status Run(const Flags& flags) {
     clients.emplace_back(RunClient, server.address(), c, std::cref(library), stop_at,
                          std::ref(tally));
   }
+  std::unique_ptr<bench::HostileClients> hostile;
+  if (flags.hostile) {
+    for (int c = 0; c < 2; ++c) {
+      clients.emplace_back(RunHttpClient, server.http_port(), stop_at, std::ref(tally));
+    }
+    hostile = std::make_unique<bench::HostileClients>(
+        bench::HostileOptions{.grpc_port = server.port(), .http_port = server.http_port()});
+  }
   std::vector<std::pair<double, double>> samples;  // (seconds, VmRSS MiB)
   for (double next = 0; Clock::now() < stop_at; next += flags.sample_s) {
     std::this_thread::sleep_until(
@@ -249,8 +296,19 @@ absl::Status Run(const Flags& flags) {
     std::fflush(stdout);
   }
   for (std::thread& client : clients) client.join();
+  if (hostile) {
+    hostile->Stop();
+    std::printf("%s\n", hostile->Report().c_str());
+  }
+  // The gRPC port takes a new connection after it all.
+  v1::ListClipsResponse listed;
+  const grpc::Status accepting =
+      v1::ClipService::NewStub(testing::InsecureChannel(server.address()))
+          ->ListClips(Context().get(), v1::ListClipsRequest(), &listed);
   samples.emplace_back(SecondsSince(start), StatusMiB(server.pid(), "VmRSS"));
   const double peak = StatusMiB(server.pid(), "VmHWM");
+  std::string log_tail = server.Log();
+  log_tail = log_tail.substr(log_tail.size() > 4000 ? log_tail.size() - 4000 : 0);
   const int stopped = server.Stop(SIGTERM);
   std::filesystem::remove_all(work);
 
@@ -266,10 +324,13 @@ absl::Status Run(const Flags& flags) {
   const double growth = samples.back().second / settled;
   std::printf(
       "VmRSS %.1f MiB at most in the second fifth, %.1f MiB at the end (%.2fx), peak %.1f MiB;"
-      " %lld failed calls; server exit code %d\n",
-      settled, samples.back().second, growth, peak, static_cast<long long>(failed), stopped);
-  if (failed > 0 || growth > 1.5 || stopped != 0) {
-    return absl::InternalError("the soak failed: errors, growing memory or an unclean stop");
+      " %lld failed calls; a new gRPC connection at the end: %s; server exit code %d\n",
+      settled, samples.back().second, growth, peak, static_cast<long long>(failed),
+      accepting.ok() ? "served" : accepting.error_message().c_str(), stopped);
+  if (failed > 0 || growth > 1.5 || stopped != 0 || !accepting.ok()) {
+    std::printf("the server's log, its end:\n%s\n", log_tail.c_str());
+    return absl::InternalError(
+        "the soak failed: errors, growing memory, a port not accepting or an unclean stop");
   }
   return absl::OkStatus();
 }
@@ -289,6 +350,12 @@ int main(int argc, char** argv) {
   app.add_option("--sample-s", flags.sample_s, "seconds between memory samples")
       ->capture_default_str()
       ->check(motiondb::cli::NumberAbove(0));
+  app.add_flag("!--no-hostile", flags.hostile,
+               "no HTTP clients, slow clients, idle streams or connection floods");
+  app.add_option("--max-open-files", flags.max_open_files,
+                 "the server's open-file limit with the hostile clients")
+      ->capture_default_str()
+      ->check(CLI::Range(128, 1 << 20));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
