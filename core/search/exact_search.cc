@@ -44,13 +44,15 @@ class ClipScan {
 
   // Runs over every column, offering each end frame's best path to `top`.
   // `bound()` is a cost that no result of other clips at or above it can rank with: paths
-  // that cannot stay below it and below the clip's own k-th best are dropped.
-  absl::Status Run(int clip_index, const SearchParams& params, absl::FunctionRef<float()> bound,
+  // that cannot stay below it and below the clip's own k-th best are dropped. `stop` is told
+  // each column's cells (a column of a long query costs as much as many short ones).
+  absl::Status Run(int clip_index, StopPoll& stop, absl::FunctionRef<float()> bound,
                    StreamingTopResults& top, SearchStats& stats) {
     const auto threshold = [&] { return std::min(top.threshold(), bound()); };
     for (int64_t j = 0; j < clip_.rows; ++j) {
+      // Every column is cleared, m x s cells, whatever it then fills.
+      if (stop.Done(m_ * s_)) return SearchStopped();
       if (j % kBlock == 0) {
-        if ((j / kBlock) % 256 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
         BlockLowerBound(j);
         if (!AnyAlive() && lower_bound_[0] >= threshold()) {
           // No path can start in this block and beat the k-th best: skip it.
@@ -237,10 +239,14 @@ class FinishedClips {
 absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const SearchParams& params,
                       std::vector<SearchResult>& results) {
   WarpWorkspace workspace;
+  StopPoll stop = SearchStop(params);
   for (SearchResult& result : results) {
+    if (stop.Done(query.rows)) return SearchStopped();
     std::optional<Warp> warp = AnchoredWarp(
         query, library.clip_coordinates(result.clip_index), static_cast<int>(query.rows - 1),
-        result.last_frame, {params.slope_limit, params.dtw_dims}, /*with_path=*/true, workspace);
+        result.last_frame, {params.slope_limit, params.dtw_dims}, /*with_path=*/true, workspace,
+        std::numeric_limits<float>::infinity(), &stop);
+    if (stop.stopped()) return SearchStopped();
     if (!warp) {
       return absl::InternalError(absl::StrCat("no warp ends at frame ", result.last_frame,
                                               " of clip ", result.clip_index,
@@ -268,10 +274,13 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
       [&](int64_t index, int thread) -> absl::Status {
         const int c = static_cast<int>(index);
         if (!allowed.empty() && !allowed[c]) return absl::OkStatus();
+        // Each thread polls on its own; every one of them stops within a poll's work.
+        StopPoll stop = SearchStop(params);
+        if (stop.Done(query.rows)) return SearchStopped();
         StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
         ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
         MOTIONDB_RETURN_IF_ERROR(scan.Run(
-            c, params, [&] { return finished.bound(); }, top, stats[thread]));
+            c, stop, [&] { return finished.bound(); }, top, stats[thread]));
         // Most clips hold nothing under the bound: adding nothing would only take the lock.
         std::vector<SearchResult> results = top.Take();
         if (!results.empty()) finished.Add(std::move(results));

@@ -73,6 +73,11 @@ int NearestFrameSeeds(const LibraryIndex& library, const SearchParams& params) {
       std::lround(1000 * (1 + std::log10(std::max(1.0, tree_frames / kTenHoursOfSeeds)))));
 }
 
+// The work of a seed as cells (kCellsPerStopPoll): a neighbour from the kd-tree took about a
+// microsecond, and clustering about 300 ns a seed (1,000,000 neighbours asked of 1 h at 30 Hz).
+constexpr int64_t kCellsPerNeighbour = 1024;
+constexpr int64_t kCellsPerClusteredSeed = 256;
+
 struct Seed {
   int clip;
   int64_t frame;
@@ -84,8 +89,9 @@ struct Seed {
 // represented by its nearest seed, and by every further seed that is the nearest within
 // `separation` frames: with many seeds, runs merge across several instances separated by
 // similar poses (the over-clustering of the thesis's Table 6.4), and one warp per run would
-// find only one of them.
-std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t separation) {
+// find only one of them. Counts its work in `stop`, and returns early once it says stop.
+std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t separation,
+                               StopPoll& stop) {
   std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) {
     return a.clip != b.clip ? a.clip < b.clip : a.frame < b.frame;
   });
@@ -101,6 +107,12 @@ std::vector<Seed> ClusterSeeds(std::vector<Seed> seeds, int64_t gap, int64_t sep
               [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
     const size_t first_kept = representatives.size();
     for (auto seed_it = run_begin; seed_it != run_end; ++seed_it) {
+      // A seed costs about 300 cells (its sorts); a run of many seeds far apart keeps many of
+      // them, each compared with the others.
+      if (stop.Done(kCellsPerClusteredSeed +
+                    static_cast<int64_t>(representatives.size() - first_kept))) {
+        return representatives;
+      }
       const Seed& seed = *seed_it;
       const bool near_kept = std::any_of(
           representatives.begin() + first_kept, representatives.end(),
@@ -178,21 +190,24 @@ class ClipBestScores {
 
 // The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
-// settled at the full rate.
+// settled at the full rate. `stop` is told the band warps' cells.
 absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
                                                  int anchor, int coarse_anchor, int factor,
                                                  const WarpConstraints& constraints,
                                                  const SearchParams& params,
-                                                 std::vector<SearchResult> candidates) {
+                                                 std::vector<SearchResult> candidates,
+                                                 StopPoll& stop) {
   BandWorkspace workspace;
   for (size_t i = 0; i < candidates.size(); ++i) {
-    if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
     SearchResult& candidate = candidates[i];
+    if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
     const int64_t phase = candidate.first_frame % factor;
     ToCoarseFrames(factor, phase, candidate);
     RefineCandidate(CoarseView(query, factor),
                     PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
-                    coarse_anchor, library.rate() / factor, constraints, workspace, candidate);
+                    coarse_anchor, library.rate() / factor, constraints, workspace, candidate,
+                    &stop);
+    if (stop.stopped()) return SearchStopped();
     ToClipFrames(factor, phase, candidate);
   }
   if (factor > 1) {
@@ -213,13 +228,14 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
            RankedCount(settled, params.max_overlap, params.max_results) == params.max_results)) {
         break;
       }
-      if (i % 8 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
       SearchResult& candidate = candidates[i];
+      if (stop.Done(query.rows)) return SearchStopped();
       if (RefineFromCoarse(query, library.clip_coordinates(candidate.clip_index), anchor, factor,
-                           constraints, ranked_above.bound(), workspace, candidate)) {
+                           constraints, ranked_above.bound(), workspace, candidate, &stop)) {
         ranked_above.Add(candidate.clip_index, candidate.score);
         settled.push_back(std::move(candidate));
       }
+      if (stop.stopped()) return SearchStopped();
     }
     candidates = std::move(settled);
   }
@@ -239,10 +255,10 @@ int CoarseRow(int frame, int factor, int64_t coarse_rows) {
 // characteristic pose `anchor` (or distinct places), the default count taken again while they
 // fall in too few places (kMostSeedDoublings), half of them at a second anchor when they scatter
 // (SearchParams::second_anchor_scatter). `coarse_rows`, `factor`: the warps' query. Fills the
-// seed and cluster stages' stats.
+// seed and cluster stages' stats. Counts its work in `stop`, and returns early once it says stop.
 std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView query, int anchor,
                                  int64_t coarse_rows, int factor, const std::vector<bool>& allowed,
-                                 const SearchParams& params, SearchStats& stats) {
+                                 const SearchParams& params, SearchStats& stats, StopPoll& stop) {
   Clock::time_point stage = Clock::now();
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
   const int64_t separation = std::max<int64_t>(gap + 1, query.rows / 2);
@@ -263,6 +279,7 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
   };
   const auto seeds_of = [&](int query_frame, int count) {
     const std::vector<Neighbour> neighbours = nearest_of(query_frame, count);
+    stop.Done(kCellsPerNeighbour * static_cast<int64_t>(neighbours.size()));
     std::vector<Seed> seeds;
     seeds.reserve(neighbours.size());
     for (const Neighbour& n : neighbours) {
@@ -276,7 +293,7 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
 
   stage = Clock::now();
   // Distinct places are their own clusters.
-  std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation);
+  std::vector<Seed> order = distinct ? nearest : ClusterSeeds(nearest, gap, separation, stop);
   const bool scattered = !distinct && params.second_anchor_scatter > 0 && nearest.size() >= 2 &&
                          static_cast<double>(order.size()) >
                              params.second_anchor_scatter * static_cast<double>(nearest.size());
@@ -285,15 +302,15 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
   // short library, a pose held long) are taken again, twice as many, while the library has
   // more and they reach more places. (Scattered seeds are in many places already.)
   const size_t wanted_clusters = kClustersPerResult * static_cast<size_t>(params.max_results);
-  for (int more = 0;
-       !distinct && !scattered && params.neighbours == 0 && more < kMostSeedDoublings &&
-       order.size() < wanted_clusters && nearest.size() == static_cast<size_t>(seed_count);
+  for (int more = 0; !stop.stopped() && !distinct && !scattered && params.neighbours == 0 &&
+                     more < kMostSeedDoublings && order.size() < wanted_clusters &&
+                     nearest.size() == static_cast<size_t>(seed_count);
        ++more) {
     seed_count *= 2;
     const Clock::time_point again = Clock::now();
     std::vector<Seed> more_seeds = seeds_of(anchor, seed_count);
     reseed_ms += MillisecondsSince(again);
-    std::vector<Seed> more_order = ClusterSeeds(more_seeds, gap, separation);
+    std::vector<Seed> more_order = ClusterSeeds(more_seeds, gap, separation, stop);
     if (more_order.size() <= order.size()) break;  // no new places: the seeds piled up anyway
     nearest = std::move(more_seeds);
     order = std::move(more_order);
@@ -310,12 +327,12 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
     const size_t half = nearest.size() / 2;
     const int rest = static_cast<int>(nearest.size() - half);
     nearest.resize(half);
-    order = ClusterSeeds(std::move(nearest), gap, separation);
+    order = ClusterSeeds(std::move(nearest), gap, separation, stop);
     const Clock::time_point second_start = Clock::now();
     std::vector<Seed> second_seeds = seeds_of(second, rest);
     second_seeds_ms = MillisecondsSince(second_start);
     stats.seeds = static_cast<int64_t>(half + second_seeds.size());
-    std::vector<Seed> more = ClusterSeeds(std::move(second_seeds), gap, separation);
+    std::vector<Seed> more = ClusterSeeds(std::move(second_seeds), gap, separation, stop);
     order.insert(order.end(), more.begin(), more.end());
     stats.second_anchor = second;
   }
@@ -354,8 +371,11 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   const CoordinateView warp_query = CoarseView(query, factor);
   const int warp_anchor = CoarseRow(anchor, factor, warp_query.rows);
 
+  StopPoll stop = SearchStop(params);
+  if (stop.Done(query.rows)) return SearchStopped();
   std::vector<Seed> order =
-      ClusteredSeeds(library, query, anchor, warp_query.rows, factor, allowed, params, stats);
+      ClusteredSeeds(library, query, anchor, warp_query.rows, factor, allowed, params, stats, stop);
+  if (stop.stopped()) return SearchStopped();
 
   stage = Clock::now();
   // Nearest clusters first: good warps early make the abandoning threshold tight early.
@@ -370,7 +390,8 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
                     : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
   for (size_t i = 0; i < order.size(); ++i) {
-    if (i % 64 == 0) MOTIONDB_RETURN_IF_ERROR(CheckStop(params));
+    // A warp's cells are counted as it fills them; its setup costs about a row's.
+    if (stop.Done(warp_query.rows)) return SearchStopped();
     const Seed& seed = order[i];
     const int64_t phase = seed.frame % factor;
     // A second anchor's warp needs its path to say where it passes the characteristic frame.
@@ -379,7 +400,8 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
     std::optional<Warp> warp =
         AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
                      CoarseRow(seed.anchor, factor, warp_query.rows), seed.frame / factor,
-                     constraints, keep_path || second_anchor, workspace, top.threshold());
+                     constraints, keep_path || second_anchor, workspace, top.threshold(), &stop);
+    if (stop.stopped()) return SearchStopped();
     if (!warp) continue;
     ++stats.warps;
     SearchResult candidate = MakeResult(seed.clip, *std::move(warp), seed.frame / factor);
@@ -396,7 +418,7 @@ absl::StatusOr<SearchResponse> Search(const LibraryIndex& library, CoordinateVie
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
     MOTIONDB_ASSIGN_OR_RETURN(candidates, Refine(library, query, anchor, warp_anchor, factor,
-                                                 constraints, params, std::move(candidates)));
+                                                 constraints, params, std::move(candidates), stop));
   }
   stats.refine_ms = MillisecondsSince(stage);
 

@@ -207,11 +207,12 @@ std::optional<Junction> Join(const Chaining& chaining, const SearchResult& previ
   return best;
 }
 
-// Links of part k's `matches` onto the chains of part k - 1.
+// Links of part k's `matches` onto the chains of part k - 1. Counts its work in `stop`, and
+// returns early once it says stop.
 std::vector<Link> LinkPart(const Chaining& chaining, const Part& previous_part,
                            const std::vector<SearchResult>& previous,
                            const std::vector<Link>& previous_links, const Part& part,
-                           const std::vector<SearchResult>& matches) {
+                           const std::vector<SearchResult>& matches, StopPoll& stop) {
   absl::flat_hash_map<int, std::vector<int>> previous_by_clip;
   for (size_t j = 0; j < previous.size(); ++j) {
     if (previous_links[j].cost < kInfinity) previous_by_clip[previous[j].clip_index].push_back(j);
@@ -223,6 +224,12 @@ std::vector<Link> LinkPart(const Chaining& chaining, const Part& previous_part,
     if (clip == previous_by_clip.end()) continue;
     const double own = match.score * part.rows;
     for (const int j : clip->second) {
+      // A join reads both matches' rows and the clip's frames between them (up to max_gap):
+      // thousands of matches of one clip make millions of joins.
+      if (stop.Done(previous_part.rows + part.rows +
+                    std::max<int64_t>(0, match.first_frame - previous[j].last_frame))) {
+        return links;
+      }
       // No pruning on the previous chain's cost alone: a pause at the junction can lower it.
       const std::optional<Junction> join = Join(chaining, previous[j], previous_part, match, part);
       if (!join) continue;
@@ -325,11 +332,15 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
   for (const SearchResult& match : matches[0]) {
     links[0].push_back({match.score * parts[0].rows, -1, -1});
   }
+  StopPoll stop = SearchStop(params);
   for (size_t k = 1; k < parts.size(); ++k) {
-    links[k] = LinkPart(chaining, parts[k - 1], matches[k - 1], links[k - 1], parts[k], matches[k]);
+    links[k] =
+        LinkPart(chaining, parts[k - 1], matches[k - 1], links[k - 1], parts[k], matches[k], stop);
+    if (stop.stopped()) return SearchStopped();
   }
   std::vector<SearchResult> candidates;
   for (size_t i = 0; i < matches.back().size(); ++i) {
+    if (stop.Done(query.rows)) return SearchStopped();
     if (links.back()[i].cost == kInfinity) continue;
     candidates.push_back(
         ChainResult(matches, links, parts, static_cast<int>(i), query.rows, params.return_path));

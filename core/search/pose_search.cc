@@ -41,6 +41,8 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   const auto start = std::chrono::steady_clock::now();
   if (pose.rows != 1) return absl::InvalidArgumentError("a pose query has one frame");
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, pose, params));
+  // One look: the work after it is bounded by max_results (a few milliseconds at most).
+  if (SearchStop(params).Done(1)) return SearchStopped();
   SearchResponse response;
   SearchStats& stats = response.stats;
   stats.characteristic_frame = 0;

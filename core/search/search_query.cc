@@ -85,11 +85,8 @@ std::vector<SearchResult> FinishResults(const LibraryIndex& library,
   return results;
 }
 
-absl::Status CheckStop(const SearchParams& params) {
-  if (params.should_stop && params.should_stop()) {
-    return absl::CancelledError("the search was stopped by its caller");
-  }
-  return absl::OkStatus();
+absl::Status SearchStopped() {
+  return absl::CancelledError("the search was stopped by its caller");
 }
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {

@@ -20,15 +20,16 @@ constexpr int kMaxRounds = 8;
 // abandoned as they go.
 std::optional<Warp> Settle(CoordinateView query, CoordinateView clip, std::vector<int64_t> centre,
                            int radius, double score, double abandon_score,
-                           const WarpConstraints& constraints, BandWorkspace& workspace) {
+                           const WarpConstraints& constraints, BandWorkspace& workspace,
+                           StopPoll* stop) {
   std::optional<Warp> best;
   for (int round = 0; round < kMaxRounds; ++round) {
     bool touches_edge = false;
     // Loosened a little, so that float rounding never abandons a warp that would be kept.
     const float abandon_at = static_cast<float>(std::min(score, abandon_score) *
                                                 static_cast<double>(query.rows) * (1 + 1e-5));
-    std::optional<Warp> warp =
-        BandWarp(query, clip, centre, radius, constraints, workspace, &touches_edge, abandon_at);
+    std::optional<Warp> warp = BandWarp(query, clip, centre, radius, constraints, workspace,
+                                        &touches_edge, abandon_at, stop);
     if (!warp || !(warp->score < score)) break;
     score = warp->score;
     centre = warp->path;
@@ -66,25 +67,25 @@ void Adopt(Warp warp, int anchor, SearchResult& candidate) {
 
 void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, double rate,
                      const WarpConstraints& constraints, BandWorkspace& workspace,
-                     SearchResult& candidate) {
+                     SearchResult& candidate, StopPoll* stop) {
   const int radius = std::max(kMinRadius, static_cast<int>(std::lround(kMovingRadiusS * rate)));
   // Its own score bounds every band already.
   std::optional<Warp> warp =
       Settle(query, clip, candidate.path, radius, candidate.score,
-             std::numeric_limits<double>::infinity(), constraints, workspace);
+             std::numeric_limits<double>::infinity(), constraints, workspace, stop);
   if (warp) Adopt(*std::move(warp), anchor, candidate);
 }
 
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
                       const WarpConstraints& constraints, double abandon_score,
-                      BandWorkspace& workspace, SearchResult& candidate) {
+                      BandWorkspace& workspace, SearchResult& candidate, StopPoll* stop) {
   // The coarse path is within about `factor` frames of the best warp near it; a band that
   // narrow re-centres when the best path touches its edge (2 * factor: the same results at
   // 10 h / 120 Hz, a third more time).
   std::optional<Warp> warp =
       Settle(query, clip, Upsample(candidate.path, factor, query.rows, clip.rows),
              std::max(kMinRadius, factor), std::numeric_limits<double>::infinity(), abandon_score,
-             constraints, workspace);
+             constraints, workspace, stop);
   if (!warp) return false;
   Adopt(*std::move(warp), anchor, candidate);
   return true;

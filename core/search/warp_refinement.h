@@ -28,9 +28,11 @@ inline CoordinateView CoarseView(CoordinateView view, int factor) {
 // `candidate` (a result with its path) becomes the best warp near it when that scores better:
 // its range, score, path, and as seed_frame the clip frame it matches to `anchor`. `rate`: the
 // frames per second of query and clip, which sets the band's width. `workspace`: one per thread.
+// `stop` (optional) is told the band warps' cells; once it says stop, the candidate may be left
+// as it was.
 void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, double rate,
                      const WarpConstraints& constraints, BandWorkspace& workspace,
-                     SearchResult& candidate);
+                     SearchResult& candidate, StopPoll* stop = nullptr);
 
 // `candidate`, a warp of CoarseView(query, factor) onto every factor-th frame of `clip` with its
 // path, its frames given as the clip's own, becomes the best full-rate warp in a narrow band
@@ -39,9 +41,10 @@ void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, doub
 // `abandon_score` (the candidate is then unchanged). The bound is a band's, not the settling's:
 // a band whose best path touches its edge would be followed by one around that path, which can
 // score under the bound, so a candidate can be given up that would have settled just under it.
+// `stop` as RefineCandidate's: false once it says stop.
 bool RefineFromCoarse(CoordinateView query, CoordinateView clip, int anchor, int factor,
                       const WarpConstraints& constraints, double abandon_score,
-                      BandWorkspace& workspace, SearchResult& candidate);
+                      BandWorkspace& workspace, SearchResult& candidate, StopPoll* stop = nullptr);
 
 }  // namespace motiondb
 

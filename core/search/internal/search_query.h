@@ -12,6 +12,7 @@
 #include "core/search/search_params.h"
 #include "core/search/search_result.h"
 #include "core/search/warp/time_warp.h"
+#include "util/stop_poll.h"
 
 namespace motiondb {
 
@@ -29,8 +30,20 @@ std::vector<SearchResult> FinishResults(const LibraryIndex& library,
                                         std::vector<SearchResult> candidates,
                                         const SearchParams& params);
 
-// CANCELLED when the caller's should_stop says so.
-absl::Status CheckStop(const SearchParams& params);
+// Work between two polls of SearchParams::should_stop, in cells of a warp or of the exact
+// search's scan (other work is counted as the cells it costs about as much as). A cell costs
+// about a nanosecond, but the first touch of a fresh page of a warp's table costs as much as a
+// thousand cells on this machine's virtual memory: so that a stop is seen within a few
+// milliseconds even then, a poll every quarter million cells (bench/RESULTS.md, issue 37).
+inline constexpr int64_t kCellsPerStopPoll = int64_t{1} << 18;
+
+// A search's poll of its should_stop, counting cells.
+inline StopPoll SearchStop(const SearchParams& params) {
+  return StopPoll(params.should_stop, kCellsPerStopPoll);
+}
+
+// CANCELLED: what a search that its should_stop stopped returns.
+absl::Status SearchStopped();
 
 // Milliseconds since `start`, for SearchStats' timings.
 double MillisecondsSince(std::chrono::steady_clock::time_point start);

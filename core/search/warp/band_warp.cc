@@ -59,7 +59,7 @@ MOTIONDB_VECTOR_CLONES std::optional<Warp> BandWarp(CoordinateView query, Coordi
                                                     const std::vector<int64_t>& centre, int radius,
                                                     const WarpConstraints& constraints,
                                                     BandWorkspace& ws, bool* touches_edge,
-                                                    float abandon_at) {
+                                                    float abandon_at, StopPoll* stop) {
   const int s = constraints.slope_limit;
   const int64_t m = query.rows, width = 2 * radius + 1, padded = width + 2 * s;
   ws.row_first.resize(m);
@@ -97,6 +97,7 @@ MOTIONDB_VECTOR_CLONES std::optional<Warp> BandWarp(CoordinateView query, Coordi
   std::copy(ws.distances.begin(), ws.distances.end(), cell(0, 0));
   const StepRowFn step = StepRowFor(s, std::make_integer_sequence<int, kMaxSlopeLimit>());
   for (int64_t i = 1; i < m; ++i) {
+    if (stop != nullptr && stop->Done(width * s)) return std::nullopt;
     row_distances(i);
     step(cell(i - 1, 0), padded, ws.row_first[i] - ws.row_first[i - 1], ws.distances.data(), width,
          cell(i, 0));

@@ -30,12 +30,14 @@ struct BandWorkspace {
 // itself a warp of the model. Sets `*touches_edge` when the best path reaches the band's edge
 // somewhere other than the clip's ends: a wider band, or one around the new path, might do
 // better still. Early abandoning: nullopt, as soon as it is sure, when the warp's cost (the sum
-// over the query's frames) exceeds `abandon_at` (`*touches_edge` is then unspecified).
+// over the query's frames) exceeds `abandon_at` (`*touches_edge` is then unspecified). `stop`,
+// when given, is told each row's cells: nullopt as soon as it says stop (AnchoredWarp's).
 std::optional<Warp> BandWarp(CoordinateView query, CoordinateView clip,
                              const std::vector<int64_t>& centre, int radius,
                              const WarpConstraints& constraints, BandWorkspace& workspace,
                              bool* touches_edge,
-                             float abandon_at = std::numeric_limits<float>::infinity());
+                             float abandon_at = std::numeric_limits<float>::infinity(),
+                             StopPoll* stop = nullptr);
 
 }  // namespace motiondb
 
