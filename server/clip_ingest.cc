@@ -28,7 +28,8 @@ absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest
                                            const std::function<bool()>& should_stop) {
   // The name is checked before the file is parsed, as a stream checks it before it is read.
   MOTIONDB_RETURN_IF_ERROR(ClipName(request).status());
-  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadUpload(bvh, request.file_name, limits));
+  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read,
+                            ReadUpload(bvh, request.file_name, limits, should_stop));
   return IngestParsedUpload(catalog, request, std::move(read), should_stop);
 }
 

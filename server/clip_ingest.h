@@ -40,8 +40,8 @@ struct IngestOutcome {
 // leaves no name. Lengths and characters of names and tags are the database's to check.
 absl::StatusOr<std::string> ClipName(const IngestRequest& request);
 
-// Parses, stores and indexes one uploaded file, or skips it (Catalog::IngestClip, which asks
-// `should_stop` before it commits).
+// Parses, stores and indexes one uploaded file, or skips it. `should_stop` is asked while the
+// file is parsed (ReadUpload) and before the catalogue commits (Catalog::IngestClip).
 absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
                                            absl::string_view bvh, const UploadLimits& limits,
                                            const std::function<bool()>& should_stop = {});

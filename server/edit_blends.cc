@@ -7,6 +7,7 @@
 #include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
+#include "util/stop_poll.h"
 
 namespace motiondb::server {
 namespace {
@@ -14,12 +15,17 @@ namespace {
 constexpr int kMaxFramesPerSegment = 10000;
 constexpr int kMaxBlendFrames = 1000000;
 
-// Placements of `poses` mixed per frame with the rows of `weights`.
-Placement MixedPlacement(const std::vector<const EditPose*>& poses, const RowMatrixXd& weights) {
+// Placements of `poses` mixed per frame with the rows of `weights`; CANCELLED once
+// `should_stop` says stop (a path of a million frames takes a second).
+absl::StatusOr<Placement> MixedPlacement(const std::vector<const EditPose*>& poses,
+                                         const RowMatrixXd& weights,
+                                         const std::function<bool()>& should_stop) {
   std::vector<PlacementFrame> sources;
   for (const EditPose* pose : poses) sources.push_back({&pose->placement, 0});
   Placement placement = EmptyPlacement(poses.front()->placement, static_cast<int>(weights.rows()));
+  StopPoll stop(should_stop, kPlacementFramesPerStopPoll);
   for (Eigen::Index k = 0; k < weights.rows(); ++k) {
+    if (stop.Done(static_cast<int64_t>(poses.size()))) return EditStopped();
     const std::vector<double> row(weights.row(k).data(), weights.row(k).data() + weights.cols());
     MixPlacementFrame(sources, row, &placement, static_cast<int>(k));
   }
@@ -64,10 +70,10 @@ absl::StatusOr<InterpolateOutcome> InterpolateInSpace(const EditContext& context
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource from,
-                            LoadSource(context.database, *snapshot, request.from, "from"));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource from, LoadSource(context.database, *snapshot,
+                                                              request.from, "from", should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource to,
-                            LoadSource(context.database, *snapshot, request.to, "to"));
+                            LoadSource(context.database, *snapshot, request.to, "to", should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(const EditPose a, PoseOf(space, from));
   MOTIONDB_ASSIGN_OR_RETURN(const EditPose b, PoseOf(space, to));
   RowMatrixXd poses(2, space.dims()), rotations(2, a.rotations.cols());
@@ -80,7 +86,8 @@ absl::StatusOr<InterpolateOutcome> InterpolateInSpace(const EditContext& context
   for (size_t i = 0; i < outcome.comparison.t.size(); ++i) {
     weights.row(i) << 1.0 - outcome.comparison.t[i], outcome.comparison.t[i];
   }
-  const Placement placement = MixedPlacement({&a, &b}, weights);
+  MOTIONDB_ASSIGN_OR_RETURN(const Placement placement,
+                            MixedPlacement({&a, &b}, weights, should_stop));
   const bool slerp = request.method == InterpolationMethod::kSlerp;
   const EditedMotion chosen{slerp ? outcome.comparison.slerp : outcome.comparison.mc_lerp,
                             placement};
@@ -112,7 +119,7 @@ absl::StatusOr<BlendOutcome> BlendInSpace(const EditContext& context, const Blen
   for (size_t i = 0; i < request.poses.size(); ++i) {
     MOTIONDB_ASSIGN_OR_RETURN(EditSource source,
                               LoadSource(context.database, *snapshot, request.poses[i].pose,
-                                         absl::StrCat("poses[", i, "].pose")));
+                                         absl::StrCat("poses[", i, "].pose"), should_stop));
     MOTIONDB_ASSIGN_OR_RETURN(EditPose pose, PoseOf(space, source));
     coordinates.row(i) = pose.coordinates.row(0);
     plane.row(i) << request.poses[i].x, request.poses[i].y;
@@ -124,8 +131,10 @@ absl::StatusOr<BlendOutcome> BlendInSpace(const EditContext& context, const Blen
                             BlendOnPlane(coordinates, plane, path, request.options));
   std::vector<const EditPose*> mixed;
   for (const EditPose& pose : poses) mixed.push_back(&pose);
-  EditedMotion edited{RowMatrixXd(), MixedPlacement(mixed, blend.weights)};
-  MOTIONDB_ASSIGN_OR_RETURN(edited.rotations, space.Reconstruct(blend.coordinates));
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
+  EditedMotion edited;
+  MOTIONDB_ASSIGN_OR_RETURN(edited.placement, MixedPlacement(mixed, blend.weights, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(edited.rotations, space.Reconstruct(blend.coordinates, should_stop));
   BlendOutcome outcome;
   outcome.weights = blend.weights;
   MOTIONDB_ASSIGN_OR_RETURN(

@@ -15,8 +15,17 @@
 
 namespace motiondb::server {
 
+absl::Status EditStopped() {
+  return absl::CancelledError("the operator was stopped by its caller");
+}
+
+absl::Status CheckEditStop(const std::function<bool()>& should_stop) {
+  return should_stop && should_stop() ? EditStopped() : absl::OkStatus();
+}
+
 absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
-                                      const ClipSelection& selection, absl::string_view field) {
+                                      const ClipSelection& selection, absl::string_view field,
+                                      const std::function<bool()>& should_stop) {
   MOTIONDB_RETURN_IF_ERROR(
       Prefixed(field, CheckClipInSpace(database, snapshot, selection.clip_id)));
   MOTIONDB_ASSIGN_OR_RETURN(const SelectedFrames selected,
@@ -27,7 +36,8 @@ absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSn
   source.clip_name = selected.record.name;
   source.fps = selected.clip.fps();
   source.skeleton = selected.clip.shared_skeleton();
-  MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, selected.clip));
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, selected.clip, should_stop));
   return source;
 }
 
@@ -54,13 +64,18 @@ absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSp
                                       const EditSource& like, const EditedMotion& motion,
                                       Provenance provenance, const EditOutput& output,
                                       const std::function<bool()>& should_stop) {
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(
       const Clip at_space_rate,
       ToClip(space, like.skeleton, PlaceRotations(space, motion.rotations, motion.placement),
              motion.placement));
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip, Resample(at_space_rate, like.fps, kBvhAnswerThreads));
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip clip,
+                            Resample(at_space_rate, like.fps, kBvhAnswerThreads, should_stop));
   EditResult result;
-  MOTIONDB_ASSIGN_OR_RETURN(result.bvh, WriteBvh(clip, std::nullopt, kBvhAnswerThreads));
+  MOTIONDB_ASSIGN_OR_RETURN(result.bvh,
+                            WriteBvh(clip, std::nullopt, kBvhAnswerThreads, should_stop));
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
   result.frames = clip.frame_count();
   result.fps = clip.fps();
   const std::string stem = output.store_name.empty() ? like.clip_name : output.store_name;

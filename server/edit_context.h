@@ -18,6 +18,7 @@
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/provenance.h"
+#include "server/search_runner.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
@@ -65,13 +66,27 @@ struct EditContext {
   storage::Database& database;
   Catalog& catalog;
   const IndexRegistry& registry;
+  // The longest search query, in frames at a space's rate (--max-query-frames), which also
+  // bounds the warp of an aligned overlap (FillGap).
+  int max_query_frames = kDefaultMaxQueryFrames;
 };
+
+// Frames of a placement mixed (MixPlacementFrame) between two polls of a stop function: about
+// a millisecond's.
+inline constexpr int64_t kPlacementFramesPerStopPoll = 4096;
+
+// CANCELLED: what an operator stopped by its caller returns.
+absl::Status EditStopped();
+// EditStopped() when `should_stop` says so: between the steps of an operator.
+absl::Status CheckEditStop(const std::function<bool()>& should_stop);
 
 // The selection's clip, range and motion in the space. NOT_FOUND for an unknown clip,
 // FAILED_PRECONDITION for a clip of another skeleton (CheckClipInSpace), INVALID_ARGUMENT naming
-// `field` for a range outside the clip.
+// `field` for a range outside the clip. `should_stop` is asked as the range enters the space:
+// CANCELLED once it says stop.
 absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
-                                      const ClipSelection& selection, absl::string_view field);
+                                      const ClipSelection& selection, absl::string_view field,
+                                      const std::function<bool()>& should_stop = {});
 
 // The source's only frame, or the projected mean of its frames with the mean of their
 // placements and the pose the mean unprojects to.
@@ -80,6 +95,8 @@ absl::StatusOr<EditPose> PoseOf(const MotionSpace& space, const EditSource& sour
 // The BVH of `motion` placed and exported with `like`'s skeleton at its rate, stored as a clip
 // when output.store_name is set (Catalog::IngestClip refusing a taken name; its errors name
 // output.store_name or output.store_tags[i]). `provenance` names the operator and its sources.
+// `should_stop` is asked between the steps and inside the long ones: CANCELLED once it says
+// stop, before anything is stored.
 absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSpace& space,
                                       const EditSource& like, const EditedMotion& motion,
                                       Provenance provenance, const EditOutput& output,

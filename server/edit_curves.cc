@@ -35,15 +35,16 @@ absl::StatusOr<EditResult> EditInSpace(const EditContext& context, const CurveEd
   const MotionSpace& space = *snapshot->space;
   MOTIONDB_RETURN_IF_ERROR(ValidateEditScope(edit.scope, space.dims()));
   MOTIONDB_RETURN_IF_ERROR(ValidateJointConstraints(space, edit.constraints));
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
-                            LoadSource(context.database, *snapshot, edit.clip, "clip"));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
+                                                                edit.clip, "clip", should_stop));
   Provenance provenance{op, edit.space, {source.range}};
   MOTIONDB_ASSIGN_OR_RETURN(
       const RowMatrixXd curve,
       function(*snapshot, source.motion.coordinates, RangeScope(edit.scope, source),
                space.sample_rate(), provenance.sources));
   EditedMotion edited{RowMatrixXd(), source.motion.placement};
-  MOTIONDB_ASSIGN_OR_RETURN(edited.rotations, space.Reconstruct(curve));
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(edited.rotations, space.Reconstruct(curve, should_stop));
   MOTIONDB_RETURN_IF_ERROR(
       ApplyJointConstraints(space, edit.constraints, source.motion.rotations, &edited.rotations));
   return FinishEdit(context, space, source, edited, std::move(provenance), edit.output,
@@ -96,9 +97,9 @@ absl::StatusOr<EditResult> Translate(const EditContext& context, const Translate
           double rate, std::vector<SourceRange>& sources) -> absl::StatusOr<RowMatrixXd> {
         RowMatrixXd poses(request.poses.size(), curve.cols());
         for (size_t i = 0; i < request.poses.size(); ++i) {
-          MOTIONDB_ASSIGN_OR_RETURN(
-              const EditSource source,
-              LoadSource(context.database, snapshot, request.poses[i], pose_fields[i]));
+          MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
+                                    LoadSource(context.database, snapshot, request.poses[i],
+                                               pose_fields[i], should_stop));
           MOTIONDB_ASSIGN_OR_RETURN(const EditPose pose, PoseOf(*snapshot.space, source));
           poses.row(i) = pose.coordinates.row(0);
           sources.push_back(source.range);

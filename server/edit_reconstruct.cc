@@ -14,11 +14,12 @@ absl::StatusOr<ReconstructOutcome> Rebuild(const EditContext& context,
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
-                            LoadSource(context.database, *snapshot, request.clip, "clip"));
-  MOTIONDB_ASSIGN_OR_RETURN(Reconstruction rebuilt,
-                            motiondb::Reconstruct(space, source.motion.coordinates,
-                                                  source.motion.rotations, request.options));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
+                                                                request.clip, "clip", should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      Reconstruction rebuilt,
+      motiondb::Reconstruct(space, source.motion.coordinates, source.motion.rotations,
+                            request.options, should_stop));
   ReconstructOutcome outcome;
   outcome.dims = rebuilt.dims;
   outcome.overall = rebuilt.overall;

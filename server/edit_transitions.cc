@@ -7,6 +7,7 @@
 #include "server/edit_fields.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
+#include "util/stop_poll.h"
 
 namespace motiondb::server {
 namespace {
@@ -19,9 +20,10 @@ absl::StatusOr<int> Frames(absl::string_view field, double seconds, double rate,
 }
 
 // The first range, `gap` and the second range in a row, with the placement of the gap mixed
-// linearly between the ranges' ends.
+// linearly between the ranges' ends; CANCELLED once `should_stop` says stop.
 absl::StatusOr<EditedMotion> Joined(const MotionSpace& space, const EditSource& first,
-                                    const EditSource& second, const RowMatrixXd& gap) {
+                                    const EditSource& second, const RowMatrixXd& gap,
+                                    const std::function<bool()>& should_stop) {
   const SpaceMotion& a = first.motion;
   const SpaceMotion& b = second.motion;
   const int na = static_cast<int>(a.coordinates.rows());
@@ -30,16 +32,22 @@ absl::StatusOr<EditedMotion> Joined(const MotionSpace& space, const EditSource& 
   RowMatrixXd curve(na + ng + nb, a.coordinates.cols());
   curve << a.coordinates, gap, b.coordinates;
   EditedMotion joined{RowMatrixXd(), EmptyPlacement(a.placement, na + ng + nb)};
-  for (int f = 0; f < na; ++f) MixPlacementFrame({{&a.placement, f}}, {1.0}, &joined.placement, f);
+  StopPoll stop(should_stop, kPlacementFramesPerStopPoll);
+  for (int f = 0; f < na; ++f) {
+    if (stop.Done(1)) return EditStopped();
+    MixPlacementFrame({{&a.placement, f}}, {1.0}, &joined.placement, f);
+  }
   for (int k = 0; k < ng; ++k) {
+    if (stop.Done(2)) return EditStopped();
     const double t = static_cast<double>(k + 1) / (ng + 1);
     MixPlacementFrame({{&a.placement, na - 1}, {&b.placement, 0}}, {1.0 - t, t}, &joined.placement,
                       na + k);
   }
   for (int f = 0; f < nb; ++f) {
+    if (stop.Done(1)) return EditStopped();
     MixPlacementFrame({{&b.placement, f}}, {1.0}, &joined.placement, na + ng + f);
   }
-  MOTIONDB_ASSIGN_OR_RETURN(joined.rotations, space.Reconstruct(curve));
+  MOTIONDB_ASSIGN_OR_RETURN(joined.rotations, space.Reconstruct(curve, should_stop));
   return joined;
 }
 
@@ -56,13 +64,15 @@ absl::StatusOr<FillGapOutcome> Gap(const EditContext& context, const MotionSpace
                             FillGap(first.motion.coordinates, second.motion.coordinates, options));
   MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd line,
                             FillGap(first.motion.coordinates, second.motion.coordinates, linear));
-  MOTIONDB_ASSIGN_OR_RETURN(const EditedMotion joined, Joined(space, first, second, gap));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditedMotion joined,
+                            Joined(space, first, second, gap, should_stop));
   // The linear fill's rotations, for its seams: they differ from `joined`'s only in the gap, and
   // reconstruction goes frame by frame, so only the gap is reconstructed (the whole joined
   // motion again took about a tenth of the call).
   const int na = static_cast<int>(first.motion.coordinates.rows());
   RowMatrixXd linear_rotations = joined.rotations;
-  MOTIONDB_ASSIGN_OR_RETURN(linear_rotations.middleRows(na, line.rows()), space.Reconstruct(line));
+  MOTIONDB_ASSIGN_OR_RETURN(linear_rotations.middleRows(na, line.rows()),
+                            space.Reconstruct(line, should_stop));
   FillGapOutcome outcome;
   outcome.transition_frames = options.frames;
   for (const int seam : {na - 1, na + options.frames}) {
@@ -92,11 +102,26 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
         a.coordinates.rows() / space.sample_rate(), " seconds (", a.coordinates.rows(),
         " frames at the space's ", space.sample_rate(), " fps)"));
   }
+  // The overlap is the warp's query: its table grows with the square of the overlap and of the
+  // slope limit, and is held to a search query's at most (server/search_runner.cc).
+  if (options.align) {
+    const int64_t budget = AnchoredWarpTableBytes(context.max_query_frames, kDefaultSlopeLimit);
+    if (AnchoredWarpTableBytes(options.overlap_frames, options.warp.slope_limit) > budget) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "overlap_s = ", request.overlap_s, ": an aligned overlap of ", options.overlap_frames,
+          " frames at the space's ", space.sample_rate(), " fps at slope limit ",
+          options.warp.slope_limit, " takes more memory than the longest search query (",
+          context.max_query_frames, " frames at slope limit ", kDefaultSlopeLimit,
+          ", --max-query-frames); shorten the overlap or lower slope_limit"));
+    }
+  }
   MOTIONDB_ASSIGN_OR_RETURN(const AlignedBlend plan,
-                            PlanAlignedBlend(a.coordinates, b.coordinates, options));
+                            PlanAlignedBlend(a.coordinates, b.coordinates, options, should_stop));
   EditedMotion blended{RowMatrixXd(),
                        EmptyPlacement(a.placement, static_cast<int>(plan.frames.size()))};
+  StopPoll stop(should_stop, kPlacementFramesPerStopPoll);
   for (size_t k = 0; k < plan.frames.size(); ++k) {
+    if (stop.Done(2)) return EditStopped();
     const BlendFrame& frame = plan.frames[k];
     std::vector<PlacementFrame> sources;
     std::vector<double> weights;
@@ -111,7 +136,8 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
     MixPlacementFrame(sources, weights, &blended.placement, static_cast<int>(k));
   }
   MOTIONDB_ASSIGN_OR_RETURN(
-      blended.rotations, space.Reconstruct(MixCurves(plan.frames, a.coordinates, b.coordinates)));
+      blended.rotations,
+      space.Reconstruct(MixCurves(plan.frames, a.coordinates, b.coordinates), should_stop));
   FillGapOutcome outcome;
   outcome.transition_frames = options.overlap_frames;
   outcome.warp_score = plan.warp_score;
@@ -126,10 +152,12 @@ absl::StatusOr<FillGapOutcome> Transition(const EditContext& context, const Fill
                                           const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource first,
-                            LoadSource(context.database, *snapshot, request.first, "first"));
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource second,
-                            LoadSource(context.database, *snapshot, request.second, "second"));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const EditSource first,
+      LoadSource(context.database, *snapshot, request.first, "first", should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const EditSource second,
+      LoadSource(context.database, *snapshot, request.second, "second", should_stop));
   if (!std::isfinite(request.overlap_s) || request.overlap_s != 0.0) {
     return Overlap(context, *snapshot->space, request, first, second, should_stop);
   }

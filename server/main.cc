@@ -127,6 +127,8 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
   flags->max_upload_buffer_mb = static_cast<int>(options->uploads.max_buffered_bytes >> 20);
   number("--max-upload-buffer-mb", flags->max_upload_buffer_mb,
          "most bytes the ingests in progress hold together, in MiB", "MB", 1, 1 << 20);
+  number("--max-query-frames", options->max_query_frames,
+         "longest search query, in frames at the space's rate", "N", 1, 1 << 20);
   number("--job-threads", options->job_threads,
          "threads a background job searches on, below calls' priority (0: one per core)", "N", 0,
          1024);

@@ -39,7 +39,7 @@ absl::StatusOr<StoredPoseModel> CreatePoseModel(const EditContext& context,
   for (size_t i = 0; i < request.examples.size(); ++i) {
     MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
                               LoadSource(context.database, *snapshot, request.examples[i],
-                                         absl::StrCat("examples[", i, "]")));
+                                         absl::StrCat("examples[", i, "]"), should_stop));
     groups.insert(groups.end(), source.motion.coordinates.rows(), static_cast<int>(i));
     parts.push_back(source.motion.coordinates);
   }
@@ -50,7 +50,8 @@ absl::StatusOr<StoredPoseModel> CreatePoseModel(const EditContext& context,
     row += part.rows();
   }
   StoredPoseModel stored;
-  MOTIONDB_ASSIGN_OR_RETURN(stored.model, FitPoseModel(examples, request.options, groups));
+  MOTIONDB_ASSIGN_OR_RETURN(stored.model,
+                            FitPoseModel(examples, request.options, groups, should_stop));
   stored.record.name = request.name;
   stored.record.space_id = snapshot->record.space_id;
   stored.record.space_name = snapshot->record.name;
@@ -88,23 +89,25 @@ absl::Status DeletePoseModel(const EditContext& context, const std::string& name
 
 namespace {
 
-absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectRequest& request) {
+absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectRequest& request,
+                                     const std::function<bool()>& should_stop) {
   if (request.model.empty()) return absl::InvalidArgumentError("model: a model name is required");
   MOTIONDB_ASSIGN_OR_RETURN(storage::PoseModelRecord record,
                             context.database.GetPoseModel(request.model));
   MOTIONDB_ASSIGN_OR_RETURN(const StoredPoseModel stored, Parsed(std::move(record)));
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, stored.record.space_name));
-  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source,
-                            LoadSource(context.database, *snapshot, request.clip, "clip"));
+  MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
+                                                                request.clip, "clip", should_stop));
   const double rate = snapshot->space->sample_rate();
   MOTIONDB_RETURN_IF_ERROR(
       CheckDuration("min_duration_s", request.min_duration_s, true, kMaxMinFrames, rate));
   DetectionOptions options;
   options.threshold = request.threshold;
   options.min_frames = std::max(1, static_cast<int>(std::ceil(request.min_duration_s * rate)));
-  MOTIONDB_ASSIGN_OR_RETURN(Detection detection,
-                            motiondb::DetectPose(stored.model, source.motion.coordinates, options));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      Detection detection,
+      motiondb::DetectPose(stored.model, source.motion.coordinates, options, should_stop));
   DetectOutcome outcome;
   outcome.space = stored.record.space_name;
   outcome.frames = source.range.frames;
@@ -127,10 +130,11 @@ absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectReq
 
 }  // namespace
 
-absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request) {
+absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request,
+                                         const std::function<bool()>& should_stop) {
   // The operator scores the clip's range as a curve; min_duration_s is checked before it
   // becomes the operator's min_frames.
-  return InRequestFields(Detect(context, request), {{"curve", "clip"}});
+  return InRequestFields(Detect(context, request, should_stop), {{"curve", "clip"}});
 }
 
 }  // namespace motiondb::server

@@ -71,8 +71,10 @@ absl::StatusOr<std::vector<StoredPoseModel>> ListPoseModels(const EditContext& c
 absl::Status DeletePoseModel(const EditContext& context, const std::string& name,
                              const std::function<bool()>& should_stop);
 // NOT_FOUND for an unknown model or clip (or a model whose space is gone); FAILED_PRECONDITION
-// for a clip of another skeleton; INVALID_ARGUMENT naming clip, threshold or min_duration_s.
-absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request);
+// for a clip of another skeleton; INVALID_ARGUMENT naming clip, threshold or min_duration_s;
+// CANCELLED once `should_stop` says stop.
+absl::StatusOr<DetectOutcome> DetectPose(const EditContext& context, const DetectRequest& request,
+                                         const std::function<bool()>& should_stop);
 
 }  // namespace motiondb::server
 

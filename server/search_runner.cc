@@ -4,8 +4,11 @@
 #include <chrono>
 
 #include "absl/strings/str_cat.h"
+#include "core/index/coarse_rate.h"
+#include "core/motion/resample.h"
 #include "core/search/exact_search.h"
 #include "core/search/motion_search.h"
+#include "core/search/warp/time_warp.h"
 #include "core/space/search_coordinates.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
@@ -34,8 +37,52 @@ void SetRows(Query* query) {
   query->row_count = last - first + 1;
 }
 
+// INVALID_ARGUMENT naming `field`, the limit and its flag when `rows`, a query's frames at the
+// space's rate (`what` says them at the query's own), exceed `max_rows`.
+absl::Status CheckQueryLength(absl::string_view field, int64_t rows, double rate,
+                              absl::string_view what, int max_rows) {
+  if (rows <= max_rows) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, ": the query spans ", rows, " frames at the space's ", rate, " fps (",
+                   what, "); this server searches queries of at most ", max_rows,
+                   " frames (--max-query-frames): search a shorter stretch"));
+}
+
+// The rows of the anchored warps a search of `rows` query frames runs: at the coarse rate
+// (core/index/coarse_rate.h) with refinement, else every frame; 0 for the exact search without
+// paths, which runs none (its scan keeps a few columns).
+int64_t AnchoredWarpRows(int64_t rows, const SearchParams& params, bool exact, double rate) {
+  if (exact) return params.return_path ? rows : 0;
+  if (!params.refine) return rows;
+  return (rows - 1) / CoarseFactor(rate) + 1;
+}
+
+// INVALID_ARGUMENT naming slope_limit when the query's warps would fill a larger table than a
+// query of `max_rows` frames warped at every frame at the default slope limit: the table grows
+// with the square of the rows and of the slope limit (AnchoredWarpTableBytes), so that at slope
+// limit 8 a query of --max-query-frames frames would take 21 times as much.
+absl::Status CheckWarpMemory(int64_t rows, const SearchParams& params, bool exact, double rate,
+                             int max_rows) {
+  const int64_t budget = AnchoredWarpTableBytes(max_rows, kDefaultSlopeLimit);
+  const int64_t warp_rows = AnchoredWarpRows(rows, params, exact, rate);
+  const int64_t bytes = AnchoredWarpTableBytes(warp_rows, params.slope_limit);
+  if (bytes <= budget) return absl::OkStatus();
+  int64_t fits = rows;  // the longest query whose warps fit; it exists: one frame takes no table
+  while (AnchoredWarpTableBytes(AnchoredWarpRows(fits, params, exact, rate), params.slope_limit) >
+         budget) {
+    fits = fits * 15 / 16;
+  }
+  constexpr double kMiB = 1 << 20;
+  return absl::InvalidArgumentError(absl::StrCat(
+      "slope_limit = ", params.slope_limit, ": the warps of this ", rows,
+      "-frame query would take ", std::lround(bytes / kMiB), " MiB, more than the ",
+      std::lround(budget / kMiB), " MiB of a ", max_rows, "-frame query at slope limit ",
+      kDefaultSlopeLimit, " (--max-query-frames); lower slope_limit, or search about ", fits,
+      " frames at most"));
+}
+
 absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapshot& snapshot,
-                                  storage::Database& database) {
+                                  storage::Database& database, int max_rows) {
   // Also covers a space without clips, hence without an index.
   MOTIONDB_RETURN_IF_ERROR(CheckClipInSpace(database, snapshot, range.clip_id));
   Query query;
@@ -44,12 +91,19 @@ absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapsho
   MOTIONDB_ASSIGN_OR_RETURN(
       query.range, ResolveFrameRange(range, snapshot.clips.at(range.clip_id).frame_count, "clip"));
   SetRows(&query);
+  MOTIONDB_RETURN_IF_ERROR(CheckQueryLength(
+      "clip", query.row_count, snapshot.space->sample_rate(),
+      absl::StrCat("frames ", query.range.first, "..", query.range.last, " of the clip at its ",
+                   snapshot.clips.at(range.clip_id).fps, " fps"),
+      max_rows));
   return query;
 }
 
 absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnapshot& snapshot,
-                                    const UploadLimits& limits) {
-  MOTIONDB_ASSIGN_OR_RETURN(const BvhReadResult read, ReadUpload(upload.bvh, "bvh", limits));
+                                    const UploadLimits& limits, int max_rows,
+                                    const std::function<bool()>& should_stop) {
+  MOTIONDB_ASSIGN_OR_RETURN(const BvhReadResult read,
+                            ReadUpload(upload.bvh, "bvh", limits, should_stop));
   const Clip& clip = read.clip;
   if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
     return absl::FailedPreconditionError(absl::StrCat(
@@ -62,7 +116,14 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnap
   MOTIONDB_ASSIGN_OR_RETURN(query.range, ResolveFrameRange(upload.first_frame, upload.last_frame,
                                                            clip.frame_count(), "bvh"));
   // The whole file is projected, as a stored clip is, so that a range of an uploaded file gives
-  // the same query as the same range of the file once stored.
+  // the same query as the same range of the file once stored: its whole length counts.
+  MOTIONDB_RETURN_IF_ERROR(CheckQueryLength(
+      "bvh",
+      ResampledFrameCount(clip.frame_count(), clip.frame_time(), snapshot.space->sample_rate()),
+      snapshot.space->sample_rate(),
+      absl::StrCat("the file's ", clip.frame_count(), " at its ", clip.fps(),
+                   " fps; a range of it is searched after the whole file is projected"),
+      max_rows));
   MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip));
   query.frames = FrameConversion(clip.fps(), clip.frame_count(), snapshot.space->sample_rate(),
                                  query.uploaded->rows());
@@ -207,16 +268,23 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
   Query query;
   HitOptions options{request.exact, request.explain, request.params.return_path, std::nullopt};
   if (const auto* stored = std::get_if<ClipSelection>(&request.query)) {
-    MOTIONDB_ASSIGN_OR_RETURN(query, StoredQuery(*stored, *snapshot, database_));
+    MOTIONDB_ASSIGN_OR_RETURN(query, StoredQuery(*stored, *snapshot, database_, max_query_frames_));
     if (request.exclude_query.value_or(true)) {
       options.own = OwnRange{stored->clip_id, query.range};
     }
   } else if (const auto* upload = std::get_if<UploadedQuery>(&request.query)) {
-    MOTIONDB_ASSIGN_OR_RETURN(query, QueryOfUpload(*upload, *snapshot, limits_));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        query, QueryOfUpload(*upload, *snapshot, limits_, max_query_frames_, should_stop));
   } else {
     return absl::InvalidArgumentError("query: give a stored clip (clip) or a BVH file (bvh)");
   }
   MOTIONDB_ASSIGN_OR_RETURN(SearchParams params, ResolveParams(request, query, dims));
+  {
+    SearchParams searched = params;
+    searched.return_path = params.return_path || request.explain;  // as Hits asks
+    MOTIONDB_RETURN_IF_ERROR(CheckWarpMemory(query.row_count, searched, request.exact,
+                                             snapshot->space->sample_rate(), max_query_frames_));
+  }
   params.should_stop = should_stop;
 
   SearchOutcome outcome;

@@ -79,12 +79,24 @@ struct SearchOutcome {
   double request_ms = 0;  // the whole request, query projection included
 };
 
+// The longest query searched, in frames at the space's rate, unless the server is told
+// otherwise (--max-query-frames). A query is an example of a motion: an action takes seconds,
+// and a query of several (characteristic_points) a minute at most; 4000 frames are 2 min 13 s at
+// the default 30 Hz, 33 s at 120 Hz. A search's memory grows with the square of its warps' rows
+// (docs/server-limits.md, "Deadlines and query length"; bench/RESULTS.md, issue 37).
+inline constexpr int kDefaultMaxQueryFrames = 4000;
+
 // Thread-safe: searches run concurrently on immutable snapshots.
 class SearchRunner {
  public:
+  // Queries longer than `max_query_frames` at the space's rate are refused with
+  // INVALID_ARGUMENT before they are projected or searched.
   SearchRunner(const IndexRegistry& registry, storage::Database& database,
-               const UploadLimits& limits)
-      : registry_(registry), database_(database), limits_(limits) {}
+               const UploadLimits& limits, int max_query_frames = kDefaultMaxQueryFrames)
+      : registry_(registry),
+        database_(database),
+        limits_(limits),
+        max_query_frames_(max_query_frames) {}
 
   // Runs `request` against the space it names. `should_stop` ends the search with CANCELLED.
   absl::StatusOr<SearchOutcome> Run(const SearchRequest& request,
@@ -94,6 +106,7 @@ class SearchRunner {
   const IndexRegistry& registry_;
   storage::Database& database_;
   UploadLimits limits_;
+  int max_query_frames_;
 };
 
 }  // namespace motiondb::server

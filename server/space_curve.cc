@@ -5,16 +5,21 @@
 #include "absl/strings/str_cat.h"
 #include "server/space_lookup.h"
 #include "util/status_macros.h"
+#include "util/stop_poll.h"
 
 namespace motiondb::server {
 namespace {
 
 constexpr int kDefaultCurveDims = 3;  // the thesis's plots
+// Products of a coordinate (a row's dims, times the space's with a learned metric) between two
+// polls of a stop function: about a millisecond's.
+constexpr int64_t kCurveProductsPerStopPoll = int64_t{1} << 18;
 
 }  // namespace
 
 absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database& database,
-                                const CurveRequest& request) {
+                                const CurveRequest& request,
+                                const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(registry, request.space));
   const int64_t clip_id = request.clip.clip_id;
@@ -38,7 +43,11 @@ absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database
   const RowMatrixXd& learned_inverse = snapshot->space->search_transform_inverse();
   curve.coordinates.resize(rows.rows, dims);
   Eigen::RowVectorXd scaled(dims);
+  StopPoll stop(should_stop, kCurveProductsPerStopPoll);
   for (int64_t r = 0; r < rows.rows; ++r) {
+    if (stop.Done(learned_inverse.size() > 0 ? int64_t{space_dims} * dims : dims)) {
+      return absl::CancelledError("reading the curve was stopped by its caller");
+    }
     if (learned_inverse.size() > 0) {
       scaled = Eigen::Map<const Eigen::RowVectorXf>(rows.row(r), space_dims).cast<double>() *
                learned_inverse.leftCols(dims);

@@ -3,6 +3,7 @@
 #ifndef MOTIONDB_SERVER_SPACE_CURVE_H_
 #define MOTIONDB_SERVER_SPACE_CURVE_H_
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -29,9 +30,11 @@ struct Curve {
 };
 
 // NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the field for dims outside
-// the space or a range outside the clip; the lookup's other codes (space_lookup.h).
+// the space or a range outside the clip; the lookup's other codes (space_lookup.h); CANCELLED
+// once `should_stop` says stop.
 absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database& database,
-                                const CurveRequest& request);
+                                const CurveRequest& request,
+                                const std::function<bool()>& should_stop = {});
 
 }  // namespace motiondb::server
 

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -35,9 +36,11 @@ struct UploadLimits {
 // streams call it as chunks arrive, so an oversize upload is refused before it is all buffered.
 absl::Status CheckUploadSize(int64_t bytes, const UploadLimits& limits);
 
-// The parsed file; errors (the size check's too) begin with `name`.
+// The parsed file; errors (the size check's too) begin with `name`. `should_stop` is asked
+// between pieces of the text (a gigabyte takes seconds to parse): CANCELLED once it says stop.
 absl::StatusOr<BvhReadResult> ReadUpload(absl::string_view bvh, absl::string_view name,
-                                         const UploadLimits& limits);
+                                         const UploadLimits& limits,
+                                         const std::function<bool()>& should_stop = {});
 
 // How the server reads an upload: its size limit, and its clip at most the budget of all.
 BvhReadOptions UploadReadOptions(const UploadLimits& limits);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <functional>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -104,10 +105,14 @@ class MotionWriter {
     }
   }
 
-  void Append(FrameRange frames, std::string& out) {
+  // False when `should_stop` said stop before a block (a block takes about 10 ms at 21 joints,
+  // 30 at 101 on two threads).
+  bool Append(FrameRange frames, std::string& out, const std::function<bool()>& should_stop) {
     for (int first = frames.first; first <= frames.last; first += kBlockFrames) {
+      if (should_stop && should_stop()) return false;
       AppendBlock({first, std::min(frames.last, first + kBlockFrames - 1)}, out);
     }
+    return true;
   }
 
  private:
@@ -198,8 +203,8 @@ class MotionWriter {
 
 }  // namespace
 
-absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange> range,
-                                     int threads) {
+absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange> range, int threads,
+                                     const std::function<bool()>& should_stop) {
   const FrameRange frames = range.value_or(FrameRange{0, clip.frame_count() - 1});
   MOTIONDB_RETURN_IF_ERROR(CheckFrameRange(frames, clip.frame_count()));
   const Skeleton& skeleton = clip.skeleton();
@@ -211,7 +216,9 @@ absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange>
   char buffer[32];
   out.append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), clip.frame_time()).ptr);
   out += '\n';
-  MotionWriter(clip, std::move(order), threads).Append(frames, out);
+  if (!MotionWriter(clip, std::move(order), threads).Append(frames, out, should_stop)) {
+    return absl::CancelledError("writing the BVH was stopped by its caller");
+  }
   return out;
 }
 

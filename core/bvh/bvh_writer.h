@@ -4,6 +4,7 @@
 #ifndef MOTIONDB_CORE_BVH_BVH_WRITER_H_
 #define MOTIONDB_CORE_BVH_BVH_WRITER_H_
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -15,10 +16,12 @@ namespace motiondb {
 // The BVH text of `range` (default: the whole clip). Fails if the range is outside the clip.
 // `threads` decompose the rotations and write the numbers (0: one a core; a thread for every
 // 128 frames at most); the text is the same for any count. 10 s at 120 fps of 31 joints take
-// about 5 ms on one thread.
+// about 5 ms on one thread. `should_stop` is asked before each block of 4096 frames:
+// CANCELLED once it says stop.
 absl::StatusOr<std::string> WriteBvh(const Clip& clip,
                                      std::optional<FrameRange> range = std::nullopt,
-                                     int threads = 1);
+                                     int threads = 1,
+                                     const std::function<bool()>& should_stop = {});
 
 // Writes to `path` atomically (a temporary file renamed into place).
 absl::Status WriteBvhFile(const std::string& path, const Clip& clip,

@@ -3,6 +3,7 @@
 #define MOTIONDB_CORE_MOTION_RESAMPLE_H_
 
 #include <cstdint>
+#include <functional>
 
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
@@ -16,8 +17,10 @@ inline constexpr double kMaxResampleRate = 10000.0;
 // [0, (frame_count - 1) * frame_time], allowing 1% of an output frame past the end (taken as
 // the last frame) so that rounded frame times such as 0.0333333 keep every frame. `target_fps` must
 // be finite and in (0, kMaxResampleRate]. `threads` share the output frames (0: one a core; a
-// thread for every 256 frames at most); the result is the same for any count.
-absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps, int threads = 1);
+// thread for every 256 frames at most); the result is the same for any count. `should_stop`
+// is asked about every millisecond of work on each thread: CANCELLED once it says stop.
+absl::StatusOr<Clip> Resample(const Clip& clip, double target_fps, int threads = 1,
+                              const std::function<bool()>& should_stop = {});
 
 // The number of frames Resample() makes of `frame_count` frames `frame_time` apart (without its
 // limit on the output's size). `target_fps` must be in Resample's range.

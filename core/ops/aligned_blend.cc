@@ -1,14 +1,20 @@
 #include "core/ops/aligned_blend.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "core/index/coordinate_view.h"
 #include "core/ops/internal/op_checks.h"
 #include "util/status_macros.h"
+#include "util/stop_poll.h"
 
 namespace motiondb {
 namespace {
+
+// Cells of the warp between two polls of a stop function, as the search's (its table's fresh
+// pages cost more than its cells): a few milliseconds at most.
+constexpr int64_t kWarpCellsPerStopPoll = int64_t{1} << 18;
 
 absl::Status CheckOptions(const AlignedBlendOptions& options, Eigen::Index a_frames, int dims) {
   MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckBetween(
@@ -22,6 +28,7 @@ absl::Status CheckOptions(const AlignedBlendOptions& options, Eigen::Index a_fra
 absl::StatusOr<std::vector<int64_t>> OverlapPath(const Eigen::Ref<const RowMatrixXd>& a_overlap,
                                                  const Eigen::Ref<const RowMatrixXd>& b,
                                                  const AlignedBlendOptions& options,
+                                                 const std::function<bool()>& should_stop,
                                                  double* score) {
   const int overlap = options.overlap_frames;
   const int dims = options.warp.dims;
@@ -45,9 +52,11 @@ absl::StatusOr<std::vector<int64_t>> OverlapPath(const Eigen::Ref<const RowMatri
   const RowMatrixXf query = a_overlap.leftCols(dims).cast<float>();
   const RowMatrixXf clip = b.topRows(reach).leftCols(dims).cast<float>();
   WarpWorkspace workspace;
+  StopPoll stop(should_stop, kWarpCellsPerStopPoll);
   const std::optional<Warp> warp =
       AnchoredWarp(CoordinateView::Of(query), CoordinateView::Of(clip), 0, 0, options.warp,
-                   /*with_path=*/true, workspace);
+                   /*with_path=*/true, workspace, std::numeric_limits<float>::infinity(), &stop);
+  if (stop.stopped()) return absl::CancelledError("the overlap's warp was stopped by its caller");
   if (!warp) {
     return absl::InvalidArgumentError(absl::StrCat(
         "b: the second clip (", b.rows(), " frames) is too short to align an overlap of ", overlap,
@@ -61,7 +70,8 @@ absl::StatusOr<std::vector<int64_t>> OverlapPath(const Eigen::Ref<const RowMatri
 
 absl::StatusOr<AlignedBlend> PlanAlignedBlend(const Eigen::Ref<const RowMatrixXd>& a,
                                               const Eigen::Ref<const RowMatrixXd>& b,
-                                              const AlignedBlendOptions& options) {
+                                              const AlignedBlendOptions& options,
+                                              const std::function<bool()>& should_stop) {
   const int dims = static_cast<int>(a.cols());
   MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckPoints("a", a, dims, 1, true));
   MOTIONDB_RETURN_IF_ERROR(ops_internal::CheckPoints("b", b, dims, 1, true));
@@ -69,8 +79,9 @@ absl::StatusOr<AlignedBlend> PlanAlignedBlend(const Eigen::Ref<const RowMatrixXd
   const int overlap = options.overlap_frames;
   const int a_first = static_cast<int>(a.rows()) - overlap;
   AlignedBlend blend;
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> path,
-                            OverlapPath(a.bottomRows(overlap), b, options, &blend.warp_score));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const std::vector<int64_t> path,
+      OverlapPath(a.bottomRows(overlap), b, options, should_stop, &blend.warp_score));
   for (int f = 0; f < a_first; ++f) blend.frames.push_back({f, -1, 0.0});
   for (int i = 0; i < overlap; ++i) {
     const double ramp = static_cast<double>(i + 1) / (overlap + 1);

@@ -11,6 +11,7 @@
 #ifndef MOTIONDB_CORE_OPS_ALIGNED_BLEND_H_
 #define MOTIONDB_CORE_OPS_ALIGNED_BLEND_H_
 
+#include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -47,10 +48,13 @@ struct AlignedBlend {
 };
 
 // `a` and `b`: frames x dims at one rate. INVALID_ARGUMENT naming overlap_frames, warp.dims,
-// warp.slope_limit, a or b, or saying the second clip is too short for the overlap.
+// warp.slope_limit, a or b, or saying the second clip is too short for the overlap. The warp's
+// memory grows with the square of the overlap (AnchoredWarpTableBytes): callers bound it.
+// `should_stop` is asked as the warp goes: CANCELLED once it says stop.
 absl::StatusOr<AlignedBlend> PlanAlignedBlend(const Eigen::Ref<const RowMatrixXd>& a,
                                               const Eigen::Ref<const RowMatrixXd>& b,
-                                              const AlignedBlendOptions& options = {});
+                                              const AlignedBlendOptions& options = {},
+                                              const std::function<bool()>& should_stop = {});
 
 // The plan's frames of two curves (frames x dims each).
 RowMatrixXd MixCurves(const std::vector<BlendFrame>& frames, const Eigen::Ref<const RowMatrixXd>& a,

@@ -6,6 +6,7 @@
 #ifndef MOTIONDB_CORE_OPS_POSE_DETECTION_H_
 #define MOTIONDB_CORE_OPS_POSE_DETECTION_H_
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -42,10 +43,12 @@ struct Detection {
 };
 
 // `curve`: frames x at least model.dims coordinates. INVALID_ARGUMENT naming threshold,
-// min_frames or the curve; the model's own errors (ValidatePoseModel).
+// min_frames or the curve; the model's own errors (ValidatePoseModel). `should_stop` is asked
+// about every millisecond of scoring: CANCELLED once it says stop.
 absl::StatusOr<Detection> DetectPose(const PoseModel& model,
                                      const Eigen::Ref<const RowMatrixXd>& curve,
-                                     const DetectionOptions& options = {});
+                                     const DetectionOptions& options = {},
+                                     const std::function<bool()>& should_stop = {});
 
 }  // namespace motiondb
 

@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/ops/internal/op_checks.h"
 #include "util/status_macros.h"
+#include "util/stop_poll.h"
 
 namespace motiondb {
 namespace {
@@ -41,6 +42,15 @@ absl::Status CheckOptions(const PoseModelOptions& options, Eigen::Index examples
   MOTIONDB_RETURN_IF_ERROR(CheckBetween("regularization", options.regularization,
                                         std::numeric_limits<double>::min(), 1.0));
   return CheckBetween("threshold_quantile", options.threshold_quantile, 0.0, 1.0);
+}
+
+// Example values (examples x dims) of one component's step between two polls of a stop
+// function: a component's E or M step costs a few of these a value (the dims-square
+// covariance terms aside), about a millisecond.
+constexpr int64_t kExampleValuesPerStopPoll = int64_t{1} << 18;
+
+absl::Status PoseModelStopped() {
+  return absl::CancelledError("fitting the pose model was stopped by its caller");
 }
 
 // k-means++: the first mean a random example, each next one drawn with probability in
@@ -79,11 +89,14 @@ Eigen::MatrixXd Shape(Eigen::MatrixXd covariance, CovarianceType type, double fl
 }
 
 // ln w_i + ln N(x_n; mu_i, Sigma_i) for every example n (rows) and component i (columns).
-RowMatrixXd LogJoint(const PoseModel& model, const Eigen::Ref<const RowMatrixXd>& x) {
+// `stop` is told each component's examples; the result is partial once it says stop.
+RowMatrixXd LogJoint(const PoseModel& model, const Eigen::Ref<const RowMatrixXd>& x,
+                     StopPoll& stop) {
   const Eigen::Index k = model.weights.size();
   const double d = model.dims;
   RowMatrixXd log_joint(x.rows(), k);
   for (Eigen::Index i = 0; i < k; ++i) {
+    if (stop.Done(x.rows() * model.dims)) break;
     const Eigen::LLT<Eigen::MatrixXd> llt(model.covariances[i]);
     const double log_det = 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
     const double constant =
@@ -107,10 +120,11 @@ Eigen::VectorXd LogSumExpRows(const RowMatrixXd& values) {
   return result;
 }
 
-// One M step from responsibilities (examples x components).
+// One M step from responsibilities (examples x components); `stop` as LogJoint's.
 void Maximise(const RowMatrixXd& x, const RowMatrixXd& responsibility, double floor,
-              PoseModel* model) {
+              PoseModel* model, StopPoll& stop) {
   for (Eigen::Index i = 0; i < model->weights.size(); ++i) {
+    if (stop.Done(x.rows() * x.cols())) return;
     const double mass = responsibility.col(i).sum();
     model->weights[i] = mass / static_cast<double>(x.rows());
     if (mass < 1e-12) continue;  // an empty component keeps its place, with weight ~0
@@ -147,8 +161,9 @@ absl::StatusOr<CovarianceType> ParseCovarianceType(absl::string_view name) {
 
 namespace {
 
-// EM from k-means++ means; its threshold is left for the caller.
-PoseModel FitMixture(const RowMatrixXd& x, const PoseModelOptions& options) {
+// EM from k-means++ means; its threshold is left for the caller. `stop` is told the work of
+// each component of each step: the model is partial once it says stop.
+PoseModel FitMixture(const RowMatrixXd& x, const PoseModelOptions& options, StopPoll& stop) {
   const int k = options.components;
   const RowMatrixXd centred = x.rowwise() - x.colwise().mean();
   const Eigen::MatrixXd spread = centred.transpose() * centred / static_cast<double>(x.rows());
@@ -163,23 +178,25 @@ PoseModel FitMixture(const RowMatrixXd& x, const PoseModelOptions& options) {
   model.covariances.assign(k, Shape(spread, options.covariance, floor));
   double previous = kNegativeInfinity;
   for (model.iterations = 1; model.iterations <= options.max_iterations; ++model.iterations) {
-    const RowMatrixXd log_joint = LogJoint(model, x);
+    const RowMatrixXd log_joint = LogJoint(model, x, stop);
+    if (stop.stopped()) return model;
     const Eigen::VectorXd log_likelihood = LogSumExpRows(log_joint);
     model.log_likelihood = log_likelihood.mean();
     RowMatrixXd responsibility = (log_joint.colwise() - log_likelihood).array().exp();
-    Maximise(x, responsibility, floor, &model);
+    Maximise(x, responsibility, floor, &model, stop);
+    if (stop.stopped()) return model;
     if (model.log_likelihood - previous < options.tolerance) break;
     previous = model.log_likelihood;
   }
   model.iterations = std::min(model.iterations, options.max_iterations);
-  model.log_likelihood = PoseLogLikelihood(model, x).mean();
+  model.log_likelihood = LogSumExpRows(LogJoint(model, x, stop)).mean();
   return model;
 }
 
 // The examples' log-likelihoods for the threshold: each group's under a model of the others.
 absl::StatusOr<Eigen::VectorXd> HeldOutScores(const RowMatrixXd& x, const PoseModelOptions& options,
                                               const std::vector<int>& groups,
-                                              const PoseModel& model) {
+                                              const PoseModel& model, StopPoll& stop) {
   std::vector<int> names = groups;
   std::sort(names.begin(), names.end());
   names.erase(std::unique(names.begin(), names.end()), names.end());
@@ -193,7 +210,8 @@ absl::StatusOr<Eigen::VectorXd> HeldOutScores(const RowMatrixXd& x, const PoseMo
                                                      out.size(), " poses cannot fit ",
                                                      options.components, " components"));
     }
-    const PoseModel others = FitMixture(x(out, Eigen::all), options);
+    const PoseModel others = FitMixture(x(out, Eigen::all), options, stop);
+    if (stop.stopped()) return PoseModelStopped();
     const Eigen::VectorXd held = PoseLogLikelihood(others, x(in, Eigen::all));
     for (size_t i = 0; i < in.size(); ++i) scores[in[i]] = held[i];
   }
@@ -204,7 +222,8 @@ absl::StatusOr<Eigen::VectorXd> HeldOutScores(const RowMatrixXd& x, const PoseMo
 
 absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& examples,
                                        const PoseModelOptions& options,
-                                       const std::vector<int>& groups) {
+                                       const std::vector<int>& groups,
+                                       const std::function<bool()>& should_stop) {
   if (examples.rows() == 0) return absl::InvalidArgumentError("examples: no poses given");
   MOTIONDB_RETURN_IF_ERROR(
       ops_internal::CheckPoints("examples", examples, static_cast<int>(examples.cols()), 1, true));
@@ -214,8 +233,10 @@ absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& exam
         absl::StrCat("groups: ", groups.size(), " given for ", examples.rows(), " examples"));
   }
   const RowMatrixXd x = examples.leftCols(options.dims);
-  PoseModel model = FitMixture(x, options);
-  MOTIONDB_ASSIGN_OR_RETURN(Eigen::VectorXd scores, HeldOutScores(x, options, groups, model));
+  StopPoll stop(should_stop, kExampleValuesPerStopPoll);
+  PoseModel model = FitMixture(x, options, stop);
+  if (stop.stopped()) return PoseModelStopped();
+  MOTIONDB_ASSIGN_OR_RETURN(Eigen::VectorXd scores, HeldOutScores(x, options, groups, model, stop));
   std::sort(scores.begin(), scores.end());
   model.threshold = scores[static_cast<Eigen::Index>(
       std::floor(options.threshold_quantile * static_cast<double>(scores.size() - 1)))];
@@ -247,7 +268,8 @@ absl::Status ValidatePoseModel(const PoseModel& model) {
 
 Eigen::VectorXd PoseLogLikelihood(const PoseModel& model,
                                   const Eigen::Ref<const RowMatrixXd>& points) {
-  return LogSumExpRows(LogJoint(model, points));
+  StopPoll never;
+  return LogSumExpRows(LogJoint(model, points, never));
 }
 
 }  // namespace motiondb

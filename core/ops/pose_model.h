@@ -12,6 +12,7 @@
 #define MOTIONDB_CORE_OPS_POSE_MODEL_H_
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -71,9 +72,11 @@ struct PoseModel {
 // likely an unseen instance of the pose is; with one, by the model itself. INVALID_ARGUMENT
 // naming the option, or examples when there are none, too few for k (in every group's
 // complement too), or NaN values, or groups of the wrong size.
+// `should_stop` is asked about every millisecond of EM: CANCELLED once it says stop.
 absl::StatusOr<PoseModel> FitPoseModel(const Eigen::Ref<const RowMatrixXd>& examples,
                                        const PoseModelOptions& options = {},
-                                       const std::vector<int>& groups = {});
+                                       const std::vector<int>& groups = {},
+                                       const std::function<bool()>& should_stop = {});
 
 // A model's consistency (shapes, weights, positive definite covariances), e.g. after parsing.
 absl::Status ValidatePoseModel(const PoseModel& model);

@@ -34,7 +34,8 @@ void AngleErrors(const Eigen::Ref<const RowMatrixXd>& a, const Eigen::Ref<const 
 absl::StatusOr<Reconstruction> Reconstruct(const MotionSpace& space,
                                            const Eigen::Ref<const RowMatrixXd>& coordinates,
                                            const Eigen::Ref<const RowMatrixXd>& rotations,
-                                           const ReconstructOptions& options) {
+                                           const ReconstructOptions& options,
+                                           const std::function<bool()>& should_stop) {
   MOTIONDB_RETURN_IF_ERROR(
       ops_internal::CheckPoints("coordinates", coordinates, space.dims(), 1, /*exact=*/true));
   const int joints = space.skeleton().joint_count();
@@ -50,12 +51,12 @@ absl::StatusOr<Reconstruction> Reconstruct(const MotionSpace& space,
                                     absl::StrCat("1..", space.dims(), " (or -1 for all)"));
   }
   result.coordinates = coordinates.leftCols(result.dims);
-  MOTIONDB_ASSIGN_OR_RETURN(result.rotations, space.Reconstruct(result.coordinates));
+  MOTIONDB_ASSIGN_OR_RETURN(result.rotations, space.Reconstruct(result.coordinates, should_stop));
   AngleErrors(rotations, result.rotations, &result.joints, &result.overall);
   if (options.error_curve) {
     for (int n = 1; n <= space.dims(); ++n) {
       MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
-                                space.Reconstruct(coordinates.leftCols(n)));
+                                space.Reconstruct(coordinates.leftCols(n), should_stop));
       AngleError error;
       AngleErrors(rotations, rebuilt, nullptr, &error);
       result.curve.push_back({n, error.mean_rad, error.max_rad});

@@ -7,6 +7,7 @@
 #ifndef MOTIONDB_CORE_OPS_RECONSTRUCTION_H_
 #define MOTIONDB_CORE_OPS_RECONSTRUCTION_H_
 
+#include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -40,11 +41,13 @@ struct Reconstruction {
 
 // `coordinates` (frames x the space's dims) and `rotations` (frames x 4 * joints) describe the
 // same poses, as SpaceMotion holds them. INVALID_ARGUMENT naming dims, or coordinates/rotations
-// for shapes that do not fit the space or each other.
+// for shapes that do not fit the space or each other. `should_stop` is asked as each
+// reconstruction goes (MotionSpace::Reconstruct): CANCELLED once it says stop.
 absl::StatusOr<Reconstruction> Reconstruct(const MotionSpace& space,
                                            const Eigen::Ref<const RowMatrixXd>& coordinates,
                                            const Eigen::Ref<const RowMatrixXd>& rotations,
-                                           const ReconstructOptions& options = {});
+                                           const ReconstructOptions& options = {},
+                                           const std::function<bool()>& should_stop = {});
 
 // The angle between the rotations of two blocks of one shape (frames x 4 * joints), per joint
 // and over all.

@@ -30,12 +30,21 @@ std::vector<int> AbovePelvis(const Skeleton& skeleton) {
 
 }  // namespace
 
-absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip) {
+absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip,
+                                       const std::function<bool()>& should_stop) {
   if (!clip.skeleton().SameTopology(space.skeleton())) {
     return absl::InvalidArgumentError(
         "the clip's skeleton differs from the space's: joint names or parents do not match");
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, Resample(clip, space.sample_rate()));
+  // Each step after resampling takes tens of milliseconds for a take of an hour.
+  const auto check_stop = [&]() -> absl::Status {
+    if (should_stop && should_stop()) {
+      return absl::CancelledError("entering the space was stopped by its caller");
+    }
+    return absl::OkStatus();
+  };
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled,
+                            Resample(clip, space.sample_rate(), /*threads=*/1, should_stop));
   const PoseOptions& options = space.data().pose;
   SpaceMotion motion;
   motion.placement.positions = sampled.positions();
@@ -47,14 +56,17 @@ absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& cli
       motion.placement.above_pelvis.middleCols(4 * i, 4) =
           pose.rotations.middleCols(4 * chain[i], 4);
     }
+    MOTIONDB_RETURN_IF_ERROR(check_stop());
     motion.placement.yaw = RemoveHeading(sampled.skeleton(), &pose.rotations);
     pose.yaw_rate = YawRate(motion.placement.yaw, sampled.fps(), options.yaw_rate_window);
     if (options.root_velocity) {
       pose.root_velocity = RootVelocity(sampled, motion.placement.yaw, options.yaw_rate_window);
     }
   }
-  MOTIONDB_ASSIGN_OR_RETURN(motion.coordinates,
-                            space.Project(EncodePoses(pose, space.data().references)));
+  MOTIONDB_RETURN_IF_ERROR(check_stop());
+  const RowMatrixXd encoded = EncodePoses(pose, space.data().references);
+  MOTIONDB_RETURN_IF_ERROR(check_stop());
+  MOTIONDB_ASSIGN_OR_RETURN(motion.coordinates, space.Project(encoded));
   motion.rotations = std::move(pose.rotations);
   return motion;
 }

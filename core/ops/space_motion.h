@@ -8,6 +8,7 @@
 #ifndef MOTIONDB_CORE_OPS_SPACE_MOTION_H_
 #define MOTIONDB_CORE_OPS_SPACE_MOTION_H_
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -38,8 +39,10 @@ struct SpaceMotion {
 };
 
 // The clip resampled to the space rate and projected, with its placement. INVALID_ARGUMENT
-// when its skeleton is not the space's.
-absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip);
+// when its skeleton is not the space's. `should_stop` is asked while the clip is resampled and
+// between the steps after: CANCELLED once it says stop.
+absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip,
+                                       const std::function<bool()>& should_stop = {});
 
 // One frame of a placement, as a mix takes it.
 struct PlacementFrame {

@@ -40,6 +40,9 @@ absl::Status CheckSampleRate(double rate, double max_rate) {
   return absl::OkStatus();
 }
 
+// Rows reconstructed between two polls of a stop function: about a millisecond's at 31 joints.
+constexpr Eigen::Index kRowsPerStopPoll = 1024;
+
 absl::Status CheckStop(const std::function<bool()>& should_stop) {
   if (should_stop && should_stop()) {
     return absl::CancelledError("stopped by its caller between training clips");
@@ -320,7 +323,8 @@ MotionSpace::MotionSpace(SpaceData data)
   project_offset_ = -data_.mean.transpose() * data_.basis;
   unproject_ = data_.basis.transpose() * pose_weights_.cwiseInverse().asDiagonal();
   unproject_offset_ = data_.mean.cwiseQuotient(pose_weights_).transpose();
-  if (data_.search_transform.size() > 0) search_transform_inverse_ = data_.search_transform.inverse();
+  if (data_.search_transform.size() > 0)
+    search_transform_inverse_ = data_.search_transform.inverse();
 }
 
 absl::StatusOr<MotionSpace> MotionSpace::WithSearchTransform(RowMatrixXd transform) const {
@@ -368,9 +372,21 @@ absl::StatusOr<RowMatrixXd> MotionSpace::ProjectClip(const Clip& clip, int dims)
 }
 
 absl::StatusOr<RowMatrixXd> MotionSpace::Reconstruct(
-    const Eigen::Ref<const RowMatrixXd>& coordinates) const {
-  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd poses, Unproject(coordinates));
-  return DecodePoses(poses, data_.references);
+    const Eigen::Ref<const RowMatrixXd>& coordinates,
+    const std::function<bool()>& should_stop) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const int n, CoordinateDims(coordinates.cols()));
+  RowMatrixXd rotations(coordinates.rows(), 4 * skeleton().joint_count());
+  // A block of rows at a time, each row on its own (the same rotations, block by block).
+  for (Eigen::Index first = 0; first < coordinates.rows(); first += kRowsPerStopPoll) {
+    if (should_stop && should_stop()) {
+      return absl::CancelledError("reconstruction was stopped by its caller");
+    }
+    const Eigen::Index rows = std::min(kRowsPerStopPoll, coordinates.rows() - first);
+    RowMatrixXd poses = coordinates.middleRows(first, rows) * unproject_.topRows(n);
+    poses.rowwise() += unproject_offset_;
+    rotations.middleRows(first, rows) = DecodePoses(poses, data_.references);
+  }
+  return rotations;
 }
 
 absl::StatusOr<Eigen::VectorXd> MotionSpace::MetricScales(int dims) const {

@@ -172,8 +172,11 @@ class MotionSpace {
   // The same, projected to its first `dims` coordinates (-1 for all): the clip's motion curve.
   absl::StatusOr<RowMatrixXd> ProjectClip(const Clip& clip, int dims = -1) const;
   // Joint rotations (n x 4 * joints) of the poses at `coordinates` (n x k, k <= dims()), as
-  // the pose describes them: facing-free when the space removes the facing.
-  absl::StatusOr<RowMatrixXd> Reconstruct(const Eigen::Ref<const RowMatrixXd>& coordinates) const;
+  // the pose describes them: facing-free when the space removes the facing. `should_stop` is
+  // asked about every millisecond of work (a long curve takes seconds): CANCELLED once it says
+  // stop.
+  absl::StatusOr<RowMatrixXd> Reconstruct(const Eigen::Ref<const RowMatrixXd>& coordinates,
+                                          const std::function<bool()>& should_stop = {}) const;
 
   // The space's metric scales for the first `dims` dimensions (-1 for all; MetricScales above).
   absl::StatusOr<Eigen::VectorXd> MetricScales(int dims = -1) const;

@@ -74,9 +74,7 @@ grpc::Status EditServiceImpl::CreatePoseModel(grpc::ServerContext* context,
 grpc::Status EditServiceImpl::DetectPose(grpc::ServerContext* context,
                                          const v1::DetectPoseRequest* request,
                                          v1::DetectPoseResponse* response) {
-  return Serve(context, *request, response,
-               [](const EditContext& edit, const DetectRequest& detect,
-                  const std::function<bool()>&) { return server::DetectPose(edit, detect); });
+  return Serve(context, *request, response, server::DetectPose);
 }
 
 grpc::Status EditServiceImpl::ListPoseModels(grpc::ServerContext* context,

@@ -75,6 +75,9 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   if (options.max_message_mb < 1 || options.max_message_mb > 2047) {
     return absl::InvalidArgumentError("--max-message-mb must be in 1..2047");
   }
+  if (options.max_query_frames < 1) {
+    return absl::InvalidArgumentError("--max-query-frames must be at least 1");
+  }
   if (options.threads < 0) {
     return absl::InvalidArgumentError("--threads must be 0 (no limit) or positive");
   }
@@ -94,7 +97,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
           .count()));
 
-  s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads);
+  s.runner = std::make_unique<SearchRunner>(s.registry, *s.database, options.uploads,
+                                            options.max_query_frames);
   s.jobs = std::make_unique<JobRunner>(
       *s.database, s.registry, *s.runner,
       JobRunnerOptions{.threads = options.job_threads,
@@ -116,8 +120,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.access,
                                                    *s.gate);
-  s.edits =
-      std::make_unique<EditServiceImpl>(EditContext{*s.database, *s.catalog, s.registry}, *s.gate);
+  s.edits = std::make_unique<EditServiceImpl>(
+      EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames}, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,

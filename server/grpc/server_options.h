@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "server/net/connection_counter.h"
+#include "server/search_runner.h"
 #include "server/upload.h"
 #include "util/token_file.h"
 
@@ -36,6 +37,10 @@ struct ServerOptions {
   // Largest BVH file accepted by IngestClip, IngestClipStream (all chunks together) and BVH
   // queries (--max-bvh-mb, in MiB).
   UploadLimits uploads;
+  // Longest search query, in frames at the space's rate (a stored clip's range, an uploaded
+  // file): longer ones are refused with INVALID_ARGUMENT before they are projected
+  // (--max-query-frames).
+  int max_query_frames = kDefaultMaxQueryFrames;
   // A client stream (IngestClipStream) that sends nothing for this long is ended, releasing
   // its thread (--stream-idle-timeout-s); 0: never.
   int stream_idle_timeout_s = 30;

@@ -60,8 +60,9 @@ grpc::Status SpaceServiceImpl::GetCurve(grpc::ServerContext* context,
                                         const v1::GetCurveRequest* request,
                                         v1::GetCurveResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<Curve> curve = ReadCurve(registry_, database_, FromProto(*request));
-    if (!curve.ok()) return ToGrpcStatus(curve.status());
+    const absl::StatusOr<Curve> curve =
+        ReadCurve(registry_, database_, FromProto(*request), StopWhenCallEnds(context));
+    if (!curve.ok()) return ToGrpcStatus(ExplainStop(curve.status(), context));
     ToProto(*curve, response);
     return grpc::Status::OK;
   });
