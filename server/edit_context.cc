@@ -26,6 +26,8 @@ absl::Status CheckEditStop(const std::function<bool()>& should_stop) {
 absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
                                       const ClipSelection& selection, absl::string_view field,
                                       const std::function<bool()>& should_stop) {
+  // Reading the range is one step (the take's whole blob, up to seconds): not begun once stopped.
+  MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
   MOTIONDB_RETURN_IF_ERROR(
       Prefixed(field, CheckClipInSpace(database, snapshot, selection.clip_id)));
   MOTIONDB_ASSIGN_OR_RETURN(const SelectedFrames selected,
