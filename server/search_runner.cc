@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "absl/strings/str_cat.h"
 #include "core/index/coarse_rate.h"
@@ -121,7 +122,7 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnap
       "bvh",
       ResampledFrameCount(clip.frame_count(), clip.frame_time(), snapshot.space->sample_rate()),
       snapshot.space->sample_rate(),
-      absl::StrCat("the file's ", clip.frame_count(), " at its ", clip.fps(),
+      absl::StrCat("the file's ", clip.frame_count(), " frames at its ", clip.fps(),
                    " fps; a range of it is searched after the whole file is projected"),
       max_rows));
   MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip));
