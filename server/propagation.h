@@ -43,7 +43,7 @@ struct PropagationRequest {
 
 // Checks `request` and fills its descriptors when empty. NOT_FOUND for an unknown space;
 // INVALID_ARGUMENT naming the field (descriptors[i]) for a descriptor no label can carry (empty,
-// over storage::kMaxDescriptorBytes, a control character) or bad search parameters;
+// over storage::kMaxDescriptorBytes, not printable text) or bad search parameters;
 // FAILED_PRECONDITION for no descriptors given while no manual label exists.
 absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& database,
                                                       const IndexRegistry& registry,

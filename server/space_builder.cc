@@ -11,6 +11,7 @@
 #include "server/learned_metric_fit.h"
 #include "server/listing.h"
 #include "server/space_report.h"
+#include "util/name_text.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -82,8 +83,8 @@ absl::Status ValidateSpaceName(const std::string& name) {
     const bool allowed = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
                          (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
     if (!allowed) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("name: '", name, "' may only contain letters, digits, '.', '_' and '-'"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "name: ", QuotedNameText(name), " may only contain letters, digits, '.', '_' and '-'"));
     }
   }
   return absl::OkStatus();

@@ -39,7 +39,7 @@
 namespace motiondb::storage {
 
 // INVALID_ARGUMENT naming `what` for a descriptor no label can carry: empty, over
-// kMaxDescriptorBytes, or holding a control character (the rules AddLabels applies).
+// kMaxDescriptorBytes, or text util/name_text.h refuses (the rules AddLabels applies).
 absl::Status CheckDescriptor(const std::string& what, const std::string& descriptor);
 
 struct DatabaseOptions {
@@ -54,8 +54,8 @@ struct DatabaseOptions {
 // A clip as stored: its frames, and what the catalogue shows.
 struct ClipRecord {
   int64_t clip_id = 0;  // assigned by InsertClip
-  // Unique. Printable text of 1 to 512 bytes; '/' separates the segments of a relative path
-  // ("session1/take_001"), none empty, "." or "..".
+  // Unique. Printable text (util/name_text.h) of 1 to 512 bytes; '/' separates the segments of
+  // a relative path ("session1/take_001"), none empty, "." or "..".
   std::string name;
   std::string source_file;        // as uploaded
   std::vector<std::string> tags;  // a set: stored sorted and without repeats
@@ -172,9 +172,9 @@ class Database {
   // the new clip id. ALREADY_EXISTS when another clip of that name exists; NOT_FOUND for an
   // unknown space or clip to replace; FAILED_PRECONDITION when `projections` misses a space of
   // the skeleton or names one of another; INVALID_ARGUMENT for a name that breaks
-  // ClipRecord::name's rules, a tag of 0 or over 128 bytes or with a control character, over 64
-  // tags, values beyond float32, or a projection with non-finite values or more columns than
-  // its space. Projection::clip_id is ignored here.
+  // ClipRecord::name's rules, a tag of 0 or over 128 bytes or of text util/name_text.h refuses,
+  // over 64 tags, values beyond float32, or a projection with non-finite values or more columns
+  // than its space. Projection::clip_id is ignored here.
   absl::StatusOr<int64_t> InsertClip(const ClipRecord& record, const Clip& clip,
                                      const std::vector<std::pair<int64_t, Projection>>& projections,
                                      const InsertClipOptions& options = {},
@@ -230,7 +230,7 @@ class Database {
   // ("labels[3].value: 1.5 is outside [0, 1]"): NOT_FOUND for an unknown clip (or source label
   // or space of a propagated label); INVALID_ARGUMENT for an empty batch, a range outside the
   // clip's frames or reversed, a value not in [0, 1] (NaN included), a descriptor that is empty,
-  // over kMaxDescriptorBytes or holds a control character, or a manual label carrying the
+  // over kMaxDescriptorBytes or of text util/name_text.h refuses, or a manual label carrying the
   // fields of a propagated one.
   absl::StatusOr<std::vector<int64_t>> AddLabels(const std::vector<LabelRecord>& labels,
                                                  const WriteOptions& write = {});
@@ -283,7 +283,7 @@ class Database {
 
   // Pose models (storage/pose_model_record.h). InsertPoseModel stores one and returns its id:
   // ALREADY_EXISTS for a taken name, NOT_FOUND for an unknown space, INVALID_ARGUMENT naming
-  // `name` for a name of 0 or over 128 bytes or with a control character.
+  // `name` for a name of 0 or over 128 bytes or of text util/name_text.h refuses.
   absl::StatusOr<int64_t> InsertPoseModel(const PoseModelRecord& model,
                                           const WriteOptions& write = {});
   absl::StatusOr<PoseModelRecord> GetPoseModel(const std::string& name);  // NOT_FOUND

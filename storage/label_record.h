@@ -22,7 +22,7 @@ struct LabelRecord {
   int64_t clip_id = 0;
   int64_t first_frame = 0;  // inclusive, at the clip's own rate
   int64_t last_frame = 0;
-  // 1 to 256 bytes of printable text (no control characters), like clip names.
+  // 1 to 256 bytes of printable text (util/name_text.h), like clip names.
   std::string descriptor;
   double value = 1;  // in [0, 1]
   LabelOrigin origin = LabelOrigin::kManual;

@@ -4,38 +4,13 @@
 #include <algorithm>
 #include <cmath>
 
-#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "storage/database.h"
+#include "util/name_text.h"
 #include "util/status_macros.h"
 
 namespace motiondb::storage {
-namespace {
-
-// The offset of the first control character in `text`, or npos: C0 (NUL included) and DEL, and
-// C1 as UTF-8 encodes it (0xC2 0x80-0x9F).
-size_t FindControlCharacter(absl::string_view text) {
-  for (size_t i = 0; i < text.size(); ++i) {
-    const auto byte = static_cast<unsigned char>(text[i]);
-    if (byte < 0x20 || byte == 0x7F) return i;
-    if (byte == 0xC2 && i + 1 < text.size()) {
-      const auto next = static_cast<unsigned char>(text[i + 1]);
-      if (next >= 0x80 && next <= 0x9F) return i;
-    }
-  }
-  return absl::string_view::npos;
-}
-
-// `name` quoted for an error message: escaped, so that the message itself holds no control
-// character, and shortened.
-std::string Quoted(absl::string_view name) {
-  constexpr size_t kShown = 80;
-  return absl::StrCat("'", absl::CHexEscape(name.substr(0, kShown)),
-                      name.size() > kShown ? "...'" : "'");
-}
-
-}  // namespace
 
 absl::Status CheckName(absl::string_view what, absl::string_view name, size_t max_bytes,
                        bool may_be_empty) {
@@ -46,12 +21,7 @@ absl::Status CheckName(absl::string_view what, absl::string_view name, size_t ma
     return absl::InvalidArgumentError(absl::StrCat(
         what, " is ", name.size(), " bytes long, at most ", max_bytes, " are allowed"));
   }
-  if (const size_t at = FindControlCharacter(name); at != absl::string_view::npos) {
-    return absl::InvalidArgumentError(absl::StrCat(what, " ", Quoted(name),
-                                                   " holds a control character at byte ", at,
-                                                   "; names and tags are printable text"));
-  }
-  return absl::OkStatus();
+  return CheckNameText(what, name);
 }
 
 absl::Status CheckClipName(absl::string_view name) {
@@ -59,18 +29,18 @@ absl::Status CheckClipName(absl::string_view name) {
   MOTIONDB_RETURN_IF_ERROR(CheckName(kWhat, name, kMaxNameBytes));
   if (name.front() == '/' || name.back() == '/') {
     return absl::InvalidArgumentError(
-        absl::StrCat(kWhat, " ", Quoted(name),
+        absl::StrCat(kWhat, " ", QuotedNameText(name),
                      " begins or ends with '/'; give a relative path such as "
                      "'session1/take_001'"));
   }
   for (const absl::string_view segment : absl::StrSplit(name, '/')) {
     if (segment.empty()) {
       return absl::InvalidArgumentError(
-          absl::StrCat(kWhat, " ", Quoted(name), " has an empty segment ('//')"));
+          absl::StrCat(kWhat, " ", QuotedNameText(name), " has an empty segment ('//')"));
     }
     if (segment == "." || segment == "..") {
       return absl::InvalidArgumentError(
-          absl::StrCat(kWhat, " ", Quoted(name), " has a '", segment,
+          absl::StrCat(kWhat, " ", QuotedNameText(name), " has a '", segment,
                        "' segment; '/' separates folders, which are named outright"));
     }
   }

@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "util/file_io.h"
+#include "util/name_text.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -165,6 +166,9 @@ absl::StatusOr<std::string> ParseJointName(Scanner& scanner, bool& brace_consume
                      return u < 0x20 || u == 0x7f || c == '{' || c == '}';
                    });
   if (bad) return ErrorAt(scanner.token_line(), "a joint name without braces", name);
+  // Names are shown in listings and answers, which carry UTF-8 only.
+  MOTIONDB_RETURN_IF_ERROR(
+      Prefixed(absl::StrCat("line ", scanner.token_line()), CheckNameText("joint name", name)));
   return std::string(name);
 }
 

@@ -1,7 +1,8 @@
 // Reads BVH motion capture files into a Clip, tolerating the dialects real exporters write
 // (any rotation order per joint, 3 or 6 channels on any joint, leaves without End Site, CRLF,
 // tabs, E-notation, colons and spaces in joint names) and rejecting malformed input with the
-// line number and what was expected.
+// line number and what was expected; a joint name must be printable UTF-8 (util/name_text.h:
+// a Latin-1 file is refused, to be converted first).
 #ifndef MOTIONDB_CORE_BVH_BVH_READER_H_
 #define MOTIONDB_CORE_BVH_BVH_READER_H_
 

@@ -12,6 +12,7 @@
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
 #include "server/listing.h"
+#include "util/name_text.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -124,8 +125,10 @@ grpc::Status ClipServiceImpl::GetClip(grpc::ServerContext* context,
     const absl::StatusOr<storage::StoredClip> stored = database_.GetClip(request->clip_id());
     if (!stored.ok()) return ToGrpcStatus(stored.status());
     ToProto(stored->record, response);
+    // Joint names an older version stored unchecked may not be UTF-8, which protobuf cannot
+    // carry: shown with U+FFFD (util/name_text.h).
     for (const Joint& joint : stored->clip.skeleton().joints())
-      response->add_joint_names(joint.name);
+      response->add_joint_names(ValidUtf8(joint.name));
     return grpc::Status::OK;
   });
 }

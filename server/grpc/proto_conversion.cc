@@ -8,6 +8,7 @@
 #include "core/space/joint_weights.h"
 #include "server/listing.h"
 #include "util/byte_coding.h"
+#include "util/name_text.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
 
@@ -372,10 +373,10 @@ void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
 
 void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton) {
   skeleton->set_skeleton_id(summary.skeleton_id);
-  skeleton->set_name(SkeletonName(summary));
+  skeleton->set_name(ValidUtf8(SkeletonName(summary)));
   skeleton->set_joint_count(summary.joint_count);
   skeleton->set_clip_count(summary.clip_count);
-  skeleton->set_root_joint(summary.root_joint);
+  skeleton->set_root_joint(ValidUtf8(summary.root_joint));
 }
 
 void ToProto(const storage::Counts& counts, v1::DatabaseCounts* out) {
@@ -410,7 +411,7 @@ void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response) {
 void ToProto(const SearchExplanation& explanation, v1::SearchExplanation* out) {
   for (const JointShare& joint : explanation.joints) {
     v1::JointShare* share = out->add_joints();
-    share->set_name(joint.name);
+    share->set_name(ValidUtf8(joint.name));
     share->set_share(joint.share);
     share->set_score(joint.score);
   }
@@ -468,7 +469,7 @@ void ToProto(const SpaceReport& report, v1::SpaceBuildReport* out) {
   out->set_weight_preset(ToProto(report.weight_preset));
   for (const JointWeightReport& weight : report.joint_weights) {
     v1::JointWeight* joint = out->add_joint_weights();
-    joint->set_joint(weight.joint);
+    joint->set_joint(ValidUtf8(weight.joint));
     joint->set_weight(weight.weight);
   }
   for (const TrainingReport& range : report.training) {
@@ -534,7 +535,7 @@ void ToProto(const storage::ClipPage& page, v1::ListClipsResponse* response) {
 
 void ToProto(const ClipPoses& poses, v1::ClipPoses* response) {
   response->set_clip_id(poses.clip_id);
-  for (const std::string& name : poses.joint_names) response->add_joint_names(name);
+  for (const std::string& name : poses.joint_names) response->add_joint_names(ValidUtf8(name));
   for (const int parent : poses.parents) response->add_parents(parent);
   response->set_sample_rate(poses.sample_rate);
   response->set_frames(static_cast<int32_t>(poses.positions.rows()));
@@ -853,7 +854,7 @@ void ToProto(ReconstructOutcome&& outcome, v1::ReconstructResponse* response) {
   response->set_dims(outcome.dims);
   for (const JointReconstructionError& joint : outcome.joints) {
     v1::JointError* out = response->add_joints();
-    out->set_joint(joint.joint);
+    out->set_joint(ValidUtf8(joint.joint));
     out->set_mean_rad(joint.error.mean_rad);
     out->set_max_rad(joint.error.max_rad);
   }

@@ -1,7 +1,9 @@
 // Every conversion between motiondb.v1 messages and the application layer's types, in one
 // place: requests to the application's request structs (INVALID_ARGUMENT naming the field for
 // values no struct can hold, such as unknown enum values), and results to response messages.
-// Defaults for unset fields are the application's, not decided here.
+// Defaults for unset fields are the application's, not decided here. Joint names go out through
+// ValidUtf8 (util/name_text.h): an older version stored a BVH file's names unchecked, and one
+// name that is not UTF-8 would fail every answer holding it.
 #ifndef MOTIONDB_SERVER_GRPC_PROTO_CONVERSION_H_
 #define MOTIONDB_SERVER_GRPC_PROTO_CONVERSION_H_
 

@@ -22,9 +22,10 @@ inline constexpr size_t kMaxTagBytes = 128;
 inline constexpr size_t kMaxTags = 64;  // a clip's
 
 // INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`), one longer than
-// `max_bytes`, or one holding a control character (NUL, the rest of C0, DEL, or C1 encoded as
-// UTF-8). Names and tags are printed in listings, logs and terminals, where a control character
-// would hide or rewrite what follows it, and NUL would cut the name short in C strings.
+// `max_bytes`, or one that util/name_text.h's rule refuses: not UTF-8, or holding a control,
+// bidirectional control or line separator character. Names and tags are printed in listings,
+// logs, terminals and spreadsheets, where such a character would hide, rewrite or reorder what
+// follows it, NUL would cut the name short in C strings, and protobuf carries UTF-8 only.
 absl::Status CheckName(absl::string_view what, absl::string_view name, size_t max_bytes,
                        bool may_be_empty = false);
 
