@@ -2,6 +2,9 @@
 // labels find DESCRIPTOR [--min V] [--tag T]... | labels delete (ID... | --clip ID |
 // --descriptor D) | labels import FILE | labels export [-o FILE] [--format csv|json]
 // [--origin manual|propagated]
+#include <unistd.h>
+
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -24,12 +27,14 @@
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
+#include "util/status_prefix.h"
 
 namespace motiondb::cli {
 namespace {
 
-// A label file larger than this is not one a labelling tool wrote.
-constexpr int64_t kMaxLabelFileBytes = int64_t{1} << 30;
+// The labels `labels import` sends in one AddLabels call (the server takes up to 100000): a few
+// MB a batch, whatever the file's size.
+constexpr int kImportBatch = 10000;
 
 constexpr char kLabelFileHelp[] =
     "Label files: CSV with the header clip,start,end,descriptor,value (and optionally unit,\n"
@@ -247,13 +252,16 @@ absl::Status AddLabel(const AddFlags& flags, bool json, const ServerConnection& 
                 LabelItemNames(0, "the label",
                                [&](const std::string& column) { return words.at(column); })));
   const v1::Label& label = response.labels(0);
+  const bool stored_before = response.skipped_size() > 0;
   if (json) {
-    std::cout << LabelJson(label).dump() << "\n";
+    nlohmann::json added = LabelJson(label);
+    if (stored_before) added["already_stored"] = true;
+    std::cout << added.dump() << "\n";
   } else {
-    absl::PrintF("added label %d: clip %d (%s) frames %d-%d (%.3f-%.3f s), %s = %g\n",
-                 label.label_id(), label.clip_id(), label.clip_name(), label.first_frame(),
-                 label.last_frame(), label.start_s(), label.end_s(), label.descriptor_name(),
-                 label.value());
+    absl::PrintF("%s label %d: clip %d (%s) frames %d-%d (%.3f-%.3f s), %s = %g\n",
+                 stored_before ? "already stored as" : "added", label.label_id(), label.clip_id(),
+                 label.clip_name(), label.first_frame(), label.last_frame(), label.start_s(),
+                 label.end_s(), label.descriptor_name(), label.value());
   }
   return absl::OkStatus();
 }
@@ -325,32 +333,100 @@ absl::Status DeleteLabels(const DeleteFlags& flags, bool json, const ServerConne
   return absl::OkStatus();
 }
 
-absl::Status ImportLabels(const std::string& path, bool json, const ServerConnection& connection) {
-  MOTIONDB_ASSIGN_OR_RETURN(const LabelFileFormat format, LabelFileFormatOf(path));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::string text, ReadFileBytes(path, kMaxLabelFileBytes));
-  absl::StatusOr<LabelFile> file = ParseLabelFile(text, format);
-  if (!file.ok())
-    return absl::InvalidArgumentError(absl::StrCat(path, ": ", file.status().message()));
-  v1::AddLabelsRequest request;
+// The server's error about a batch of a file's labels in the file's words: each
+// "labels[i].field" it names (i in the batch) said as "FILE: line 12, column".
+absl::Status SpeakBatchError(const absl::Status& error, const std::string& path,
+                             const std::vector<std::string>& places) {
+  const std::string message(error.message());
   FlagNames names;
-  for (size_t i = 0; i < file->labels.size(); ++i) {
-    *request.add_labels() = std::move(file->labels[i]);
-    const std::string item = absl::StrCat(path, ": ", file->places[i]);
+  for (size_t at = message.find("labels["); at != std::string::npos;
+       at = message.find("labels[", at + 1)) {
+    size_t index = 0;
+    const size_t close = message.find(']', at);
+    if (close == std::string::npos ||
+        !absl::SimpleAtoi(message.substr(at + 7, close - at - 7), &index) ||
+        index >= places.size()) {
+      continue;
+    }
+    const std::string item = absl::StrCat(path, ": ", places[index]);
     const FlagNames item_names = LabelItemNames(
-        i, item, [&](const std::string& column) { return absl::StrCat(item, ", ", column); });
+        index, item, [&](const std::string& column) { return absl::StrCat(item, ", ", column); });
     names.insert(names.end(), item_names.begin(), item_names.end());
   }
-  // One batch: the server stores every label of the file or none.
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const v1::AddLabelsResponse response,
-      CallUnary(connection, &v1::LabelService::Stub::AddLabels, request, names));
+  return absl::Status(error.code(), SpeakFlags(message, names));
+}
+
+// Opens a label file for one reading of it.
+absl::StatusOr<std::unique_ptr<std::ifstream>> OpenLabelFile(const std::string& path) {
+  auto in = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*in) return absl::NotFoundError(absl::StrCat("cannot read ", path));
+  return in;
+}
+
+// Imports a label file of any size, holding one batch of it at a time. The whole file is read
+// first, so that an error in it stores nothing; then it is read again and sent in batches of
+// kImportBatch labels, each stored all or nothing: a file of up to that many is stored whole
+// or not at all. The server does not store a label twice, so that importing a file again after
+// a batch failed (or after it was imported) adds only what is missing.
+absl::Status ImportLabels(const std::string& path, bool json, const ServerConnection& connection) {
+  MOTIONDB_ASSIGN_OR_RETURN(const LabelFileFormat format, LabelFileFormatOf(path));
+  int64_t total = 0;
+  {
+    MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<std::ifstream> in, OpenLabelFile(path));
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(path, ReadLabelFile(*in, format, [&total](PlacedLabel) {
+                                        ++total;
+                                        return absl::OkStatus();
+                                      })));
+  }
+  if (total == 0)
+    return absl::InvalidArgumentError(absl::StrCat(path, ": the file holds no labels"));
+  const bool progress_bar = ::isatty(STDERR_FILENO) && !json && total > kImportBatch;
+  int64_t sent = 0, added = 0, skipped = 0;
+  v1::AddLabelsRequest request;
+  std::vector<std::string> places;
+  absl::Status refused;  // the server's, told in the file's words
+  const auto send = [&]() -> absl::Status {
+    absl::StatusOr<v1::AddLabelsResponse> response =
+        CallUnary(connection, &v1::LabelService::Stub::AddLabels, request);
+    if (!response.ok()) {
+      refused = SpeakBatchError(response.status(), path, places);
+      if (sent > 0) {
+        refused = absl::Status(refused.code(),
+                               absl::StrCat(refused.message(), " (the file's first ", sent,
+                                            " labels were stored; importing the file again adds "
+                                            "only the labels missing)"));
+      }
+      return refused;
+    }
+    sent += request.labels_size();
+    skipped += response->skipped_size();
+    added += response->labels_size() - response->skipped_size();
+    request.clear_labels();
+    places.clear();
+    if (progress_bar) {
+      std::cerr << absl::StrFormat("\r\033[Klabels import: %d of %d labels", sent, total)
+                << std::flush;
+    }
+    return absl::OkStatus();
+  };
+  MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<std::ifstream> in, OpenLabelFile(path));
+  absl::Status read = ReadLabelFile(*in, format, [&](PlacedLabel placed) {
+    *request.add_labels() = std::move(placed.label);
+    places.push_back(std::move(placed.place));
+    return request.labels_size() < kImportBatch ? absl::OkStatus() : send();
+  });
+  if (read.ok() && request.labels_size() > 0) read = send();
+  if (progress_bar) std::cerr << "\n";
+  if (!refused.ok()) return refused;
+  // An error of the file itself now means it changed since it was read.
+  MOTIONDB_RETURN_IF_ERROR(Prefixed(path, read));
   if (json) {
-    std::vector<int64_t> ids;
-    for (const v1::Label& label : response.labels()) ids.push_back(label.label_id());
-    std::cout << nlohmann::json{{"file", path}, {"imported", ids.size()}, {"label_ids", ids}}.dump()
+    std::cout << nlohmann::json{{"file", path}, {"imported", added}, {"skipped", skipped}}.dump()
               << "\n";
   } else {
-    absl::PrintF("imported %d labels from %s\n", response.labels_size(), path);
+    absl::PrintF("imported %d labels from %s", added, path);
+    if (skipped > 0) absl::PrintF(" (%d already stored, not added again)", skipped);
+    absl::PrintF("\n");
   }
   return absl::OkStatus();
 }
@@ -482,14 +558,22 @@ void AddDeleteImportExport(Commands& commands, CLI::App* labels) {
 
   auto path = std::make_shared<std::string>();
   CLI::App* importer =
-      commands.AddServer(labels, "import", "add the labels of a CSV or JSON file, all or none",
+      commands.AddServer(labels, "import", "add the labels of a CSV or JSON file not stored yet",
                          [path, &global](const ServerConnection& connection) {
                            return ImportLabels(*path, global.json, connection);
                          });
   importer->add_option("FILE", *path, "a .csv or .json file (see below)")
       ->required()
       ->check(ExistingFile());
-  importer->footer(kLabelFileHelp);
+  importer->footer(absl::StrCat(
+      kLabelFileHelp,
+      "\nA bad line stores nothing. A label stored already (same clip, range, descriptor and\n"
+      "value) is not added again. A file of up to ",
+      kImportBatch,
+      " labels is stored whole or not at all;\na larger one in batches of that many, each "
+      "whole or not at all: after an error, importing\nthe file again adds what is missing. "
+      "CSV text cells that export wrote after an apostrophe\n(= + - @ first: formula "
+      "injection) are read without it."));
 
   auto out = std::make_shared<LabelExportFlags>();
   CLI::App* exporter =

@@ -6,6 +6,9 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -83,27 +86,99 @@ absl::StatusOr<v1::NewLabel> ToNewLabel(const LabelFields& fields) {
   return label;
 }
 
-// The fields of one CSV line: commas separate them, quotes ("...", with "" for a quote) keep
-// commas inside one.
-absl::StatusOr<std::vector<std::string>> SplitCsvLine(absl::string_view line) {
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-      fields.back() += '"';
-      ++i;
-    } else if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      fields.emplace_back();
-    } else {
-      fields.back() += c;
+// OWASP's rule against formula injection: a spreadsheet runs a cell that begins with one of
+// these as a formula (=cmd|' /C calc'!A0), unless an apostrophe comes first, which it hides.
+bool StartsFormula(char c) {
+  return c == '=' || c == '+' || c == '-' || c == '@' || c == '\t' || c == '\r';
+}
+
+// Whether `text` is a cell that export neutralised: an apostrophe, then what starts a formula
+// or another apostrophe (so that a text beginning so is told apart, and comes back exactly).
+bool IsNeutralised(absl::string_view text) {
+  return text.size() >= 2 && text[0] == '\'' && (StartsFormula(text[1]) || text[1] == '\'');
+}
+
+// A text cell as export writes it: after an apostrophe when a spreadsheet would run it (or
+// when it would read as neutralised); Restored() undoes it.
+std::string Neutralised(const std::string& text) {
+  if (!text.empty() && (StartsFormula(text[0]) || IsNeutralised(text))) return "'" + text;
+  return text;
+}
+
+std::string Restored(std::string text) {
+  if (IsNeutralised(text)) text.erase(0, 1);
+  return text;
+}
+
+// A CSV file's records (RFC 4180), read from a stream a character at a time: commas separate
+// the fields, quotes ("...", with "" for a quote) keep commas and line breaks inside one, and a
+// line break outside quotes (LF or CRLF) ends a record. Blank lines are skipped.
+class CsvRecords {
+ public:
+  // A record longer than this is a quote left open, not a label.
+  static constexpr size_t kMaxRecordBytes = size_t{1} << 20;
+
+  struct Record {
+    std::vector<std::string> fields;
+    int line = 0;  // where it starts
+  };
+
+  explicit CsvRecords(std::istream& in) : in_(*in.rdbuf()) {}
+
+  // The next record, or nullopt at the end. INVALID_ARGUMENT naming the line the record starts
+  // on for a quoted field not closed, or a record over kMaxRecordBytes.
+  absl::StatusOr<std::optional<Record>> Next() {
+    Record record{{""}, line_};
+    bool quoted = false;
+    bool blank = true;      // nothing but blanks yet
+    bool after_cr = false;  // the last character was a CR outside quotes
+    size_t bytes = 0;
+    for (int c = in_.sbumpc();; c = in_.sbumpc()) {
+      if (c == std::char_traits<char>::eof()) {
+        if (quoted) return Unclosed(record.line);
+        if (blank) return std::nullopt;
+        return record;
+      }
+      if (++bytes > kMaxRecordBytes) {
+        return absl::InvalidArgumentError(absl::StrCat("line ", record.line,
+                                                       ": the record runs past ", kMaxRecordBytes,
+                                                       " bytes (a quoted field not closed?)"));
+      }
+      const char ch = static_cast<char>(c);
+      if (ch == '\n') ++line_;
+      if (ch == '\n' && !quoted) {
+        if (blank) {  // a blank line: the next record starts after it
+          record = {{""}, line_};
+          bytes = 0;
+          continue;
+        }
+        if (after_cr) record.fields.back().pop_back();
+        return record;
+      }
+      after_cr = ch == '\r' && !quoted;
+      if (!absl::ascii_isspace(static_cast<unsigned char>(ch))) blank = false;
+      if (quoted && ch == '"' && in_.sgetc() == '"') {
+        in_.sbumpc();
+        record.fields.back() += '"';
+      } else if (ch == '"') {
+        quoted = !quoted;
+      } else if (ch == ',' && !quoted) {
+        record.fields.emplace_back();
+      } else {
+        record.fields.back() += ch;
+      }
     }
   }
-  if (quoted) return absl::InvalidArgumentError("a quoted field is not closed");
-  return fields;
-}
+
+ private:
+  static absl::Status Unclosed(int line) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("line ", line, ": a quoted field is not closed by the end of the file"));
+  }
+
+  std::streambuf& in_;
+  int line_ = 1;
+};
 
 absl::StatusOr<std::optional<double>> CsvNumber(const std::string& text, const char* column) {
   if (text.empty()) return std::nullopt;
@@ -149,7 +224,7 @@ absl::StatusOr<LabelFields> CsvFields(const std::vector<std::string>& row,
   LabelFields fields;
   // clip is always a name, digits too; an id is a clip_id.
   if (const auto clip = columns.find("clip"); clip != columns.end()) {
-    fields.clip_name = row[clip->second];
+    fields.clip_name = Restored(row[clip->second]);
   }
   if (const auto clip_id = columns.find("clip_id");
       clip_id != columns.end() && !row[clip_id->second].empty()) {
@@ -163,36 +238,34 @@ absl::StatusOr<LabelFields> CsvFields(const std::vector<std::string>& row,
   MOTIONDB_ASSIGN_OR_RETURN(fields.start, CsvNumber(row[columns.at("start")], "start"));
   MOTIONDB_ASSIGN_OR_RETURN(fields.end, CsvNumber(row[columns.at("end")], "end"));
   MOTIONDB_ASSIGN_OR_RETURN(fields.value, CsvNumber(row[columns.at("value")], "value"));
-  fields.descriptor = row[columns.at("descriptor")];
+  fields.descriptor = Restored(row[columns.at("descriptor")]);
   if (const auto unit = columns.find("unit"); unit != columns.end() && !row[unit->second].empty()) {
     fields.unit = row[unit->second];
   }
   return fields;
 }
 
-absl::StatusOr<LabelFile> ParseCsv(absl::string_view text) {
-  // Spreadsheets saving "CSV UTF-8" begin the file with a byte order mark.
-  absl::ConsumePrefix(&text, "\xEF\xBB\xBF");
-  LabelFile file;
+absl::Status ReadCsv(std::istream& in, const LabelConsumer& consume) {
+  CsvRecords records(in);
   std::optional<std::map<std::string, size_t>> columns;
-  int line_number = 0;
-  for (absl::string_view line : absl::StrSplit(text, '\n')) {
-    ++line_number;
-    if (absl::EndsWith(line, "\r")) line.remove_suffix(1);
-    if (absl::StripAsciiWhitespace(line).empty()) continue;
-    const std::string place = absl::StrCat("line ", line_number);
-    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> row,
-                              Prefixed(place, SplitCsvLine(line)));
+  while (true) {
+    MOTIONDB_ASSIGN_OR_RETURN(std::optional<CsvRecords::Record> record, records.Next());
+    if (!record) break;
+    const std::string place = absl::StrCat("line ", record->line);
     if (!columns) {
-      MOTIONDB_ASSIGN_OR_RETURN(columns, Prefixed(place, CsvHeader(row)));
+      // Spreadsheets saving "CSV UTF-8" begin the file with a byte order mark.
+      absl::string_view first = record->fields[0];
+      if (absl::ConsumePrefix(&first, "\xEF\xBB\xBF")) record->fields[0] = std::string(first);
+      MOTIONDB_ASSIGN_OR_RETURN(columns, Prefixed(place, CsvHeader(record->fields)));
       continue;
     }
-    MOTIONDB_ASSIGN_OR_RETURN(const LabelFields fields, Prefixed(place, CsvFields(row, *columns)));
-    MOTIONDB_ASSIGN_OR_RETURN(file.labels.emplace_back(), Prefixed(place, ToNewLabel(fields)));
-    file.places.push_back(place);
+    MOTIONDB_ASSIGN_OR_RETURN(const LabelFields fields,
+                              Prefixed(place, CsvFields(record->fields, *columns)));
+    MOTIONDB_ASSIGN_OR_RETURN(v1::NewLabel label, Prefixed(place, ToNewLabel(fields)));
+    MOTIONDB_RETURN_IF_ERROR(consume({std::move(label), place}));
   }
   if (!columns) return absl::InvalidArgumentError("the file has no header line");
-  return file;
+  return absl::OkStatus();
 }
 
 // A JSON field that may be absent or null: a number, or INVALID_ARGUMENT naming `key`.
@@ -239,24 +312,58 @@ absl::StatusOr<LabelFields> JsonFields(const nlohmann::json& item) {
   return fields;
 }
 
-absl::StatusOr<LabelFile> ParseJson(const std::string& text) {
-  const nlohmann::json items = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (items.is_discarded()) return absl::InvalidArgumentError("not valid JSON");
-  if (!items.is_array()) return absl::InvalidArgumentError("expected a list of labels");
-  LabelFile file;
-  for (size_t i = 0; i < items.size(); ++i) {
-    const std::string place = absl::StrCat("item ", i);
-    MOTIONDB_ASSIGN_OR_RETURN(const LabelFields fields, Prefixed(place, JsonFields(items[i])));
-    MOTIONDB_ASSIGN_OR_RETURN(file.labels.emplace_back(), Prefixed(place, ToNewLabel(fields)));
-    file.places.push_back(place);
+// Thrown from nlohmann's parser callback to stop the parse at the first error, which `status`
+// then holds.
+struct StopParsing {};
+
+absl::Status ReadJson(std::istream& in, const LabelConsumer& consume) {
+  using Event = nlohmann::json::parse_event_t;
+  absl::Status status;
+  bool list = false;
+  size_t item = 0;
+  // Each item of the list, once parsed whole, is handed on and dropped from the list, so that
+  // one item at a time is held.
+  const nlohmann::json::parser_callback_t each_item = [&](int depth, Event event,
+                                                          nlohmann::json& parsed) {
+    if (depth == 0) {
+      if (event == Event::array_start) list = true;
+      if (list) return true;
+      status = absl::InvalidArgumentError("expected a list of labels");
+      throw StopParsing();
+    }
+    const bool whole = depth == 1 && (event == Event::object_end || event == Event::array_end ||
+                                      event == Event::value);
+    if (!whole) return true;
+    const std::string place = absl::StrCat("item ", item++);
+    status = [&]() -> absl::Status {
+      MOTIONDB_ASSIGN_OR_RETURN(const LabelFields fields, Prefixed(place, JsonFields(parsed)));
+      MOTIONDB_ASSIGN_OR_RETURN(v1::NewLabel label, Prefixed(place, ToNewLabel(fields)));
+      return consume({std::move(label), place});
+    }();
+    if (!status.ok()) throw StopParsing();
+    return false;
+  };
+  try {
+    [[maybe_unused]] const nlohmann::json emptied = nlohmann::json::parse(in, each_item);
+  } catch (const StopParsing&) {
+    return status;
+  } catch (const nlohmann::json::exception& error) {
+    // "[json.exception.parse_error.101] parse error at line 2, column 5: ..."
+    absl::string_view what = error.what();
+    if (const size_t end = what.find("] "); end != absl::string_view::npos) {
+      what.remove_prefix(end + 2);
+    }
+    return absl::InvalidArgumentError(absl::StrCat("not valid JSON: ", what));
   }
-  return file;
+  return absl::OkStatus();
 }
 
+// A text cell: neutralised, then quoted when it holds a comma, a quote or a line break.
 std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"") == std::string::npos) return text;
+  const std::string cell = Neutralised(text);
+  if (cell.find_first_of(",\"\r\n") == std::string::npos) return cell;
   std::string quoted = "\"";
-  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  for (const char c : cell) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
   return quoted + "\"";
 }
 
@@ -270,8 +377,19 @@ absl::StatusOr<LabelFileFormat> LabelFileFormatOf(const std::string& path) {
       absl::StrCat(path, ": expected a .csv or .json file (the extension says which)"));
 }
 
+absl::Status ReadLabelFile(std::istream& in, LabelFileFormat format, const LabelConsumer& consume) {
+  return format == LabelFileFormat::kCsv ? ReadCsv(in, consume) : ReadJson(in, consume);
+}
+
 absl::StatusOr<LabelFile> ParseLabelFile(const std::string& text, LabelFileFormat format) {
-  return format == LabelFileFormat::kCsv ? ParseCsv(text) : ParseJson(text);
+  std::istringstream in(text);
+  LabelFile file;
+  MOTIONDB_RETURN_IF_ERROR(ReadLabelFile(in, format, [&file](PlacedLabel placed) {
+    file.labels.push_back(std::move(placed.label));
+    file.places.push_back(std::move(placed.place));
+    return absl::OkStatus();
+  }));
+  return file;
 }
 
 std::string FormatLabelFile(const std::vector<v1::Label>& labels, LabelFileFormat format) {

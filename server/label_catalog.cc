@@ -121,9 +121,9 @@ absl::Status ResolveRange(const NewLabel& label, const storage::ClipRecord& clip
 
 }  // namespace
 
-absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
-    storage::Database& database, const std::vector<NewLabel>& labels,
-    const std::function<bool()>& should_stop) {
+absl::StatusOr<storage::AddedLabels> AddLabels(storage::Database& database,
+                                               const std::vector<NewLabel>& labels,
+                                               const std::function<bool()>& should_stop) {
   if (labels.size() > kMaxLabelsPerBatch) {
     return absl::InvalidArgumentError(
         absl::StrCat("labels: at most ", kMaxLabelsPerBatch, " a call, got ", labels.size()));
@@ -146,10 +146,7 @@ absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
     record.value = label.value.value_or(1.0);
     record.created_unix_ms = now;
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> ids,
-                            database.AddLabels(records, {.should_stop = should_stop}));
-  for (size_t i = 0; i < ids.size(); ++i) records[i].label_id = ids[i];
-  return records;
+  return database.AddLabels(records, {.should_stop = should_stop});
 }
 
 absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,

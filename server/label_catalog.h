@@ -35,14 +35,16 @@ struct NewLabel {
   std::optional<double> value{};  // unset: 1
 };
 
-// Stores the batch, all or nothing; returns the labels as stored, in its order. NOT_FOUND for
+// Stores the batch, all or nothing; returns the labels as stored, in its order, an item
+// identical to a stored label (or an earlier item) returned as that one and listed as skipped
+// (storage::Database::AddLabels). NOT_FOUND for
 // an unknown clip; INVALID_ARGUMENT for what storage::Database::AddLabels refuses, a first
 // frame or time that is past the clip, a time that is not finite, negative or reversed, frames
 // and seconds both given, no clip named or clip_id and clip_name naming two, or over
 // kMaxLabelsPerBatch labels. `should_stop` as the Catalog's writes take it.
-absl::StatusOr<std::vector<storage::LabelRecord>> AddLabels(
-    storage::Database& database, const std::vector<NewLabel>& labels,
-    const std::function<bool()>& should_stop = {});
+absl::StatusOr<storage::AddedLabels> AddLabels(storage::Database& database,
+                                               const std::vector<NewLabel>& labels,
+                                               const std::function<bool()>& should_stop = {});
 
 // Pages as ListClips pages (server/listing.h).
 absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const PageRequest& page,

@@ -226,14 +226,17 @@ class Database {
   absl::StatusOr<std::vector<int64_t>> ClipsOfSkeleton(int64_t skeleton_id);
 
   // Labels (storage/label_record.h). AddLabels stores the batch in one transaction, all or
-  // nothing, and returns the new ids in its order. Errors name the item and field
+  // nothing, and returns it as stored. An item identical to a stored label (or to an earlier
+  // item) in every column but id and creation time is not stored again: it is returned as the
+  // stored label, and AddedLabels::skipped lists it, so that importing a file twice adds its
+  // labels once. Errors name the item and field
   // ("labels[3].value: 1.5 is outside [0, 1]"): NOT_FOUND for an unknown clip (or source label
   // or space of a propagated label); INVALID_ARGUMENT for an empty batch, a range outside the
   // clip's frames or reversed, a value not in [0, 1] (NaN included), a descriptor that is empty,
   // over kMaxDescriptorBytes or of text util/name_text.h refuses, or a manual label carrying the
   // fields of a propagated one.
-  absl::StatusOr<std::vector<int64_t>> AddLabels(const std::vector<LabelRecord>& labels,
-                                                 const WriteOptions& write = {});
+  absl::StatusOr<AddedLabels> AddLabels(const std::vector<LabelRecord>& labels,
+                                        const WriteOptions& write = {});
   // Labels matching `filter`, in label id order; Page as ListClips takes it (its token is the
   // last label id). NOT_FOUND naming clip_id when the filter's clip is unknown.
   absl::StatusOr<LabelPage> ListLabels(const Page& page, const LabelFilter& filter);

@@ -193,48 +193,74 @@ absl::Status CheckLabelReferences(SqliteConnection& db, ClipFrames& clips, const
   return absl::OkStatus();
 }
 
-// Inserts `label` with `insert` (reset here); a manual label's propagation columns stay NULL.
-absl::Status InsertLabel(SqliteStatement& insert, const LabelRecord& label, int64_t now) {
-  insert.Reset();
-  insert.BindInt64(1, label.clip_id)
+// Binds `label`'s columns to ?1..?10 of `statement` (reset here), in the labels table's order
+// from clip_id to job_id; a manual label's propagation columns stay NULL.
+void BindLabelColumns(SqliteStatement& statement, const LabelRecord& label) {
+  statement.Reset();
+  statement.BindInt64(1, label.clip_id)
       .BindInt64(2, label.first_frame)
       .BindInt64(3, label.last_frame)
       .BindText(4, label.descriptor)
       .BindDouble(5, label.value)
-      .BindText(6, OriginText(label.origin))
-      .BindInt64(11, now);
+      .BindText(6, OriginText(label.origin));
   if (label.origin == LabelOrigin::kPropagated) {
-    insert.BindInt64(7, label.source_label_id).BindDouble(9, label.score);
-    if (label.space_id != 0) insert.BindInt64(8, label.space_id);
-    if (!label.job_id.empty()) insert.BindText(10, label.job_id);
+    statement.BindInt64(7, label.source_label_id).BindDouble(9, label.score);
+    if (label.space_id != 0) statement.BindInt64(8, label.space_id);
+    if (!label.job_id.empty()) statement.BindText(10, label.job_id);
   }
-  return insert.Run();
+}
+
+// Whether a label identical to `label` in every column but id and creation time is stored;
+// if so, `label` takes its id and time.
+absl::StatusOr<bool> FindIdentical(SqliteStatement& find, LabelRecord& label) {
+  BindLabelColumns(find, label);
+  MOTIONDB_ASSIGN_OR_RETURN(const bool found, find.Step());
+  if (found) {
+    label.label_id = find.ColumnInt64(0);
+    label.created_unix_ms = find.ColumnInt64(1);
+  }
+  return found;
 }
 
 }  // namespace
 
-absl::StatusOr<std::vector<int64_t>> Database::AddLabels(const std::vector<LabelRecord>& labels,
-                                                         const WriteOptions& write) {
+absl::StatusOr<AddedLabels> Database::AddLabels(const std::vector<LabelRecord>& labels,
+                                                const WriteOptions& write) {
   if (labels.empty()) return absl::InvalidArgumentError("labels: the batch is empty");
   for (size_t i = 0; i < labels.size(); ++i) MOTIONDB_RETURN_IF_ERROR(CheckLabel(labels[i], i));
-  std::vector<int64_t> ids;
+  AddedLabels added;
   MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
-    ids.clear();
+    added = {labels, {}};
     ClipFrames clips(db);
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement insert,
         db.Prepare("INSERT INTO labels (clip_id, first_frame, last_frame, descriptor, value, "
                    "origin, source_label_id, space_id, score, job_id, created_unix_ms) "
                    "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)"));
-    for (size_t i = 0; i < labels.size(); ++i) {
-      MOTIONDB_RETURN_IF_ERROR(CheckLabelReferences(db, clips, labels[i], i));
-      MOTIONDB_RETURN_IF_ERROR(
-          InsertLabel(insert, labels[i], CreationTime(labels[i].created_unix_ms)));
-      ids.push_back(db.last_insert_rowid());
+    // One seek in labels_by_clip (schema migration 6); IS matches the NULLs of manual labels.
+    MOTIONDB_ASSIGN_OR_RETURN(
+        SqliteStatement find,
+        db.Prepare("SELECT label_id, created_unix_ms FROM labels WHERE clip_id = ?1 AND "
+                   "first_frame = ?2 AND last_frame = ?3 AND descriptor = ?4 AND value = ?5 AND "
+                   "origin = ?6 AND source_label_id IS ?7 AND space_id IS ?8 AND score IS ?9 AND "
+                   "job_id IS ?10 LIMIT 1"));
+    for (size_t i = 0; i < added.labels.size(); ++i) {
+      LabelRecord& label = added.labels[i];
+      MOTIONDB_RETURN_IF_ERROR(CheckLabelReferences(db, clips, label, i));
+      MOTIONDB_ASSIGN_OR_RETURN(const bool stored, FindIdentical(find, label));
+      if (stored) {
+        added.skipped.push_back(i);
+        continue;
+      }
+      label.created_unix_ms = CreationTime(label.created_unix_ms);
+      BindLabelColumns(insert, label);
+      insert.BindInt64(11, label.created_unix_ms);
+      MOTIONDB_RETURN_IF_ERROR(insert.Run());
+      label.label_id = db.last_insert_rowid();
     }
     return absl::OkStatus();
   }));
-  return ids;
+  return added;
 }
 
 absl::StatusOr<LabelPage> Database::ListLabels(const Page& page, const LabelFilter& filter) {

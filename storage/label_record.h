@@ -55,6 +55,14 @@ struct LabelQuery {
   std::vector<std::string> tags{};  // only clips carrying at least one of them; empty: any
 };
 
+// What Database::AddLabels did with a batch: its labels as stored, in its order, their ids and
+// creation times filled in (an item already stored: the stored label's), and the items
+// (indices, ascending) that were already stored and so were not added again.
+struct AddedLabels {
+  std::vector<LabelRecord> labels;
+  std::vector<size_t> skipped;
+};
+
 struct LabelPage {
   std::vector<LabelRecord> labels;
   std::string next_page_token;  // empty on the last page

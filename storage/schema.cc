@@ -217,6 +217,16 @@ absl::Status CopyRotationsLast(SqliteConnection& connection) {
   return absl::OkStatus();
 }
 
+// AddLabels looks for a label identical to each it is given, so as not to store it twice
+// (issue 37): labels_by_clip takes the rest of what identifies a label, so that the lookup is
+// one seek however many labels a clip has on one first frame (measured: 50,000 labels of one
+// clip's range, each its own descriptor, took 284 s to import with the index on clip_id and
+// first_frame alone, 1.2 s with this one). Its old columns lead it: what used them still does.
+constexpr const char* kMigration6 = R"sql(
+DROP INDEX labels_by_clip;
+CREATE INDEX labels_by_clip ON labels (clip_id, first_frame, last_frame, descriptor, value);
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -266,6 +276,7 @@ constexpr std::array kMigrations = {
     Migration{kMigration3},
     Migration{kMigration4},
     Migration{kMigration5, CopyRotationsLast, kMigration5Finish},
+    Migration{kMigration6},
 };
 // clang-format on
 

@@ -1445,6 +1445,12 @@ std::vector<int64_t> IdsOf(const std::vector<LabelRecord>& labels) {
   return ids;
 }
 
+// The ids of a batch AddLabels stored, in its order.
+absl::StatusOr<std::vector<int64_t>> IdsOf(const absl::StatusOr<AddedLabels>& added) {
+  if (!added.ok()) return added.status();
+  return IdsOf(added->labels);
+}
+
 TEST_F(StorageTest, ListClipsFiltersBySkeletonAndDescriptorAndCountsTheMatches) {
   const int64_t chain_a = Insert(Named("chain_a", {"t"}), Motion(testing::ChainSkeleton(), 20, 1));
   const int64_t humanoid =
@@ -1491,13 +1497,13 @@ TEST_F(StorageTest, ListClipsFiltersBySkeletonAndDescriptorAndCountsTheMatches) 
 TEST_F(StorageTest, LabelsAreListedFoundAndTimelinedAndPagedOnce) {
   const int64_t walk = Insert(Named("walk", {"gait"}), Motion(testing::ChainSkeleton(), 50, 1));
   const int64_t kick = Insert(Named("kick", {"fight"}), Motion(testing::ChainSkeleton(), 30, 2));
-  const absl::StatusOr<std::vector<int64_t>> ids = Db().AddLabels({
+  const absl::StatusOr<std::vector<int64_t>> ids = IdsOf(Db().AddLabels({
       Manual(walk, 20, 29, "step", 0.5),  // ids[0]
       Manual(kick, 0, 9, "step", 0.9),    // ids[1]
       Manual(walk, 0, 9, "step", 0.9),    // ids[2]
       Manual(walk, 5, 49, "walk", 1),     // ids[3]
       Manual(kick, 10, 29, "kick", 1),    // ids[4]
-  });
+  }));
   ASSERT_TRUE(ids.ok()) << ids.status();
   ASSERT_EQ(ids->size(), 5u);
   EXPECT_TRUE(std::is_sorted(ids->begin(), ids->end()));
@@ -1575,14 +1581,14 @@ TEST_F(StorageTest, LabelsAreListedFoundAndTimelinedAndPagedOnce) {
 TEST_F(StorageTest, FindLabelsPagesAcrossTies) {
   const int64_t walk = Insert(Named("walk"), Motion(testing::ChainSkeleton(), 50, 1));
   const int64_t kick = Insert(Named("kick"), Motion(testing::ChainSkeleton(), 30, 2));
-  const absl::StatusOr<std::vector<int64_t>> ids = Db().AddLabels({
+  const absl::StatusOr<std::vector<int64_t>> ids = IdsOf(Db().AddLabels({
       Manual(walk, 20, 29, "step", 0.5),  // ids[0]
       Manual(walk, 10, 19, "step", 0.5),  // ids[1]
       Manual(walk, 10, 12, "step", 0.5),  // ids[2]: ids[1]'s first frame
       Manual(kick, 0, 9, "step", 0.5),    // ids[3]
       Manual(walk, 10, 30, "step", 0.5),  // ids[4]: ids[1]'s first frame again
       Manual(walk, 0, 5, "step", 0.9),    // ids[5]
-  });
+  }));
   ASSERT_TRUE(ids.ok()) << ids.status();
   const std::vector<int64_t> order = {(*ids)[5], (*ids)[1], (*ids)[2],
                                       (*ids)[4], (*ids)[0], (*ids)[3]};
@@ -1685,7 +1691,7 @@ TEST_F(StorageTest, LabelBatchesAreAllOrNothing) {
   };
   for (const auto& c : cases) {
     // A good label first, which must not be stored either.
-    const absl::StatusOr<std::vector<int64_t>> added =
+    const absl::StatusOr<AddedLabels> added =
         Db().AddLabels({Manual(walk, 10, 19, "good", 1), c.bad, Manual(walk, 0, 49, "ok", 1)});
     EXPECT_EQ(added.status().code(), c.code) << c.message;
     EXPECT_THAT(std::string(added.status().message()), HasSubstr(c.message));
@@ -1705,8 +1711,8 @@ StorageSpaceTest::LabelledLibrary StorageSpaceTest::InsertLabelledLibrary() {
   library.space_id =
       *Db().InsertSpace(SpaceNamed("body", skeleton), space_,
                         {ProjectionOf(library.walk, walk_), ProjectionOf(library.wave, wave_)});
-  library.manual = *Db().AddLabels(
-      {Manual(library.walk, 0, 9, "kick", 1), Manual(library.walk, 20, 29, "wave", 0.8)});
+  library.manual = *IdsOf(Db().AddLabels(
+      {Manual(library.walk, 0, 9, "kick", 1), Manual(library.walk, 20, 29, "wave", 0.8)}));
   return library;
 }
 
@@ -1720,7 +1726,7 @@ TEST_F(StorageSpaceTest, LabelDeletesCascadeAndStoppedLabelWritesChangeNothing) 
   found.space_id = space_id;
   found.score = 0.25;
   found.job_id = "job-1";
-  const int64_t propagated = Db().AddLabels({found})->front();
+  const int64_t propagated = Db().AddLabels({found})->labels.front().label_id;
   const absl::StatusOr<LabelPage> listed =
       Db().ListLabels({}, {.origin = LabelOrigin::kPropagated});
   ASSERT_EQ(listed->labels.size(), 1u);

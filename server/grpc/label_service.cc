@@ -11,10 +11,11 @@ grpc::Status LabelServiceImpl::AddLabels(grpc::ServerContext* context,
                                          const v1::AddLabelsRequest* request,
                                          v1::AddLabelsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<std::vector<storage::LabelRecord>> added =
+    const absl::StatusOr<storage::AddedLabels> added =
         server::AddLabels(database_, FromProto(*request), StopWhenCallEnds(context));
     if (!added.ok()) return ToGrpcStatus(ExplainStop(added.status(), context));
-    for (const storage::LabelRecord& label : *added) ToProto(label, response->add_labels());
+    for (const storage::LabelRecord& label : added->labels) ToProto(label, response->add_labels());
+    for (const size_t item : added->skipped) response->add_skipped(static_cast<int32_t>(item));
     return grpc::Status::OK;
   });
 }
