@@ -3,7 +3,7 @@
 //   motiondb-server [--db ./motiondb.sqlite] [--listen 127.0.0.1:50051] [--threads N]
 //       [--max-message-mb 256] [--max-bvh-mb 1024] [--auth-token-file FILE]
 //       [--tls-cert CERT.pem --tls-key KEY.pem] [--http 127.0.0.1:8080|off] [--web-root DIR]
-//       [--quiet]
+//       [--http-allowed-hosts HOSTS] [--http-cors-origins ORIGINS] [--quiet]
 //
 // (`--help` lists them with their defaults; they are parsed with CLI11.)
 // Runs until SIGTERM or SIGINT, then stops accepting calls, lets running ones finish (up to 10 s)
@@ -59,6 +59,16 @@ void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http, ServerFlag
   app.add_option("--web-root", http->web_root, "the built web UI served at /")
       ->type_name("DIR")
       ->default_str(motiondb::server::DefaultWebRoot());
+  app.add_option("--http-allowed-hosts", http->allowed_hosts,
+                 "Host header names HTTP answers to beside IP addresses and localhost, "
+                 "comma-separated, without ports; * for any")
+      ->type_name("HOSTS")
+      ->delimiter(',');
+  app.add_option("--http-cors-origins", http->cors_origins,
+                 "origins whose pages may call the API (CORS), comma-separated, e.g. "
+                 "https://studio.example; none by default")
+      ->type_name("ORIGINS")
+      ->delimiter(',');
   app.add_option("--http-timeout-s", http->call_timeout_s,
                  "an HTTP API call still running after this long ends with 504")
       ->type_name("S")

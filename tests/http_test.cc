@@ -372,11 +372,12 @@ TEST_F(HttpTest, SearchAnswersAsGrpc) {
       {absl::StrCat(R"({"space":"body","bvh":{"bvh":")", absl::Base64Escape(bvh),
                     R"(","firstFrame":10,"lastFrame":70}})"),
        "space: 'body' bvh { first_frame: 10 last_frame: 70 }"}};
-  // A body sent as a form (curl -d without a Content-Type) is read as JSON all the same.
+  // A body sent as a form (curl -d without a Content-Type) is refused: another site's page may
+  // send one (http_request_checks_test.cc).
   const httplib::Result form =
       http.Post("/v1/search", queries[0].first, "application/x-www-form-urlencoded");
   ASSERT_TRUE(form);
-  EXPECT_EQ(form->status, 200) << form->body;
+  EXPECT_EQ(form->status, 415) << form->body;
   for (const auto& [json, text] : queries) {
     v1::SearchRequest request = Parse<v1::SearchRequest>(text);
     if (request.has_bvh()) request.mutable_bvh()->set_bvh(bvh);

@@ -261,7 +261,7 @@ TEST_F(ServerLimitsTest, AFullLineOfRequestsIsRefusedWith503) {
       StartServer({"--http-threads", "1", "--http-max-waiting", "0", "--web-root", web.string()});
   ASSERT_NE(server, nullptr);
   RawConnection reader(server->http_port());
-  ASSERT_TRUE(reader.Send("GET /big.bin HTTP/1.1\r\nHost: x\r\n\r\n"));
+  ASSERT_TRUE(reader.Send("GET /big.bin HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"));
   // Its answer has begun: the worker is writing 64 MB that nobody reads.
   EXPECT_THAT(reader.ReadUntil("\r\n\r\n"), HasSubstr("200 OK"));
   RawConnection second(server->http_port());

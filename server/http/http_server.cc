@@ -23,6 +23,7 @@
 #include "server/http/http_exchange.h"
 #include "server/http/http_status.h"
 #include "server/http/json_transcoding.h"
+#include "server/http/request_checks.h"
 #include "server/http/tls_context.h"
 #include "server/net/listener.h"
 #include "util/status_macros.h"
@@ -133,29 +134,47 @@ int HttpServer::port() const { return state_->listener->port(); }
 namespace {
 
 // The checks of a request's head, before its body is read (the connection loop's hook).
-std::optional<HttpRefusal> CheckHead(MotionDbServer& server, size_t max_body,
-                                     const std::vector<std::regex>& body_routes,
+std::optional<HttpRefusal> CheckHead(MotionDbServer& server, const RequestChecks& checks,
+                                     size_t max_body, const std::vector<std::regex>& body_routes,
                                      const RequestHead& head, const HttpConnection& connection) {
-  TokenScope scope;
-  if (std::optional<HttpRefusal> refusal =
-          CheckAccess(server, head.method, head.path, connection.peer_address(),
-                      head.Values("authorization"), &scope)) {
-    return refusal;
+  const RequestFacts facts = RequestFacts::Of(head);
+  std::optional<HttpRefusal> refusal;
+  // A listed origin's preflight carries no token (httplib answers it).
+  if (!checks.ListedPreflight(facts)) {
+    TokenScope scope;
+    refusal = CheckAccess(server, head.method, head.path, connection.peer_address(),
+                          head.Values("authorization"), &scope);
   }
-  return RefuseBody(head, max_body, body_routes);
+  if (!refusal) refusal = RefuseBody(head, max_body, body_routes);
+  if (!refusal) refusal = checks.Refuse(facts);
+  // So that a listed origin's page can read why.
+  if (refusal) {
+    for (auto& header : checks.CorsHeaders(facts)) refusal->headers.push_back(std::move(header));
+  }
+  return refusal;
 }
 
-// The access check again on httplib's own reading of the path (the loop's came first, on its
-// own), the scope granted for the call, the metrics' bookkeeping and JSON bodies for the
-// library's own errors.
-void AddHooks(MotionDbServer& server, httplib::Server& http) {
-  http.set_pre_routing_handler([&server](const httplib::Request& request,
-                                         httplib::Response& response) {
+// The request and access checks again on httplib's own reading of the request (the loop's came
+// first, on its own), a listed origin's preflight answered and its CORS headers, the scope
+// granted for the call, the metrics' bookkeeping and JSON bodies for the library's own errors.
+void AddHooks(MotionDbServer& server, RequestChecks checks, httplib::Server& http) {
+  http.set_pre_routing_handler([&server, checks = std::move(checks)](
+                                   const httplib::Request& request, httplib::Response& response) {
     // Until a route's handler names itself.
     exchange = {std::chrono::steady_clock::now(), IsApiPath(request.path) ? "unmatched" : "static"};
-    const std::optional<HttpRefusal> refusal =
-        CheckAccess(server, request.method, request.path, request.remote_addr,
-                    AuthorizationHeaders(request), &exchange.scope);
+    const RequestFacts facts = RequestFacts::Of(request);
+    for (const auto& [name, value] : checks.CorsHeaders(facts)) response.set_header(name, value);
+    std::optional<HttpRefusal> refusal;
+    if (!checks.ListedPreflight(facts)) {
+      refusal = CheckAccess(server, request.method, request.path, request.remote_addr,
+                            AuthorizationHeaders(request), &exchange.scope);
+    }
+    if (!refusal) refusal = checks.Refuse(facts);
+    if (!refusal && checks.ListedPreflight(facts)) {
+      exchange.route = "preflight";
+      response.status = 204;
+      return httplib::Server::HandlerResponse::Handled;
+    }
     if (!refusal) return httplib::Server::HandlerResponse::Unhandled;
     exchange.route = "refused";
     response.status = refusal->status;
@@ -288,6 +307,8 @@ void RefuseConnection(int socket, absl::string_view reason) {
 
 absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions& options,
                                                               MotionDbServer& server) {
+  MOTIONDB_ASSIGN_OR_RETURN(RequestChecks checks,
+                            RequestChecks::Create(options.allowed_hosts, options.cors_origins));
   auto state = std::make_unique<State>(server);
   MOTIONDB_ASSIGN_OR_RETURN(
       state->api, ApiTranscoder::Create(server.InProcessChannel(), options.call_timeout_s));
@@ -300,7 +321,7 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
   const size_t max_body =
       (static_cast<size_t>(server.options().max_message_mb) << 20) / 3 * 4 + (size_t{1} << 20);
   router.set_payload_max_length(max_body);
-  AddHooks(server, router);
+  AddHooks(server, checks, router);
   AddApiRoutes(*state->api, router);
   AddOperationsRoutes(*state->api, server, router);
   const std::string web_root = options.web_root.empty() ? DefaultWebRoot() : options.web_root;
@@ -314,9 +335,10 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
                                      .limits = options.connections,
                                      .log = [](absl::string_view line) { LogLine(line); }}));
   ConnectionLoop::Hooks hooks;
-  hooks.check_head = [&server, max_body, body_routes = BodyRoutePaths()](
-                         const RequestHead& head, const HttpConnection& connection) {
-    return CheckHead(server, max_body, body_routes, head, connection);
+  hooks.check_head = [&server, checks = std::move(checks), max_body,
+                      body_routes = BodyRoutePaths()](const RequestHead& head,
+                                                      const HttpConnection& connection) {
+    return CheckHead(server, checks, max_body, body_routes, head, connection);
   };
   const std::chrono::milliseconds stall = options.loop.write_stall_timeout;
   hooks.answer = [&router, stall](HttpConnection& connection, absl::string_view request,

@@ -3,7 +3,8 @@
 // (Prometheus), /healthz and /readyz, and the web UI's built files at /. HTTPS with the gRPC
 // port's certificate and key when TLS is on; the API and the metrics need the gRPC token
 // (Authorization: Bearer), the health routes as the gRPC health service does, the web UI's
-// files never (they hold no data). The port and its connections are motiondb's
+// files never (they hold no data); requests from other web sites' pages are kept out
+// (server/http/request_checks.h). The port and its connections are motiondb's
 // (server/net/listener.h, server/http/connection_loop.h); cpp-httplib parses and routes each
 // request once it has arrived whole (server/http/http_exchange.h).
 //
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "server/grpc/motiondb_server.h"
@@ -27,6 +29,12 @@ struct HttpOptions {
   std::string listen = "127.0.0.1:8080";
   // The built web UI served at / (--web-root); empty: DefaultWebRoot().
   std::string web_root;
+  // Host header names the face answers to beside IP addresses and localhost
+  // (--http-allowed-hosts), or "*" for any (server/http/request_checks.h).
+  std::vector<std::string> allowed_hosts;
+  // Origins whose pages may call the API from their own (CORS, --http-cors-origins); none by
+  // default, and then no Access-Control-* header is sent.
+  std::vector<std::string> cors_origins;
   // An API call still running after this many seconds ends with 504 (DEADLINE_EXCEEDED), its
   // work stopped as a gRPC call's deadline stops it; HTTP clients send no deadline of their own
   // (--http-timeout-s).

@@ -38,7 +38,7 @@ grpc::StatusCode CodeOfHttpStatus(int status) {
   if (status == 404) return grpc::StatusCode::NOT_FOUND;
   if (status == 413 || status == 429 || status == 431) return grpc::StatusCode::RESOURCE_EXHAUSTED;
   if (status == 401) return grpc::StatusCode::UNAUTHENTICATED;
-  if (status == 403) return grpc::StatusCode::PERMISSION_DENIED;
+  if (status == 403 || status == 421) return grpc::StatusCode::PERMISSION_DENIED;
   if (status == 408) return grpc::StatusCode::DEADLINE_EXCEEDED;
   if (status == 503) return grpc::StatusCode::UNAVAILABLE;
   if (status >= 400 && status < 500) return grpc::StatusCode::INVALID_ARGUMENT;

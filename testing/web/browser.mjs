@@ -23,11 +23,12 @@ const ARGS = [
 ];
 
 export class Browser {
-  static async launch(viewport = { width: 1400, height: 860 }) {
+  /** `args`: Chromium's command-line switches beyond ARGS. */
+  static async launch(viewport = { width: 1400, height: 860 }, args = []) {
     const profile = mkdtempSync(join(tmpdir(), "motiondb_chromium_"));
     const context = await chromium.launchPersistentContext(profile, {
       executablePath: CHROMIUM,
-      args: ARGS,
+      args: [...ARGS, ...args],
       headless: true,
       viewport,
     });

@@ -4,12 +4,13 @@
 // Screenshots go to $MOTIONDB_WEB_TEST_OUT.
 import assert from "node:assert/strict";
 import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { createServer } from "node:http";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { after, before, test } from "node:test";
 import { Browser } from "../../testing/web/browser.mjs";
 import { ASSIMP_BVH, cli, cliOffline, loadDemoLibrary } from "../../testing/web/library.mjs";
-import { ServerProcess } from "../../testing/web/server.mjs";
+import { ServerProcess, freePort } from "../../testing/web/server.mjs";
 
 const SERVER = process.env.MOTIONDB_SERVER_BIN;
 const CLI = process.env.MOTIONDB_CLI_BIN;
@@ -333,6 +334,150 @@ test("a read-only token sees labelling turned off, and the server refuses it too
   } finally {
     await own.close();
     await guarded.stop();
+  }
+});
+
+/**
+ * Another web site's page, served from a port of its own: it calls `target` (an HTTP face) as a
+ * page may without asking: a fetch of JSON sent as text/plain (no preflight; its answer opaque),
+ * a form posted as text/plain (its body a label's JSON, the '=' a form adds inside its
+ * descriptor: csrf=form), then a fetch of application/json, which needs the server's leave (a
+ * CORS preflight). Resolves to the page's origin and a function that stops serving it.
+ */
+async function serveOtherSite() {
+  const html = `<!doctype html><meta charset="utf-8"><title>another site</title>
+<iframe name="sink"></iframe><pre id="outcome"></pre>
+<script type="module">
+  const params = new URLSearchParams(location.search);
+  const target = params.get("target");
+  const label = (descriptor) =>
+    JSON.stringify({ labels: [{ clip_id: params.get("clip"), last_frame: 5, descriptor_name: descriptor }] });
+  const outcome = {};
+  await fetch(target + "/v1/labels", {
+    method: "POST", mode: "no-cors", headers: { "Content-Type": "text/plain" }, body: label("csrf-text"),
+  });
+  await fetch(target + "/v1/jobs", {
+    method: "POST", mode: "no-cors", body: JSON.stringify({ space: "demo", descriptor_names: ["kick"] }),
+  });
+  const form = document.createElement("form");
+  Object.assign(form, { method: "POST", enctype: "text/plain", target: "sink", action: target + "/v1/labels" });
+  const field = document.createElement("input");
+  const body = label("csrfform");
+  const cut = body.indexOf("csrfform") + 4;
+  Object.assign(field, { name: body.slice(0, cut), value: body.slice(cut) });
+  form.append(field);
+  document.body.append(form);
+  await new Promise((resolve) => {
+    document.querySelector("iframe").addEventListener("load", resolve, { once: true });
+    form.submit();
+  });
+  try {
+    const answer = await fetch(target + "/v1/labels", {
+      method: "POST", headers: { "Content-Type": "application/json" }, body: label("csrf-json"),
+    });
+    outcome.json = answer.status;
+  } catch {
+    outcome.json = "blocked";
+  }
+  document.querySelector("#outcome").textContent = JSON.stringify(outcome);
+  document.body.dataset.done = "true";
+</script>`;
+  const site = createServer((request, response) => {
+    response.writeHead(200, { "Content-Type": "text/html; charset=utf-8" });
+    response.end(html);
+  });
+  const port = await freePort();
+  await new Promise((resolve) => site.listen(port, "127.0.0.1", resolve));
+  return {
+    origin: `http://127.0.0.1:${port}`,
+    close: () => new Promise((resolve) => site.close(resolve)),
+  };
+}
+
+/** The labels of `descriptor` and the jobs `server` holds, through its HTTP face. */
+async function holdings(server, descriptor) {
+  const get = async (path) => (await fetch(server.baseUrl + path)).json();
+  const labels = await get(`/v1/labels?descriptor_name=${encodeURIComponent(descriptor)}`);
+  return { labels: labels.labels.length, jobs: (await get("/v1/jobs")).jobs.length };
+}
+
+/** Opens the other site's page in a browser of its own (its refused calls log errors). */
+async function visitOtherSite(site, target, clipId) {
+  const own = await Browser.launch();
+  try {
+    const page = await own.page();
+    const query = new URLSearchParams({ target: target.baseUrl, clip: String(clipId) });
+    await page.goto(`${site.origin}/?${query}`);
+    await page.waitForSelector("body[data-done=true]", WAIT);
+    return JSON.parse(await page.textContent("#outcome"));
+  } finally {
+    await own.close();
+  }
+}
+
+test("a page of another site can neither add a label nor start a job", async () => {
+  const site = await serveOtherSite();
+  try {
+    const before = await Promise.all(
+      ["csrf-text", "csrf=form", "csrf-json"].map((d) => holdings(server, d)),
+    );
+    const outcome = await visitOtherSite(site, server, clips["01_03"].clip_id);
+    // The JSON fetch needed a preflight, which the server refused: it was never sent.
+    assert.equal(outcome.json, "blocked");
+    const after = await Promise.all(
+      ["csrf-text", "csrf=form", "csrf-json"].map((d) => holdings(server, d)),
+    );
+    assert.deepEqual(after, before);
+    assert.deepEqual(
+      after.map((h) => h.labels),
+      [0, 0, 0],
+    );
+
+    // Listed in --http-cors-origins, its JSON calls are let through, and only those.
+    const open = await ServerProcess.start(SERVER, ["--http-cors-origins", site.origin]);
+    try {
+      const upload = await fetch(`${open.baseUrl}/v1/clips`, {
+        method: "POST",
+        headers: { "Content-Type": "application/json" },
+        body: JSON.stringify({
+          file_name: "01_03.bvh",
+          bvh: readFileSync(join(ASSIMP_BVH, "01_03.bvh")).toString("base64"),
+        }),
+      });
+      const uploaded = await upload.text();
+      assert.equal(upload.status, 200, uploaded);
+      const clipId = JSON.parse(uploaded).clip.clip_id;
+      assert.deepEqual(await visitOtherSite(site, open, clipId), { json: 200 });
+      assert.deepEqual(
+        await Promise.all(["csrf-text", "csrf=form", "csrf-json"].map((d) => holdings(open, d))),
+        [
+          { labels: 0, jobs: 0 },
+          { labels: 0, jobs: 0 },
+          { labels: 1, jobs: 0 },
+        ],
+      );
+    } finally {
+      await open.stop();
+    }
+  } finally {
+    await site.close();
+  }
+});
+
+test("a name rebound to the server's address (DNS rebinding) is refused", async () => {
+  const port = new URL(server.baseUrl).port;
+  const own = await Browser.launch(undefined, ["--host-resolver-rules=MAP rebound.test 127.0.0.1"]);
+  try {
+    const page = await own.page();
+    const refused = await page.goto(`http://rebound.test:${port}/v1/clips`);
+    assert.equal(refused.status(), 421);
+    assert.match(await refused.text(), /does not name this server/);
+    // By the name localhost the page is the server's own.
+    await page.goto(`http://localhost:${port}/`);
+    await page.waitForSelector("body[data-ready=true]", WAIT);
+    await expectListed(page, ["01_01", "01_03", "Boxing_Toes"]);
+  } finally {
+    await own.close();
   }
 });
 
