@@ -337,6 +337,14 @@ test("a read-only token sees labelling turned off, and the server refuses it too
   }
 });
 
+test("a deep link to an unknown space says so and names the spaces", async () => {
+  const id = clips["01_01"].clip_id;
+  const page = await openPage(`/?space=nope&clip=${id}&from=40&to=124`);
+  await page.waitForSelector("#status.error", WAIT);
+  assert.equal(await page.textContent("#status"), "no space is named 'nope'; the spaces are: demo");
+  await page.close();
+});
+
 /**
  * Another web site's page, served from a port of its own: it calls `target` (an HTTP face) as a
  * page may without asking: a fetch of JSON sent as text/plain (no preflight; its answer opaque),

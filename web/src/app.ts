@@ -67,7 +67,11 @@ export class App {
   }
 
   private async follow(link: DeepLink): Promise<void> {
-    if (link.space) this.spaceSelect.value = link.space;
+    if (link.space) {
+      if (!this.spaces.some((s) => s.name === link.space))
+        throw new Error(this.noSpace(link.space));
+      this.spaceSelect.value = link.space;
+    }
     if (!link.clipId) return;
     const clip = await api.clip(link.clipId);
     await this.open(clip, !link.space);
@@ -93,6 +97,16 @@ export class App {
       return stage;
     });
     return this.stageLoad;
+  }
+
+  /** Why there is no space `name` to search in: it is unknown, or there is none at all. */
+  private noSpace(name: string): string {
+    if (!this.spaces.length)
+      return "no space to search in: create one with `motiondb space create`";
+    const known = this.spaces.map((s) => s.name).join(", ");
+    return name
+      ? `no space is named '${name}'; the spaces are: ${known}`
+      : `choose a space to search in: ${known}`;
   }
 
   private get space(): Space | null {
@@ -157,7 +171,7 @@ export class App {
 
   private async runSearch(query: Query): Promise<void> {
     const space = this.space;
-    if (!space) throw new Error("no space to search in: create one with `motiondb space create`");
+    if (!space) throw new Error(this.noSpace(this.spaceSelect.value));
     this.query = query;
     this.search.setQuery(describe(query));
     this.search.busy(`Searching ${describe(query)} in ${space.name}…`);
