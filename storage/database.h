@@ -100,6 +100,12 @@ struct StoredClip {
   Clip clip;  // offsets and channels are the clip's own
 };
 
+// A clip without its frames: what answers about it are sized by before they are read.
+struct ClipLayout {
+  ClipRecord record;
+  std::shared_ptr<const Skeleton> skeleton;  // the clip's own offsets and channels
+};
+
 // A clip's projection into a space: frames at the space rate x the space's dimensions,
 // pre-scaled by the space's metric (core/search_coordinates.h).
 struct Projection {
@@ -187,6 +193,18 @@ class Database {
   absl::StatusOr<StoredClip> GetClip(int64_t clip_id,
                                      std::optional<FrameRange> frames = std::nullopt);
   absl::StatusOr<ClipRecord> GetClipRecord(int64_t clip_id);
+  // The record (tags included) and skeleton, without the frames. NOT_FOUND for an unknown clip.
+  absl::StatusOr<ClipLayout> GetClipLayout(int64_t clip_id);
+  // The clip's frames `frames` handed to `consume` in batches of at most `batch_frames`, in
+  // order, each a clip of those frames sharing one skeleton (the clip's own), read from the
+  // stored blobs piece by piece in one read snapshot: memory holds a batch whatever the clip's
+  // length (GetClip of a range reads the whole blobs), and the clip stays as it was until the
+  // last batch. The snapshot is held while `consume` runs, so a slow consumer keeps the
+  // write-ahead log from being checkpointed past it. consume's first error ends the read and is
+  // returned. NOT_FOUND for an unknown clip; OUT_OF_RANGE when `frames` is empty or not inside
+  // it; INVALID_ARGUMENT for a batch_frames below 1.
+  absl::Status ReadClipFrames(int64_t clip_id, FrameRange frames, int batch_frames,
+                              const std::function<absl::Status(const Clip& batch)>& consume);
   absl::StatusOr<ClipRecord> GetClipRecordByName(const std::string& name);  // NOT_FOUND
   // Up to `limit` clips whose content hash is `content_hash`, in id order.
   absl::StatusOr<std::vector<ClipRecord>> FindClipsByContentHash(const std::string& content_hash,

@@ -26,29 +26,43 @@ ClipRecord ReadClipRecord(const SqliteStatement& row) {
   return record;
 }
 
-absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record,
-                              int64_t frames) {
-  const int64_t joints = record.joint_count;
-  // kClipFrameColumns (or kClipFrameRangeColumns) follow the record's.
+absl::StatusOr<std::shared_ptr<const Skeleton>> ReadClipLayout(const SqliteStatement& row,
+                                                               const ClipRecord& record) {
+  // kClipLayoutColumns follow the record's.
   constexpr int kFirst = kClipRecordColumnCount;
   const int64_t position_joints = row.ColumnInt64(kFirst);
   absl::StatusOr<std::shared_ptr<const Skeleton>> skeleton =
       ParseSkeletonLayout(row.ColumnBlob(kFirst + 1));
   // Bytes this code wrote that no longer parse are damage, whatever the parser calls it.
   if (!skeleton.ok()) return absl::DataLossError(skeleton.status().message());
-  if ((*skeleton)->joint_count() != joints ||
+  if ((*skeleton)->joint_count() != record.joint_count ||
       (*skeleton)->position_joint_count() != position_joints) {
     return absl::DataLossError("its layout does not match its row");
   }
+  return skeleton;
+}
+
+absl::StatusOr<Clip> DecodeClipFrames(std::shared_ptr<const Skeleton> skeleton, double frame_time,
+                                      absl::string_view rotations_blob,
+                                      absl::string_view positions_blob, int64_t frames) {
   MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXd rotations,
-                            ParseRotationBlob(row.ColumnBlob(kFirst + 2), frames, joints));
+                            ParseRotationBlob(rotations_blob, frames, skeleton->joint_count()));
   MOTIONDB_ASSIGN_OR_RETURN(
       const RowMatrixXf positions,
-      ParseFloat32Blob(row.ColumnBlob(kFirst + 3), frames, 3 * position_joints, "positions"));
-  absl::StatusOr<Clip> clip = Clip::Create(*std::move(skeleton), record.frame_time,
-                                           std::move(rotations), positions.cast<double>());
+      ParseFloat32Blob(positions_blob, frames, 3 * skeleton->position_joint_count(), "positions"));
+  absl::StatusOr<Clip> clip =
+      Clip::Create(std::move(skeleton), frame_time, std::move(rotations), positions.cast<double>());
   if (!clip.ok()) return absl::DataLossError(clip.status().message());
   return clip;
+}
+
+absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record,
+                              int64_t frames) {
+  MOTIONDB_ASSIGN_OR_RETURN(std::shared_ptr<const Skeleton> skeleton, ReadClipLayout(row, record));
+  // The blobs follow kClipLayoutColumns.
+  constexpr int kBlobs = kClipRecordColumnCount + 2;
+  return DecodeClipFrames(std::move(skeleton), record.frame_time, row.ColumnBlob(kBlobs),
+                          row.ColumnBlob(kBlobs + 1), frames);
 }
 
 SpaceRecord ReadSpaceRecord(const SqliteStatement& row) {

@@ -5,8 +5,11 @@
 
 namespace motiondb {
 
-// The most characters WriteDecimal12 writes ("-1.23456789012e-100" is 19).
+// Room for what WriteDecimal12 writes, with a margin.
 inline constexpr int kMaxDecimal12Chars = 24;
+// The longest text WriteDecimal12 writes: a sign, 12 digits, the point and a three-digit exponent
+// ("-1.23456789012e-100"); what bounds on the size of such text count.
+inline constexpr int kLongestDecimal12Text = 19;
 
 // Writes at `out` exactly the text of std::to_chars(value, std::chars_format::general, 12):
 // "-32.9847707373", "0.000125", "1e+15", "nan"; returns the end of it. Values from 1e-4 to

@@ -18,6 +18,8 @@ namespace motiondb {
 namespace {
 
 constexpr double kRadiansToDegrees = 180.0 / std::numbers::pi;
+// Room for the frame time's text: std::to_chars' shortest form of a double is at most 24.
+constexpr int kFrameTimeRoom = 32;
 
 // Numbers have 12 significant digits (WriteDecimal12): far below the 1e-6 round-trip tolerance,
 // and short rows.
@@ -89,14 +91,14 @@ constexpr int kBlockFrames = 4096;
 // A thread is started for at least this many frames (about 0.5 ms of work at 31 joints).
 constexpr int kFramesPerThread = 128;
 
-// The MOTION rows. The Euler decomposition (three atan2 a joint) and the numbers' text, most of
-// an export's time, run on several threads; only the choice of each joint's triple nearest the
-// previous frame's, which keeps the angles continuous, runs in frame order.
+// The MOTION rows, of one clip's frames handed over in one or several batches. The Euler
+// decomposition (three atan2 a joint) and the numbers' text, most of an export's time, run on
+// several threads; only the choice of each joint's triple nearest the previous frame's, which
+// keeps the angles continuous, runs in frame order, across batches too.
 class MotionWriter {
  public:
-  MotionWriter(const Clip& clip, std::vector<int> order, int threads)
-      : clip_(clip),
-        skeleton_(clip.skeleton()),
+  MotionWriter(const Skeleton& skeleton, std::vector<int> order, int threads)
+      : skeleton_(skeleton),
         order_(std::move(order)),
         threads_(threads),
         previous_(skeleton_.joint_count(), Eigen::Vector3d::Zero()) {
@@ -105,18 +107,20 @@ class MotionWriter {
     }
   }
 
-  // False when `should_stop` said stop before a block (a block takes about 10 ms at 21 joints,
-  // 30 at 101 on two threads).
-  bool Append(FrameRange frames, std::string& out, const std::function<bool()>& should_stop) {
+  // `frames` of `clip`, a clip of the writer's skeleton (its offsets and channels), after the
+  // frames appended before. False when `should_stop` said stop before a block (a block takes
+  // about 10 ms at 21 joints, 30 at 101 on two threads).
+  bool Append(const Clip& clip, FrameRange frames, std::string& out,
+              const std::function<bool()>& should_stop) {
     for (int first = frames.first; first <= frames.last; first += kBlockFrames) {
       if (should_stop && should_stop()) return false;
-      AppendBlock({first, std::min(frames.last, first + kBlockFrames - 1)}, out);
+      AppendBlock(clip, {first, std::min(frames.last, first + kBlockFrames - 1)}, out);
     }
     return true;
   }
 
  private:
-  void AppendBlock(FrameRange block, std::string& out) {
+  void AppendBlock(const Clip& clip, FrameRange block, std::string& out) {
     first_ = block.first;
     const int pieces = PieceCount(block.size(), kFramesPerThread, threads_);
     const auto frames = [&](int64_t begin, int64_t end) {
@@ -125,14 +129,14 @@ class MotionWriter {
     };
     angles_.resize(static_cast<size_t>(block.size()) * skeleton_.joint_count());
     ForEachPiece(block.size(), pieces,
-                 [&](int, int64_t begin, int64_t end) { Decompose(frames(begin, end)); });
+                 [&](int, int64_t begin, int64_t end) { Decompose(clip, frames(begin, end)); });
     MakeContinuous(block);
     // The first piece goes straight into `out` (reserved for the whole answer), the others into
     // texts of their own appended after.
     std::vector<std::string> texts(pieces);
     ForEachPiece(block.size(), pieces, [&](int piece, int64_t begin, int64_t end) {
       if (piece > 0) texts[piece].reserve(RowsRoom(end - begin, skeleton_.channel_count()));
-      WriteRows(frames(begin, end), piece == 0 ? out : texts[piece]);
+      WriteRows(clip, frames(begin, end), piece == 0 ? out : texts[piece]);
     });
     for (int piece = 1; piece < pieces; ++piece) out += texts[piece];
   }
@@ -144,10 +148,10 @@ class MotionWriter {
   Eigen::Vector3d& Angles(int frame, int joint) { return angles_[Slot(frame, joint)]; }
   const Eigen::Vector3d& Angles(int frame, int joint) const { return angles_[Slot(frame, joint)]; }
 
-  void Decompose(FrameRange frames) {
+  void Decompose(const Clip& clip, FrameRange frames) {
     for (int f = frames.first; f <= frames.last; ++f) {
       for (int j : rotating_) {
-        Angles(f, j) = EulerAngles(clip_.rotation(f, j), skeleton_.rotation_order(j));
+        Angles(f, j) = EulerAngles(clip.rotation(f, j), skeleton_.rotation_order(j));
       }
     }
   }
@@ -162,7 +166,7 @@ class MotionWriter {
   }
 
   // A row is written in place: room for its longest text first, cut to what it took after.
-  void WriteRows(FrameRange frames, std::string& out) const {
+  void WriteRows(const Clip& clip, FrameRange frames, std::string& out) const {
     const size_t row_room = RowRoom(skeleton_.channel_count());
     for (int f = frames.first; f <= frames.last; ++f) {
       const size_t row_start = out.size();
@@ -179,7 +183,7 @@ class MotionWriter {
           const int axis = static_cast<int>(c) % 3;
           const double value = c >= Channel::kXrotation
                                    ? angles[rotation_index++]
-                                   : clip_.positions()(f, 3 * skeleton_.position_slot(j) + axis);
+                                   : clip.positions()(f, 3 * skeleton_.position_slot(j) + axis);
           if (p != row) *p++ = ' ';
           p = WriteDecimal12(p, value);
         }
@@ -189,7 +193,6 @@ class MotionWriter {
     }
   }
 
-  const Clip& clip_;
   const Skeleton& skeleton_;
   const std::vector<int> order_;  // the joints in the order of a row's channels
   const int threads_;
@@ -201,24 +204,78 @@ class MotionWriter {
   std::vector<Eigen::Vector3d> previous_;
 };
 
+// "MOTION", the frame count and the frame time, after the hierarchy.
+void AppendMotionHeader(int64_t frames, double frame_time, std::string& out) {
+  absl::StrAppend(&out, "MOTION\nFrames: ", frames, "\nFrame Time: ");
+  char buffer[kFrameTimeRoom];
+  out.append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), frame_time).ptr);
+  out += '\n';
+}
+
 }  // namespace
+
+struct BvhStreamWriter::State {
+  State(std::shared_ptr<const Skeleton> shared, int threads)
+      : skeleton(std::move(shared)),
+        rows(*skeleton, HierarchyWriter(*skeleton, hierarchy).Write(), threads) {}
+
+  std::shared_ptr<const Skeleton> skeleton;
+  std::string hierarchy;  // written as the rows' joint order is found
+  MotionWriter rows;
+};
+
+BvhStreamWriter::BvhStreamWriter(std::shared_ptr<const Skeleton> skeleton, int threads)
+    : state_(std::make_unique<State>(std::move(skeleton), threads)) {}
+
+BvhStreamWriter::~BvhStreamWriter() = default;
+
+std::string BvhStreamWriter::Header(int64_t frames, double frame_time) const {
+  std::string header = state_->hierarchy;
+  AppendMotionHeader(frames, frame_time, header);
+  return header;
+}
+
+absl::Status BvhStreamWriter::AppendRows(const Clip& batch, std::optional<FrameRange> frames,
+                                         std::string& out,
+                                         const std::function<bool()>& should_stop) {
+  const Skeleton& skeleton = *state_->skeleton;
+  if (batch.skeleton().joint_count() != skeleton.joint_count() ||
+      batch.skeleton().channel_count() != skeleton.channel_count()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the frames' skeleton (", batch.skeleton().joint_count(), " joints, ",
+                     batch.skeleton().channel_count(), " channels) is not the writer's (",
+                     skeleton.joint_count(), " joints, ", skeleton.channel_count(), " channels)"));
+  }
+  const FrameRange range = frames.value_or(FrameRange{0, batch.frame_count() - 1});
+  MOTIONDB_RETURN_IF_ERROR(CheckFrameRange(range, batch.frame_count()));
+  if (!state_->rows.Append(batch, range, out, should_stop)) {
+    return absl::CancelledError("writing the BVH was stopped by its caller");
+  }
+  return absl::OkStatus();
+}
+
+int64_t BvhRowBound(const Skeleton& skeleton) {
+  // Each value at its longest, a space between values, the line end.
+  const int64_t channels = skeleton.channel_count();
+  return channels * kLongestDecimal12Text + std::max<int64_t>(channels, 1);
+}
+
+int64_t BvhTextBound(const Skeleton& skeleton, int64_t frames) {
+  std::string hierarchy;
+  HierarchyWriter(skeleton, hierarchy).Write();
+  const int64_t motion_header =
+      absl::StrCat("MOTION\nFrames: ", frames, "\nFrame Time: \n").size() + kFrameTimeRoom;
+  return static_cast<int64_t>(hierarchy.size()) + motion_header + frames * BvhRowBound(skeleton);
+}
 
 absl::StatusOr<std::string> WriteBvh(const Clip& clip, std::optional<FrameRange> range, int threads,
                                      const std::function<bool()>& should_stop) {
   const FrameRange frames = range.value_or(FrameRange{0, clip.frame_count() - 1});
   MOTIONDB_RETURN_IF_ERROR(CheckFrameRange(frames, clip.frame_count()));
-  const Skeleton& skeleton = clip.skeleton();
-
-  std::string out;
-  out.reserve(4096 + RowsRoom(frames.size(), skeleton.channel_count()));  // 4 KB: the hierarchy
-  std::vector<int> order = HierarchyWriter(skeleton, out).Write();
-  absl::StrAppend(&out, "MOTION\nFrames: ", frames.size(), "\nFrame Time: ");
-  char buffer[32];
-  out.append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), clip.frame_time()).ptr);
-  out += '\n';
-  if (!MotionWriter(clip, std::move(order), threads).Append(frames, out, should_stop)) {
-    return absl::CancelledError("writing the BVH was stopped by its caller");
-  }
+  BvhStreamWriter writer(clip.shared_skeleton(), threads);
+  std::string out = writer.Header(frames.size(), clip.frame_time());
+  out.reserve(out.size() + RowsRoom(frames.size(), clip.skeleton().channel_count()));
+  MOTIONDB_RETURN_IF_ERROR(writer.AppendRows(clip, frames, out, should_stop));
   return out;
 }
 

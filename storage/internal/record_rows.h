@@ -8,6 +8,7 @@
 #define MOTIONDB_STORAGE_INTERNAL_RECORD_ROWS_H_
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,11 +29,15 @@ inline constexpr absl::string_view kClipRecordColumns =
     "c.clip_id, c.name, c.source_file, c.skeleton_id, c.created_unix_ms, c.frame_time, "
     "c.frame_count, c.joint_count, c.content_hash, c.provenance";
 inline constexpr int kClipRecordColumnCount = 10;
-// The columns ReadClip reads besides, listed after kClipRecordColumns.
+// The columns ReadClipLayout reads, listed after kClipRecordColumns.
+inline constexpr absl::string_view kClipLayoutColumns = "c.position_joint_count, c.layout";
+// The columns ReadClip reads besides, listed after kClipRecordColumns: kClipLayoutColumns, then
+// the frames' blobs.
 inline constexpr absl::string_view kClipFrameColumns =
     "c.position_joint_count, c.layout, c.rotations, c.positions";
 // kClipFrameColumns of `?3` frames from frame `?2` only: those frames' bytes of the blobs (16 a
-// joint a frame, 12 a position joint a frame).
+// joint a frame, 12 a position joint a frame). substr() reads the whole blob, however short the
+// range: a long clip read in many ranges is read by ReadClipFrames instead.
 inline constexpr absl::string_view kClipFrameRangeColumns =
     "c.position_joint_count, c.layout, "
     "substr(c.rotations, 1 + ?2 * 16 * c.joint_count, ?3 * 16 * c.joint_count), "
@@ -47,6 +52,15 @@ ClipRecord ReadClipRecord(const SqliteStatement& row);
 // or kClipFrameRangeColumns (the range's), whose record is `record`. DATA_LOSS when the stored
 // bytes no longer decode into the clip the row describes.
 absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record, int64_t frames);
+// The skeleton of a row of kClipRecordColumns then kClipLayoutColumns (or kClipFrameColumns),
+// whose record is `record`; DATA_LOSS as ReadClip.
+absl::StatusOr<std::shared_ptr<const Skeleton>> ReadClipLayout(const SqliteStatement& row,
+                                                               const ClipRecord& record);
+// `frames` frames of a clip of `skeleton` from the bytes of its blobs (ParseRotationBlob's
+// quaternions, float32 positions); DATA_LOSS as ReadClip.
+absl::StatusOr<Clip> DecodeClipFrames(std::shared_ptr<const Skeleton> skeleton, double frame_time,
+                                      absl::string_view rotations_blob,
+                                      absl::string_view positions_blob, int64_t frames);
 // The record of a row of kSpaceRecordColumns.
 SpaceRecord ReadSpaceRecord(const SqliteStatement& row);
 

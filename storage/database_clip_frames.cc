@@ -1,0 +1,106 @@
+// A clip's layout without its frames, and its frames read in batches through blob handles
+// (storage/sqlite_blob.h): what an answer about a long clip is sized by, and what a streamed
+// export reads without holding the clip.
+#include <algorithm>
+#include <optional>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "storage/database.h"
+#include "storage/internal/database_impl.h"
+#include "storage/internal/record_rows.h"
+#include "storage/sqlite_blob.h"
+#include "util/status_macros.h"
+#include "util/status_prefix.h"
+
+namespace motiondb::storage {
+namespace {
+
+// Bytes a frame takes in each blob: a float32 quaternion a joint, a float32 vector a position
+// joint (storage/blob_codec.h).
+constexpr int64_t kRotationBytes = 16;
+constexpr int64_t kPositionBytes = 12;
+
+absl::StatusOr<ClipLayout> ReadLayout(SqliteConnection& db, int64_t clip_id) {
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement query,
+      db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ", kClipLayoutColumns,
+                              " FROM clips c WHERE c.clip_id = ?")));
+  query.BindInt64(1, clip_id);
+  MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.Step());
+  if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
+  ClipLayout layout;
+  layout.record = ReadClipRecord(query);
+  MOTIONDB_ASSIGN_OR_RETURN(layout.skeleton, Prefixed(absl::StrCat("stored clip ", clip_id),
+                                                      ReadClipLayout(query, layout.record)));
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
+  MOTIONDB_ASSIGN_OR_RETURN(layout.record.tags, LoadTags(tags, clip_id));
+  return layout;
+}
+
+// One of the clip's frame blobs, `bytes_per_frame` a frame; DATA_LOSS when its size is not that
+// of the clip's frames.
+absl::StatusOr<SqliteBlob> OpenFrameBlob(SqliteConnection& db, const ClipRecord& record,
+                                         const char* column, int64_t bytes_per_frame) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob blob, SqliteBlob::Open(db, "clips", column, record.clip_id,
+                                                              SqliteBlob::Mode::kRead));
+  if (blob.size() != record.frame_count * bytes_per_frame) {
+    return absl::DataLossError(absl::StrCat("stored clip ", record.clip_id, ": its ", column,
+                                            " hold ", blob.size(), " bytes, not ",
+                                            record.frame_count * bytes_per_frame));
+  }
+  return blob;
+}
+
+}  // namespace
+
+absl::StatusOr<ClipLayout> Database::GetClipLayout(int64_t clip_id) {
+  std::optional<ClipLayout> layout;
+  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(layout, ReadLayout(db, clip_id));
+    return absl::OkStatus();
+  }));
+  return *std::move(layout);
+}
+
+absl::Status Database::ReadClipFrames(int64_t clip_id, FrameRange frames, int batch_frames,
+                                      const std::function<absl::Status(const Clip&)>& consume) {
+  if (batch_frames < 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("batch_frames = ", batch_frames, "; expected at least 1"));
+  }
+  return impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const ClipLayout layout, ReadLayout(db, clip_id));
+    const ClipRecord& record = layout.record;
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("stored clip ", clip_id),
+                                      CheckFrameRange(frames, record.frame_count)));
+    const int64_t rotation_bytes = kRotationBytes * record.joint_count;
+    const int64_t position_bytes = kPositionBytes * layout.skeleton->position_joint_count();
+    MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob rotations,
+                              OpenFrameBlob(db, record, "rotations", rotation_bytes));
+    // A skeleton without translation channels stores no positions (and an empty blob, which
+    // need not open).
+    std::optional<SqliteBlob> positions;
+    if (position_bytes > 0) {
+      MOTIONDB_ASSIGN_OR_RETURN(positions, OpenFrameBlob(db, record, "positions", position_bytes));
+    }
+    std::string rotation_piece, position_piece;
+    for (int64_t first = frames.first; first <= frames.last; first += batch_frames) {
+      const int64_t count = std::min<int64_t>(batch_frames, frames.last - first + 1);
+      MOTIONDB_RETURN_IF_ERROR(
+          rotations.Read(first * rotation_bytes, count * rotation_bytes, rotation_piece));
+      if (positions) {
+        MOTIONDB_RETURN_IF_ERROR(
+            positions->Read(first * position_bytes, count * position_bytes, position_piece));
+      }
+      MOTIONDB_ASSIGN_OR_RETURN(const Clip batch,
+                                Prefixed(absl::StrCat("stored clip ", clip_id, " at frame ", first),
+                                         DecodeClipFrames(layout.skeleton, record.frame_time,
+                                                          rotation_piece, position_piece, count)));
+      MOTIONDB_RETURN_IF_ERROR(consume(batch));
+    }
+    return absl::OkStatus();
+  });
+}
+
+}  // namespace motiondb::storage
