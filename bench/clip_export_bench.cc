@@ -132,7 +132,8 @@ void BM_ExportClip(benchmark::State& state) {
   Fixture& fixture = TheFixture();
   const server::ClipSelection range{fixture.clip_id, 0, kRangeFrames - 1};
   for (auto _ : state) {
-    absl::StatusOr<server::ExportedBvh> exported = server::ExportClip(*fixture.database, range);
+    absl::StatusOr<server::ExportedBvh> exported =
+        server::ExportClip(*fixture.database, range, server::AnswerLimit(), [] { return false; });
     if (!exported.ok()) return Fail(state, exported.status());
     benchmark::DoNotOptimize(exported->bvh.data());
   }
@@ -144,7 +145,8 @@ void BM_ExportClip(benchmark::State& state) {
 void BM_ExportClipResponseCopies(benchmark::State& state) {
   Fixture& fixture = TheFixture();
   absl::StatusOr<server::ExportedBvh> exported =
-      server::ExportClip(*fixture.database, {fixture.clip_id, 0, kRangeFrames - 1});
+      server::ExportClip(*fixture.database, {fixture.clip_id, 0, kRangeFrames - 1},
+                         server::AnswerLimit(), [] { return false; });
   if (!exported.ok()) return Fail(state, exported.status());
   std::string wire;
   for (auto _ : state) {

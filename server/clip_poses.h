@@ -10,6 +10,7 @@
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
+#include "server/answer_limit.h"
 #include "server/frame_conversion.h"
 #include "storage/database.h"
 
@@ -35,8 +36,10 @@ struct ClipPoses {
 };
 
 // NOT_FOUND for an unknown clip; INVALID_ARGUMENT naming the field for a range outside the clip
-// or a max_rate that is negative or not a number.
-absl::StatusOr<ClipPoses> ReadClipPoses(storage::Database& database, const PosesRequest& request);
+// or a max_rate that is negative or not a number; RESOURCE_EXHAUSTED, before the frames are
+// read, when the poses could exceed `answers` (frames after resampling x joints x 12 bytes).
+absl::StatusOr<ClipPoses> ReadClipPoses(storage::Database& database, const PosesRequest& request,
+                                        const AnswerLimit& answers);
 
 }  // namespace motiondb::server
 

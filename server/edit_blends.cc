@@ -32,8 +32,9 @@ absl::StatusOr<Placement> MixedPlacement(const std::vector<const EditPose*>& pos
   return placement;
 }
 
-// The path with `per_segment` frames from each point to the next.
-absl::StatusOr<RowMatrixXd> PathPoints(const std::vector<Eigen::Vector2d>& path, int per_segment) {
+// The frames of the path with `per_segment` frames from each point to the next; INVALID_ARGUMENT
+// for a bad path or count.
+absl::StatusOr<int64_t> PathFrames(const std::vector<Eigen::Vector2d>& path, int per_segment) {
   if (per_segment < 1 || per_segment > kMaxFramesPerSegment) {
     return absl::InvalidArgumentError(absl::StrCat("frames_per_segment = ", per_segment,
                                                    " is out of range; expected 1..",
@@ -53,6 +54,12 @@ absl::StatusOr<RowMatrixXd> PathPoints(const std::vector<Eigen::Vector2d>& path,
     return absl::InvalidArgumentError(
         absl::StrCat("path: ", frames, " frames, at most ", kMaxBlendFrames));
   }
+  return frames;
+}
+
+// The `frames` points of the path (PathFrames's) with `per_segment` frames from each point to
+// the next.
+RowMatrixXd PathPoints(const std::vector<Eigen::Vector2d>& path, int per_segment, int64_t frames) {
   RowMatrixXd points(frames, 2);
   for (size_t i = 0; i + 1 < path.size(); ++i) {
     for (int k = 0; k < per_segment; ++k) {
@@ -70,6 +77,18 @@ absl::StatusOr<InterpolateOutcome> InterpolateInSpace(const EditContext& context
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape like,
+                            ShapeOf(context.database, *snapshot, request.from, "from"));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<double> t, InterpolationParameters(request.options));
+  // Both methods' poses, a frame per t, and a step (t, three numbers) per t.
+  const int64_t steps = static_cast<int64_t>(t.size());
+  MOTIONDB_RETURN_IF_ERROR(
+      CheckEditAnswer(context, space, like,
+                      {.space_frames = steps,
+                       .results = 2,
+                       .sources = 2,
+                       .extra_bytes = steps * (4 * kNumberFieldBytes + kFieldFramingBytes)},
+                      request.output, "ask for fewer steps (or t values)"));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource from, LoadSource(context.database, *snapshot,
                                                               request.from, "from", should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource to,
@@ -110,8 +129,21 @@ absl::StatusOr<BlendOutcome> BlendInSpace(const EditContext& context, const Blen
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
   if (request.poses.empty()) return absl::InvalidArgumentError("poses: no poses to blend");
-  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd path,
-                            PathPoints(request.path, request.frames_per_segment));
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t frames,
+                            PathFrames(request.path, request.frames_per_segment));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const SourceShape like,
+      ShapeOf(context.database, *snapshot, request.poses.front().pose, "poses[0].pose"));
+  // A frame a path point, and each frame's weights (a double a pose).
+  const int64_t pose_count = static_cast<int64_t>(request.poses.size());
+  MOTIONDB_RETURN_IF_ERROR(CheckEditAnswer(
+      context, space, like,
+      {.space_frames = frames,
+       .sources = pose_count,
+       .extra_bytes =
+           frames * (pose_count * static_cast<int64_t>(sizeof(double)) + 2 * kFieldFramingBytes)},
+      request.output, "ask for fewer frames: fewer path points or a lower frames_per_segment"));
+  const RowMatrixXd path = PathPoints(request.path, request.frames_per_segment, frames);
   std::vector<EditSource> sources;
   std::vector<EditPose> poses;
   RowMatrixXd coordinates(request.poses.size(), space.dims()), plane(request.poses.size(), 2);

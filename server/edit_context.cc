@@ -1,5 +1,7 @@
 #include "server/edit_context.h"
 
+#include <algorithm>
+#include <limits>
 #include <utility>
 
 #include "absl/strings/match.h"
@@ -41,6 +43,43 @@ absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSn
   MOTIONDB_RETURN_IF_ERROR(CheckEditStop(should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(source.motion, EnterSpace(*snapshot.space, selected.clip, should_stop));
   return source;
+}
+
+absl::StatusOr<SourceShape> ShapeOf(storage::Database& database, const SpaceSnapshot& snapshot,
+                                    const ClipSelection& selection, absl::string_view field) {
+  MOTIONDB_RETURN_IF_ERROR(
+      Prefixed(field, CheckClipInSpace(database, snapshot, selection.clip_id)));
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipLayout layout,
+                            database.GetClipLayout(selection.clip_id));
+  SourceShape shape;
+  shape.skeleton = layout.skeleton;
+  shape.fps = 1.0 / layout.record.frame_time;
+  MOTIONDB_ASSIGN_OR_RETURN(
+      shape.frames,
+      ResolveFrameRange(selection, static_cast<int>(layout.record.frame_count), field));
+  shape.space_frames = ResampledFrameCount(shape.frames.size(), layout.record.frame_time,
+                                           snapshot.space->sample_rate());
+  return shape;
+}
+
+absl::Status CheckEditAnswer(const EditContext& context, const MotionSpace& space,
+                             const SourceShape& like, const EditAnswer& answer,
+                             const EditOutput& output, absl::string_view remedy) {
+  // FinishEdit's resampling from the space's rate to the source's.
+  const int64_t frames = ResampledFrameCount(
+      static_cast<int>(std::min<int64_t>(answer.space_frames, std::numeric_limits<int>::max())),
+      1.0 / space.sample_rate(), like.fps);
+  int64_t bytes = answer.results * BvhFieldBytes(*like.skeleton, frames) + answer.extra_bytes +
+                  kAnswerFixedBytes;
+  if (!output.store_name.empty()) {
+    bytes += answer.sources * kClipRangeBytes +
+             TextFieldBytes(static_cast<int64_t>(output.parameters_json.size()));
+  }
+  return context.answers.Check(
+      bytes,
+      absl::StrCat("the answer (", answer.results == 1 ? "a BVH" : "two BVHs", " of ", frames,
+                   " frames at ", like.fps, " fps)"),
+      remedy);
 }
 
 absl::StatusOr<EditPose> PoseOf(const MotionSpace& space, const EditSource& source) {

@@ -14,6 +14,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/ops/space_motion.h"
+#include "server/answer_limit.h"
 #include "server/catalog.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
@@ -27,7 +28,8 @@ namespace motiondb::server {
 struct EditOutput {
   std::string store_name{};  // empty: the result is only returned
   std::vector<std::string> store_tags{};
-  std::string parameters_json{};  // the request's parameters, for the stored clip's provenance
+  // The request's parameters, for the stored clip's provenance (empty without store_name).
+  std::string parameters_json{};
 };
 
 struct EditResult {
@@ -69,6 +71,25 @@ struct EditContext {
   // The longest search query, in frames at a space's rate (--max-query-frames), which also
   // bounds the warp of an aligned overlap (FillGap).
   int max_query_frames = kDefaultMaxQueryFrames;
+  AnswerLimit answers{};  // what an operator's answer may take (--max-answer-mb)
+};
+
+// A stored clip's range as an operator finds it, read without its frames: what the operator's
+// answer is sized by before the work.
+struct SourceShape {
+  std::shared_ptr<const Skeleton> skeleton;  // the clip's own offsets and channels
+  double fps = 0;                            // the clip's own
+  FrameRange frames;                         // at the clip's rate
+  int64_t space_frames = 0;                  // the range at the space's rate
+};
+
+// What an operator's answer holds, known before it runs: its BVH results of `space_frames`
+// frames at the space's rate, exported like a source, and its own fields.
+struct EditAnswer {
+  int64_t space_frames = 0;
+  int results = 1;          // BVH texts: Interpolate's other method's too
+  int64_t sources = 1;      // clip ranges a stored clip's provenance names
+  int64_t extra_bytes = 0;  // the operator's own fields (weights, steps, joints), at most
 };
 
 // Frames of a placement mixed (MixPlacementFrame) between two polls of a stop function: about
@@ -87,6 +108,17 @@ absl::Status CheckEditStop(const std::function<bool()>& should_stop);
 absl::StatusOr<EditSource> LoadSource(storage::Database& database, const SpaceSnapshot& snapshot,
                                       const ClipSelection& selection, absl::string_view field,
                                       const std::function<bool()>& should_stop = {});
+
+// LoadSource's errors, from the clip's layout alone.
+absl::StatusOr<SourceShape> ShapeOf(storage::Database& database, const SpaceSnapshot& snapshot,
+                                    const ClipSelection& selection, absl::string_view field);
+
+// OK when `answer`, its results exported like `like` (FinishEdit) and, with output.store_name,
+// the stored clip and its provenance (output.parameters_json), fits context.answers; else
+// RESOURCE_EXHAUSTED naming the limit, the frames and `remedy`.
+absl::Status CheckEditAnswer(const EditContext& context, const MotionSpace& space,
+                             const SourceShape& like, const EditAnswer& answer,
+                             const EditOutput& output, absl::string_view remedy);
 
 // The source's only frame, or the projected mean of its frames with the mean of their
 // placements and the pose the mean unprojects to.

@@ -35,6 +35,12 @@ absl::StatusOr<EditResult> EditInSpace(const EditContext& context, const CurveEd
   const MotionSpace& space = *snapshot->space;
   MOTIONDB_RETURN_IF_ERROR(ValidateEditScope(edit.scope, space.dims()));
   MOTIONDB_RETURN_IF_ERROR(ValidateJointConstraints(space, edit.constraints));
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape shape,
+                            ShapeOf(context.database, *snapshot, edit.clip, "clip"));
+  // The sources: the clip's range, and a translation's poses (at most two).
+  MOTIONDB_RETURN_IF_ERROR(CheckEditAnswer(context, space, shape,
+                                           {.space_frames = shape.space_frames, .sources = 3},
+                                           edit.output, "ask for a shorter range of the clip"));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
                                                                 edit.clip, "clip", should_stop));
   Provenance provenance{op, edit.space, {source.range}};

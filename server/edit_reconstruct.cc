@@ -14,6 +14,20 @@ absl::StatusOr<ReconstructOutcome> Rebuild(const EditContext& context,
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   const MotionSpace& space = *snapshot->space;
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape shape,
+                            ShapeOf(context.database, *snapshot, request.clip, "clip"));
+  // Each joint's error (its name and two numbers), and with error_curve one per dimension.
+  int64_t extra = 0;
+  for (const Joint& joint : shape.skeleton->joints()) {
+    extra += TextFieldBytes(static_cast<int64_t>(joint.name.size())) + 2 * kNumberFieldBytes +
+             kFieldFramingBytes;
+  }
+  if (request.options.error_curve) {
+    extra += space.dims() * (3 * kNumberFieldBytes + kFieldFramingBytes);
+  }
+  MOTIONDB_RETURN_IF_ERROR(CheckEditAnswer(
+      context, space, shape, {.space_frames = shape.space_frames, .extra_bytes = extra},
+      request.output, "ask for a shorter range of the clip"));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
                                                                 request.clip, "clip", should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(

@@ -148,10 +148,31 @@ absl::StatusOr<FillGapOutcome> Overlap(const EditContext& context, const MotionS
   return outcome;
 }
 
+// The answer's size checked before the ranges are read: both ranges and the gap between them
+// (an overlap makes fewer frames than the ranges), exported like the first.
+absl::Status CheckTransitionAnswer(const EditContext& context, const SpaceSnapshot& snapshot,
+                                   const FillGapRequest& request) {
+  const MotionSpace& space = *snapshot.space;
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape first,
+                            ShapeOf(context.database, snapshot, request.first, "first"));
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape second,
+                            ShapeOf(context.database, snapshot, request.second, "second"));
+  int64_t gap = 0;
+  if (std::isfinite(request.overlap_s) && request.overlap_s == 0.0) {
+    MOTIONDB_ASSIGN_OR_RETURN(gap,
+                              Frames("gap_s", request.gap_s, space.sample_rate(), kMaxGapFrames));
+  }
+  return CheckEditAnswer(
+      context, space, first,
+      {.space_frames = first.space_frames + gap + second.space_frames, .sources = 2},
+      request.output, "ask for shorter ranges (first, second) or a shorter gap_s");
+}
+
 absl::StatusOr<FillGapOutcome> Transition(const EditContext& context, const FillGapRequest& request,
                                           const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
+  MOTIONDB_RETURN_IF_ERROR(CheckTransitionAnswer(context, *snapshot, request));
   MOTIONDB_ASSIGN_OR_RETURN(
       const EditSource first,
       LoadSource(context.database, *snapshot, request.first, "first", should_stop));

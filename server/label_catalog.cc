@@ -1,5 +1,6 @@
 #include "server/label_catalog.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -119,15 +120,30 @@ absl::Status ResolveRange(const NewLabel& label, const storage::ClipRecord& clip
   return absl::OkStatus();
 }
 
+// A label listing's page, storage's: StoragePage's, and no more labels than an answer holds.
+absl::StatusOr<storage::Page> LabelListingPage(const PageRequest& page,
+                                               const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(storage::Page stored, StoragePage(page));
+  stored.page_size =
+      static_cast<int>(std::min<int64_t>(stored.page_size, answers.MostItems(LabelAnswerBytes())));
+  return stored;
+}
+
 }  // namespace
 
 absl::StatusOr<storage::AddedLabels> AddLabels(storage::Database& database,
                                                const std::vector<NewLabel>& labels,
+                                               const AnswerLimit& answers,
                                                const std::function<bool()>& should_stop) {
   if (labels.size() > kMaxLabelsPerBatch) {
     return absl::InvalidArgumentError(
         absl::StrCat("labels: at most ", kMaxLabelsPerBatch, " a call, got ", labels.size()));
   }
+  // The answer holds every label as stored, its clip's name too.
+  MOTIONDB_RETURN_IF_ERROR(answers.Check(
+      static_cast<int64_t>(labels.size()) * LabelAnswerBytes() + kAnswerFixedBytes,
+      absl::StrCat("the answer of ", labels.size(), " labels"),
+      absl::StrCat("send at most ", answers.MostItems(LabelAnswerBytes()), " labels a call")));
   // One time for the batch, so that what is returned is what was stored.
   const int64_t now = absl::ToUnixMillis(absl::Now());
   ClipResolver clips(database);
@@ -164,14 +180,16 @@ absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database
 }
 
 absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const PageRequest& page,
-                                              const storage::LabelFilter& filter) {
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
+                                              const storage::LabelFilter& filter,
+                                              const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, LabelListingPage(page, answers));
   return database.ListLabels(stored, filter);
 }
 
 absl::StatusOr<storage::LabelPage> FindLabels(storage::Database& database, const PageRequest& page,
-                                              const storage::LabelQuery& query) {
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(page));
+                                              const storage::LabelQuery& query,
+                                              const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, LabelListingPage(page, answers));
   return database.FindLabels(stored, query);
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "server/answer_limit.h"
 #include "server/listing.h"
 #include "storage/database.h"
 
@@ -41,16 +42,22 @@ struct NewLabel {
 // an unknown clip; INVALID_ARGUMENT for what storage::Database::AddLabels refuses, a first
 // frame or time that is past the clip, a time that is not finite, negative or reversed, frames
 // and seconds both given, no clip named or clip_id and clip_name naming two, or over
-// kMaxLabelsPerBatch labels. `should_stop` as the Catalog's writes take it.
+// kMaxLabelsPerBatch labels; RESOURCE_EXHAUSTED, before anything is stored, for more labels
+// than an answer of `answers` holds. `should_stop` as the Catalog's writes take it.
 absl::StatusOr<storage::AddedLabels> AddLabels(storage::Database& database,
                                                const std::vector<NewLabel>& labels,
+                                               const AnswerLimit& answers,
                                                const std::function<bool()>& should_stop = {});
 
-// Pages as ListClips pages (server/listing.h).
+// Pages as ListClips pages (server/listing.h), of at most the labels an answer of `answers`
+// holds (AnswerLimit::MostItems of LabelAnswerBytes: a larger page_size is read as that, as one
+// over 1000 is read as 1000).
 absl::StatusOr<storage::LabelPage> ListLabels(storage::Database& database, const PageRequest& page,
-                                              const storage::LabelFilter& filter);
+                                              const storage::LabelFilter& filter,
+                                              const AnswerLimit& answers);
 absl::StatusOr<storage::LabelPage> FindLabels(storage::Database& database, const PageRequest& page,
-                                              const storage::LabelQuery& query);
+                                              const storage::LabelQuery& query,
+                                              const AnswerLimit& answers);
 
 // Every manual label of `descriptor` (empty: of any), every page read.
 absl::StatusOr<std::vector<storage::LabelRecord>> ManualLabels(storage::Database& database,

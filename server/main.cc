@@ -129,6 +129,9 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
          "KIB_S", 1, 1 << 20);
   number("--max-message-mb", options->max_message_mb, "largest request message, in MiB", "MB", 1,
          2047);
+  number("--max-answer-mb", options->max_answer_mb,
+         "largest answer, in MiB: larger ones are refused before they are made", "MB", 1,
+         motiondb::server::kMaxAnswerMbCeiling);
   flags->max_bvh_mb = static_cast<int>(options->uploads.max_bvh_bytes >> 20);
   number("--max-bvh-mb", flags->max_bvh_mb, "largest BVH upload, streamed or not, in MiB", "MB", 1,
          1 << 20);

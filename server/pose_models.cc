@@ -34,6 +34,10 @@ absl::StatusOr<StoredPoseModel> CreatePoseModel(const EditContext& context,
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, request.space));
   if (request.examples.empty()) return absl::InvalidArgumentError("examples: no poses given");
+  // The answer holds the model's request as its parameters.
+  MOTIONDB_RETURN_IF_ERROR(context.answers.Check(
+      TextFieldBytes(static_cast<int64_t>(request.parameters_json.size())) + kAnswerFixedBytes,
+      "the model with its parameters", "give fewer examples, as longer ranges"));
   std::vector<RowMatrixXd> parts;
   std::vector<int> groups;  // each example range is a group for the threshold
   for (size_t i = 0; i < request.examples.size(); ++i) {
@@ -97,6 +101,16 @@ absl::StatusOr<DetectOutcome> Detect(const EditContext& context, const DetectReq
   MOTIONDB_ASSIGN_OR_RETURN(const StoredPoseModel stored, Parsed(std::move(record)));
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(context.registry, stored.record.space_name));
+  MOTIONDB_ASSIGN_OR_RETURN(const SourceShape shape,
+                            ShapeOf(context.database, *snapshot, request.clip, "clip"));
+  // The curve, a float32 a sample, and the intervals, at most one every other sample.
+  const int64_t samples = shape.space_frames;
+  MOTIONDB_RETURN_IF_ERROR(context.answers.Check(
+      TextFieldBytes(samples * static_cast<int64_t>(sizeof(float))) +
+          (samples + 1) / 2 * (6 * kNumberFieldBytes + kFieldFramingBytes) + kAnswerFixedBytes,
+      absl::StrCat("the detection over clip ", request.clip.clip_id, "'s frames ",
+                   shape.frames.first, "..", shape.frames.last, " (", samples, " samples)"),
+      "ask for a shorter range of the clip"));
   MOTIONDB_ASSIGN_OR_RETURN(const EditSource source, LoadSource(context.database, *snapshot,
                                                                 request.clip, "clip", should_stop));
   const double rate = snapshot->space->sample_rate();

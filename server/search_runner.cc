@@ -257,6 +257,24 @@ absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const
   }
 }
 
+// The answer's size at most (SearchAnswerBytes), checked with what the batch's earlier answers
+// took against request.answers.
+absl::StatusOr<int64_t> CheckAnswer(const SearchRequest& request, const SearchParams& params,
+                                    const Query& query, const Skeleton& skeleton) {
+  const int64_t path_rows = request.params.return_path ? query.row_count : 0;
+  const int64_t bytes = SearchAnswerBytes(params.max_results, path_rows, request.explain, skeleton);
+  MOTIONDB_RETURN_IF_ERROR(request.answers->Check(
+      request.answers_used + bytes + kAnswerFixedBytes,
+      absl::StrCat(request.answers_used > 0 ? "with the batch's earlier answers, " : "",
+                   "the answer of up to ", params.max_results, " results",
+                   path_rows > 0 ? absl::StrCat(" with paths of ", path_rows, " frames") : "",
+                   request.explain ? " explained" : ""),
+      request.answers_used > 0
+          ? "send the rest of the batch in another call, or ask for fewer max_results"
+          : "ask for fewer max_results, or without return_path and explain"));
+  return bytes;
+}
+
 }  // namespace
 
 absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
@@ -289,6 +307,10 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
   params.should_stop = should_stop;
 
   SearchOutcome outcome;
+  if (request.answers != nullptr) {
+    MOTIONDB_ASSIGN_OR_RETURN(outcome.answer_bytes,
+                              CheckAnswer(request, params, query, snapshot->space->skeleton()));
+  }
   outcome.query_frames = query.row_count;
   if (snapshot->index) {
     outcome.library_frames = snapshot->index->total_frames();

@@ -15,6 +15,7 @@
 #include "absl/status/statusor.h"
 #include "core/search/search_params.h"
 #include "core/search/search_result.h"
+#include "server/answer_limit.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/search_explanation.h"
@@ -52,6 +53,12 @@ struct SearchRequest {
   // Each hit with its SearchExplanation (the path is computed for it, and returned only when
   // params.return_path asks).
   bool explain = false;
+  // The answer's limit, for a search whose hits are sent (not a job's): RESOURCE_EXHAUSTED
+  // before the search when `answers_used` (what a batch's earlier answers took) and this answer
+  // (SearchAnswerBytes of max_results, the query's rows when paths are returned) could exceed
+  // it. Null: no limit.
+  const AnswerLimit* answers = nullptr;
+  int64_t answers_used = 0;
 };
 
 // A ranked time range, in the clip's own frames (inclusive).
@@ -75,6 +82,7 @@ struct SearchOutcome {
   std::vector<int> characteristic_frames;  // every one used, as characteristic_frame
   int second_anchor_frame = -1;            // as characteristic_frame; -1 when none was used
   int64_t query_frames = 0;                // at the space rate
+  int64_t answer_bytes = 0;  // with SearchRequest::answers: the answer's size, at most
   int64_t library_frames = 0;
   double request_ms = 0;  // the whole request, query projection included
 };

@@ -18,7 +18,7 @@ constexpr int64_t kCurveProductsPerStopPoll = int64_t{1} << 18;
 }  // namespace
 
 absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database& database,
-                                const CurveRequest& request,
+                                const CurveRequest& request, const AnswerLimit& answers,
                                 const std::function<bool()>& should_stop) {
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(registry, request.space));
@@ -35,6 +35,12 @@ absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database
       curve.frames,
       ResolveFrameRange(request.clip, snapshot->clips.at(clip_id).frame_count, "clip"));
   const auto [first, last] = snapshot->Conversion(clip_id).ToSpace(curve.frames);
+  MOTIONDB_RETURN_IF_ERROR(answers.Check(
+      TextFieldBytes((last - first + 1) * dims * static_cast<int64_t>(sizeof(float))) +
+          kAnswerFixedBytes,
+      absl::StrCat("the curve of clip ", clip_id, "'s frames ", curve.frames.first, "..",
+                   curve.frames.last, " in ", dims, " dimensions"),
+      "ask for a range of the clip (clip.first_frame, clip.last_frame) or fewer dims"));
   const CoordinateView rows = snapshot->index->clip_coordinates(snapshot->index->FindClip(clip_id))
                                   .middle_rows(first, last - first + 1);
   // The index holds search coordinates: the projection multiplied by the metric's scales (then

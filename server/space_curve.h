@@ -10,6 +10,7 @@
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
+#include "server/answer_limit.h"
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "storage/database.h"
@@ -30,10 +31,11 @@ struct Curve {
 };
 
 // NOT_FOUND for an unknown space or clip; INVALID_ARGUMENT naming the field for dims outside
-// the space or a range outside the clip; the lookup's other codes (space_lookup.h); CANCELLED
-// once `should_stop` says stop.
+// the space or a range outside the clip; RESOURCE_EXHAUSTED, before the curve is made, when it
+// could exceed `answers`; the lookup's other codes (space_lookup.h); CANCELLED once
+// `should_stop` says stop.
 absl::StatusOr<Curve> ReadCurve(const IndexRegistry& registry, storage::Database& database,
-                                const CurveRequest& request,
+                                const CurveRequest& request, const AnswerLimit& answers,
                                 const std::function<bool()>& should_stop = {});
 
 }  // namespace motiondb::server

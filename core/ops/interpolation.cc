@@ -13,7 +13,22 @@ using ops_internal::CheckBetween;
 
 constexpr int kMaxSteps = 10000;
 
-absl::StatusOr<std::vector<double>> Parameters(const InterpolationOptions& options) {
+RowMatrixXd SlerpJoints(const Eigen::Ref<const RowMatrixXd>& rotations,
+                        const std::vector<double>& t) {
+  RowMatrixXd slerp(t.size(), rotations.cols());
+  for (Eigen::Index j = 0; j < rotations.cols(); j += 4) {
+    const Quat qa = ops_internal::QuatAt(rotations, 0, j);
+    const Quat qb = ops_internal::QuatAt(rotations, 1, j);
+    for (size_t i = 0; i < t.size(); ++i) {
+      ops_internal::SetQuatAt(Slerp(qa, qb, t[i]), slerp, static_cast<Eigen::Index>(i), j);
+    }
+  }
+  return slerp;
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<double>> InterpolationParameters(const InterpolationOptions& options) {
   if (!options.t.empty()) {
     if (options.t.size() > kMaxSteps) {
       return ops_internal::OutOfRange("t", static_cast<double>(options.t.size()),
@@ -30,21 +45,6 @@ absl::StatusOr<std::vector<double>> Parameters(const InterpolationOptions& optio
   return t;
 }
 
-RowMatrixXd SlerpJoints(const Eigen::Ref<const RowMatrixXd>& rotations,
-                        const std::vector<double>& t) {
-  RowMatrixXd slerp(t.size(), rotations.cols());
-  for (Eigen::Index j = 0; j < rotations.cols(); j += 4) {
-    const Quat qa = ops_internal::QuatAt(rotations, 0, j);
-    const Quat qb = ops_internal::QuatAt(rotations, 1, j);
-    for (size_t i = 0; i < t.size(); ++i) {
-      ops_internal::SetQuatAt(Slerp(qa, qb, t[i]), slerp, static_cast<Eigen::Index>(i), j);
-    }
-  }
-  return slerp;
-}
-
-}  // namespace
-
 absl::StatusOr<Interpolation> InterpolatePoses(const MotionSpace& space,
                                                const Eigen::Ref<const RowMatrixXd>& poses,
                                                const Eigen::Ref<const RowMatrixXd>& rotations,
@@ -60,7 +60,7 @@ absl::StatusOr<Interpolation> InterpolatePoses(const MotionSpace& space,
                                     absl::StrCat("1..", space.dims(), " (or -1 for all)"));
   }
   Interpolation result;
-  MOTIONDB_ASSIGN_OR_RETURN(result.t, Parameters(options));
+  MOTIONDB_ASSIGN_OR_RETURN(result.t, InterpolationParameters(options));
   const int n = static_cast<int>(result.t.size());
   result.mc_lerp_coordinates.resize(n, dims);
   for (int i = 0; i < n; ++i) {

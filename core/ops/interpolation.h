@@ -42,6 +42,10 @@ struct Interpolation {
   std::vector<double> curve_distance{};
 };
 
+// The parameters InterpolatePoses samples: options.t, or options.steps from 0 to 1.
+// INVALID_ARGUMENT naming t, t[i] or steps.
+absl::StatusOr<std::vector<double>> InterpolationParameters(const InterpolationOptions& options);
+
 // `poses`: 2 x the space's dims, the two poses' coordinates; `rotations`: 2 x 4 * joints, the
 // pose rotations they encode (SpaceMotion rows). INVALID_ARGUMENT naming t[i], steps, dims or
 // the inputs.

@@ -98,7 +98,7 @@ grpc::Status ClipServiceImpl::GetClipPoses(grpc::ServerContext* context,
                                            const v1::GetClipPosesRequest* request,
                                            v1::ClipPoses* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<ClipPoses> poses = ReadClipPoses(database_, FromProto(*request));
+    const absl::StatusOr<ClipPoses> poses = ReadClipPoses(database_, FromProto(*request), answers_);
     if (!poses.ok()) return ToGrpcStatus(poses.status());
     ToProto(*poses, response);
     return grpc::Status::OK;
@@ -157,11 +157,29 @@ grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
                                          const v1::ExportClipRequest* request,
                                          v1::ExportClipResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    absl::StatusOr<ExportedBvh> exported =
-        server::ExportClip(database_, FromProto(request->clip()));
-    if (!exported.ok()) return ToGrpcStatus(exported.status());
+    absl::StatusOr<ExportedBvh> exported = server::ExportClip(database_, FromProto(request->clip()),
+                                                              answers_, StopWhenCallEnds(context));
+    if (!exported.ok()) return ToGrpcStatus(ExplainStop(exported.status(), context));
     ToProto(*std::move(exported), response);
     return grpc::Status::OK;
+  });
+}
+
+grpc::Status ClipServiceImpl::ExportClipStream(grpc::ServerContext* context,
+                                               const v1::ExportClipRequest* request,
+                                               grpc::ServerWriter<v1::ExportClipResponse>* writer) {
+  return gate_.Run(context, [&]() -> grpc::Status {
+    // Write blocks while the client's window is full, so a client that stops reading holds a
+    // piece here, not the clip; it returns false once the call has ended.
+    const auto send = [&](ExportedBvh piece) -> absl::Status {
+      v1::ExportClipResponse message;
+      ToProto(std::move(piece), &message);
+      if (!writer->Write(message)) return absl::CancelledError("the client stopped reading");
+      return absl::OkStatus();
+    };
+    return ToGrpcStatus(ExplainStop(
+        StreamClipExport(database_, FromProto(request->clip()), send, StopWhenCallEnds(context)),
+        context));
   });
 }
 

@@ -7,6 +7,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "server/answer_limit.h"
 #include "server/catalog.h"
 #include "server/clip_ingest.h"
 #include "server/grpc/call_gate.h"
@@ -22,13 +23,14 @@ namespace motiondb::server {
 class ClipServiceImpl final : public v1::ClipService::Service {
  public:
   // `budget` and `watchdog` bound the ingests in progress (server/upload_budget.h,
-  // server/grpc/stream_watchdog.h).
+  // server/grpc/stream_watchdog.h); `answers` the exports and poses.
   ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits,
-                  UploadBudget& budget, StreamWatchdog& watchdog, ServerMetrics& metrics,
-                  CallGate& gate)
+                  const AnswerLimit& answers, UploadBudget& budget, StreamWatchdog& watchdog,
+                  ServerMetrics& metrics, CallGate& gate)
       : database_(database),
         catalog_(catalog),
         limits_(limits),
+        answers_(answers),
         budget_(budget),
         watchdog_(watchdog),
         metrics_(metrics),
@@ -49,6 +51,8 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                           v1::Clip* response) override;
   grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
                           v1::ExportClipResponse* response) override;
+  grpc::Status ExportClipStream(grpc::ServerContext* context, const v1::ExportClipRequest* request,
+                                grpc::ServerWriter<v1::ExportClipResponse>* writer) override;
   grpc::Status GetClipPoses(grpc::ServerContext* context, const v1::GetClipPosesRequest* request,
                             v1::ClipPoses* response) override;
   grpc::Status ListSkeletons(grpc::ServerContext* context, const v1::ListSkeletonsRequest* request,
@@ -68,6 +72,7 @@ class ClipServiceImpl final : public v1::ClipService::Service {
   storage::Database& database_;
   Catalog& catalog_;
   UploadLimits limits_;
+  AnswerLimit answers_;
   UploadBudget& budget_;
   StreamWatchdog& watchdog_;
   ServerMetrics& metrics_;

@@ -12,7 +12,7 @@ grpc::Status LabelServiceImpl::AddLabels(grpc::ServerContext* context,
                                          v1::AddLabelsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::AddedLabels> added =
-        server::AddLabels(database_, FromProto(*request), StopWhenCallEnds(context));
+        server::AddLabels(database_, FromProto(*request), answers_, StopWhenCallEnds(context));
     if (!added.ok()) return ToGrpcStatus(ExplainStop(added.status(), context));
     for (const storage::LabelRecord& label : added->labels) ToProto(label, response->add_labels());
     for (const size_t item : added->skipped) response->add_skipped(static_cast<int32_t>(item));
@@ -26,8 +26,8 @@ grpc::Status LabelServiceImpl::ListLabels(grpc::ServerContext* context,
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::LabelFilter> filter = FromProto(*request);
     if (!filter.ok()) return ToGrpcStatus(filter.status());
-    const absl::StatusOr<storage::LabelPage> page =
-        server::ListLabels(database_, {request->page_size(), request->page_token()}, *filter);
+    const absl::StatusOr<storage::LabelPage> page = server::ListLabels(
+        database_, {request->page_size(), request->page_token()}, *filter, answers_);
     if (!page.ok()) return ToGrpcStatus(page.status());
     ToProto(*page, response);
     return grpc::Status::OK;
@@ -53,7 +53,7 @@ grpc::Status LabelServiceImpl::FindLabels(grpc::ServerContext* context,
                                           v1::FindLabelsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::LabelPage> page = server::FindLabels(
-        database_, {request->page_size(), request->page_token()}, FromProto(*request));
+        database_, {request->page_size(), request->page_token()}, FromProto(*request), answers_);
     if (!page.ok()) return ToGrpcStatus(page.status());
     ToProto(*page, response);
     return grpc::Status::OK;

@@ -3,6 +3,7 @@
 #define MOTIONDB_SERVER_GRPC_LABEL_SERVICE_H_
 
 #include "motiondb/v1/label_service.grpc.pb.h"
+#include "server/answer_limit.h"
 #include "server/grpc/call_gate.h"
 #include "storage/database.h"
 
@@ -10,8 +11,8 @@ namespace motiondb::server {
 
 class LabelServiceImpl final : public v1::LabelService::Service {
  public:
-  LabelServiceImpl(storage::Database& database, CallGate& gate)
-      : database_(database), gate_(gate) {}
+  LabelServiceImpl(storage::Database& database, const AnswerLimit& answers, CallGate& gate)
+      : database_(database), answers_(answers), gate_(gate) {}
 
   grpc::Status AddLabels(grpc::ServerContext* context, const v1::AddLabelsRequest* request,
                          v1::AddLabelsResponse* response) override;
@@ -26,6 +27,7 @@ class LabelServiceImpl final : public v1::LabelService::Service {
 
  private:
   storage::Database& database_;
+  AnswerLimit answers_;
   CallGate& gate_;
 };
 

@@ -78,6 +78,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   if (options.max_query_frames < 1) {
     return absl::InvalidArgumentError("--max-query-frames must be at least 1");
   }
+  if (options.max_answer_mb < 1 || options.max_answer_mb > kMaxAnswerMbCeiling) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--max-answer-mb must be in 1..", kMaxAnswerMbCeiling));
+  }
   if (options.threads < 0) {
     return absl::InvalidArgumentError("--threads must be 0 (no limit) or positive");
   }
@@ -112,16 +116,19 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
       StreamLimits{.idle_timeout = std::chrono::seconds(options.stream_idle_timeout_s),
                    .min_bytes_per_s = options.uploads.min_bytes_per_s,
                    .rate_grace = options.uploads.rate_grace});
-  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, *s.uploads,
-                                              *s.watchdog, *s.metrics, *s.gate);
-  s.spaces = std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, *s.gate);
-  s.search = std::make_unique<SearchServiceImpl>(*s.runner, *s.metrics, *s.gate);
-  s.labels = std::make_unique<LabelServiceImpl>(*s.database, *s.gate);
+  const AnswerLimit answers(int64_t{options.max_answer_mb} << 20);
+  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
+                                              *s.uploads, *s.watchdog, *s.metrics, *s.gate);
+  s.spaces =
+      std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, answers, *s.gate);
+  s.search = std::make_unique<SearchServiceImpl>(*s.runner, answers, *s.metrics, *s.gate);
+  s.labels = std::make_unique<LabelServiceImpl>(*s.database, answers, *s.gate);
   s.job_service = std::make_unique<JobServiceImpl>(*s.jobs, *s.gate);
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.access,
                                                    *s.gate);
   s.edits = std::make_unique<EditServiceImpl>(
-      EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames}, *s.gate);
+      EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames, answers},
+      *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,

@@ -647,12 +647,14 @@ std::string ParametersJson(const Request& request) {
   return JsonOf(parameters);
 }
 
+// The parameters only for a result that is stored: a request's JSON is a copy of it (a blend's
+// path of a million points takes seconds), made for nothing when the result is only answered.
 template <typename Request>
 EditOutput OutputOf(const Request& request) {
   const v1::EditOutput& output = request.output();
   return {output.store_name(),
           std::vector<std::string>(output.store_tags().begin(), output.store_tags().end()),
-          ParametersJson(request)};
+          output.store_name().empty() ? std::string() : ParametersJson(request)};
 }
 
 EditScope FromProto(const v1::EditScope& scope) {

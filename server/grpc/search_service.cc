@@ -16,9 +16,13 @@ constexpr int kMaxBatch = 1000;
 }  // namespace
 
 absl::StatusOr<v1::SearchResponse> SearchServiceImpl::SearchOne(
-    const v1::SearchRequest& request, const std::function<bool()>& should_stop) const {
-  MOTIONDB_ASSIGN_OR_RETURN(const SearchRequest search, FromProto(request));
+    const v1::SearchRequest& request, const std::function<bool()>& should_stop,
+    int64_t* answers_used) const {
+  MOTIONDB_ASSIGN_OR_RETURN(SearchRequest search, FromProto(request));
+  search.answers = &answers_;
+  search.answers_used = *answers_used;
   MOTIONDB_ASSIGN_OR_RETURN(const SearchOutcome outcome, runner_.Run(search, should_stop));
+  *answers_used += outcome.answer_bytes;
   metrics_.CountSearch(outcome);
   v1::SearchResponse response;
   ToProto(outcome, &response);
@@ -29,7 +33,9 @@ grpc::Status SearchServiceImpl::Search(grpc::ServerContext* context,
                                        const v1::SearchRequest* request,
                                        v1::SearchResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    absl::StatusOr<v1::SearchResponse> found = SearchOne(*request, StopWhenCallEnds(context));
+    int64_t answers_used = 0;
+    absl::StatusOr<v1::SearchResponse> found =
+        SearchOne(*request, StopWhenCallEnds(context), &answers_used);
     if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
     *response = *std::move(found);
     return grpc::Status::OK;
@@ -44,11 +50,14 @@ absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
                                                    " searches; at most ", kMaxBatch, " per batch"));
   }
   const std::function<bool()> should_stop = StopWhenCallEnds(context);
+  // The items' answers share the answer limit: each is checked with those before it.
+  int64_t answers_used = 0;
   for (int i = 0; i < request.requests_size(); ++i) {
     if (should_stop()) {
       return ExplainStop(absl::CancelledError(absl::StrCat("before requests[", i, "]")), context);
     }
-    absl::StatusOr<v1::SearchResponse> found = SearchOne(request.requests(i), should_stop);
+    absl::StatusOr<v1::SearchResponse> found =
+        SearchOne(request.requests(i), should_stop, &answers_used);
     // A stop ends the whole batch; any other failure belongs to its item alone.
     if (absl::IsCancelled(found.status())) return ExplainStop(found.status(), context);
     v1::SearchBatchItem* item = response->add_items();
@@ -57,6 +66,8 @@ absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
     } else {
       item->set_code(static_cast<int>(found.status().code()));
       item->set_message(absl::StrCat("requests[", i, "]: ", found.status().message()));
+      answers_used += TextFieldBytes(static_cast<int64_t>(item->message().size())) +
+                      kNumberFieldBytes + kFieldFramingBytes;
     }
   }
   return absl::OkStatus();

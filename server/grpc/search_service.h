@@ -6,6 +6,7 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
+#include "server/answer_limit.h"
 #include "server/grpc/call_gate.h"
 #include "server/search_runner.h"
 #include "server/server_metrics.h"
@@ -14,8 +15,9 @@ namespace motiondb::server {
 
 class SearchServiceImpl final : public v1::SearchService::Service {
  public:
-  SearchServiceImpl(const SearchRunner& runner, ServerMetrics& metrics, CallGate& gate)
-      : runner_(runner), metrics_(metrics), gate_(gate) {}
+  SearchServiceImpl(const SearchRunner& runner, const AnswerLimit& answers, ServerMetrics& metrics,
+                    CallGate& gate)
+      : runner_(runner), answers_(answers), metrics_(metrics), gate_(gate) {}
 
   grpc::Status Search(grpc::ServerContext* context, const v1::SearchRequest* request,
                       v1::SearchResponse* response) override;
@@ -26,11 +28,14 @@ class SearchServiceImpl final : public v1::SearchService::Service {
   absl::Status Batch(const v1::SearchBatchRequest& request, grpc::ServerContext* context,
                      v1::SearchBatchResponse* response);
 
-  // One search through the runner, as the response message.
+  // One search through the runner, as the response message, its answer checked with the
+  // `answers_used` before it (a batch's), which its own then joins.
   absl::StatusOr<v1::SearchResponse> SearchOne(const v1::SearchRequest& request,
-                                               const std::function<bool()>& should_stop) const;
+                                               const std::function<bool()>& should_stop,
+                                               int64_t* answers_used) const;
 
   const SearchRunner& runner_;
+  AnswerLimit answers_;
   ServerMetrics& metrics_;
   CallGate& gate_;
 };

@@ -30,6 +30,7 @@ grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* context,
     response->set_index_bytes(index_bytes);
     response->set_max_message_bytes(int64_t{options_.max_message_mb} << 20);
     response->set_max_bvh_bytes(options_.uploads.max_bvh_bytes);
+    response->set_max_answer_bytes(int64_t{options_.max_answer_mb} << 20);
     response->set_auth_required(!options_.auth_tokens.empty());
     response->set_scope(std::string(TokenScopeName(access_.VerdictOf(context).scope)));
     response->set_tls(!options_.tls_cert_pem.empty());

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "server/answer_limit.h"
 #include "server/net/connection_counter.h"
 #include "server/search_runner.h"
 #include "server/upload.h"
@@ -34,6 +35,9 @@ struct ServerOptions {
   // Largest request message, in MiB: gRPC itself refuses larger ones with RESOURCE_EXHAUSTED
   // before any handler runs (--max-message-mb).
   int max_message_mb = 256;
+  // Largest answer, in MiB, 1..kMaxAnswerMbCeiling: an answer that could be larger is refused
+  // with RESOURCE_EXHAUSTED before it is made (server/answer_limit.h) (--max-answer-mb).
+  int max_answer_mb = kDefaultMaxAnswerMb;
   // Largest BVH file accepted by IngestClip, IngestClipStream (all chunks together) and BVH
   // queries (--max-bvh-mb, in MiB).
   UploadLimits uploads;

@@ -61,7 +61,7 @@ grpc::Status SpaceServiceImpl::GetCurve(grpc::ServerContext* context,
                                         v1::GetCurveResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<Curve> curve =
-        ReadCurve(registry_, database_, FromProto(*request), StopWhenCallEnds(context));
+        ReadCurve(registry_, database_, FromProto(*request), answers_, StopWhenCallEnds(context));
     if (!curve.ok()) return ToGrpcStatus(ExplainStop(curve.status(), context));
     ToProto(*curve, response);
     return grpc::Status::OK;

@@ -4,6 +4,7 @@
 
 #include "absl/status/statusor.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "server/answer_limit.h"
 #include "server/catalog.h"
 #include "server/grpc/call_gate.h"
 #include "server/index_registry.h"
@@ -14,8 +15,12 @@ namespace motiondb::server {
 class SpaceServiceImpl final : public v1::SpaceService::Service {
  public:
   SpaceServiceImpl(storage::Database& database, Catalog& catalog, const IndexRegistry& registry,
-                   CallGate& gate)
-      : database_(database), catalog_(catalog), registry_(registry), gate_(gate) {}
+                   const AnswerLimit& answers, CallGate& gate)
+      : database_(database),
+        catalog_(catalog),
+        registry_(registry),
+        answers_(answers),
+        gate_(gate) {}
 
   grpc::Status CreateSpace(grpc::ServerContext* context, const v1::CreateSpaceRequest* request,
                            v1::Space* response) override;
@@ -32,6 +37,7 @@ class SpaceServiceImpl final : public v1::SpaceService::Service {
   storage::Database& database_;
   Catalog& catalog_;
   const IndexRegistry& registry_;
+  AnswerLimit answers_;
   CallGate& gate_;
 };
 

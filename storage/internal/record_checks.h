@@ -14,12 +14,9 @@
 #include "absl/strings/string_view.h"
 #include "core/motion/matrix.h"
 #include "storage/label_record.h"
+#include "storage/record_limits.h"
 
 namespace motiondb::storage {
-
-inline constexpr size_t kMaxNameBytes = 512;  // clip, source file and space names
-inline constexpr size_t kMaxTagBytes = 128;
-inline constexpr size_t kMaxTags = 64;  // a clip's
 
 // INVALID_ARGUMENT naming `what` for an empty `name` (unless `may_be_empty`), one longer than
 // `max_bytes`, or one that util/name_text.h's rule refuses: not UTF-8, or holding a control,

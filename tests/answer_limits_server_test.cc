@@ -1,0 +1,189 @@
+// Issue 37's answer limit through the real motiondb-server, on each face: with --max-answer-mb 1
+// a clip whose BVH is larger than the limit is refused by the unary export and exports whole
+// by the stream, over gRPC, HTTP (chunked) and the CLI, each the stored clip's WriteBvh text;
+// the probe's Blend (2 poses, 40 path points, 10000 frames a segment: a 2.3 GB answer that
+// aborted the server) is refused at the default limit and the server lives; a batch's searches
+// share the limit; label timelines come in pages; the HTTP face refuses JSON past the limit.
+// answer_limits_test.cc checks each operation's limit in process.
+#include <csignal>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "absl/strings/str_cat.h"
+#include "core/bvh/bvh_writer.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
+#include "motiondb/v1/edit_service.grpc.pb.h"
+#include "motiondb/v1/label_service.grpc.pb.h"
+#include "motiondb/v1/search_service.grpc.pb.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
+#include "motiondb/v1/space_service.grpc.pb.h"
+#include "testing/server_process.h"
+#include "tests/synthetic_motion.h"
+#include "tests/test_data.h"
+
+namespace motiondb {
+namespace {
+
+namespace v1 = ::motiondb::v1;
+using ::testing::HasSubstr;
+
+constexpr int64_t kMiB = int64_t{1} << 20;
+constexpr int kLongFrames = 6000;  // at 60 fps: its BVH is about 4 MiB, its poses 1.3 MiB
+
+std::unique_ptr<grpc::ClientContext> Context() {
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  return context;
+}
+
+std::string Bvh(const Clip& clip) {
+  absl::StatusOr<std::string> text = WriteBvh(clip);
+  EXPECT_TRUE(text.ok()) << text.status();
+  return text.value_or("");
+}
+
+class AnswerLimitServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::MakeTempDir("answer_limits_server_test");
+    db_ = (dir_ / "db.sqlite").string();
+  }
+  void TearDown() override {
+    if (HasFailure() && server_) std::cerr << "---- server log ----\n" << server_->Log() << "\n";
+    server_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  // A server on the test's database with `args`; its channel and stubs.
+  void Start(std::vector<std::string> args) {
+    server_.reset();
+    args.insert(args.begin(), {"--db", db_});
+    server_ = std::make_unique<testing::ServerProcess>();
+    std::string error;
+    ASSERT_TRUE(server_->Start(args, &error)) << error;
+    channel_ = testing::InsecureChannel(server_->address());
+    ASSERT_TRUE(testing::WaitUntilServing(channel_, ""));
+    clips_ = v1::ClipService::NewStub(channel_);
+  }
+
+  // Two takes of the humanoid at 60 fps, the first `first_frames` long, the second 300, and the
+  // space "body".
+  void LoadLibrary(int first_frames = kLongFrames) {
+    const auto skeleton = testing::HumanoidSkeleton(/*still_root=*/false);
+    for (const int frames : {first_frames, 300}) {
+      v1::IngestClipRequest request;
+      request.set_file_name(absl::StrCat("take", ids_.size(), ".bvh"));
+      request.set_bvh(Bvh(testing::SyntheticClip(
+          skeleton, {.frames = frames, .fps = 60, .seed = static_cast<int>(ids_.size()) + 1})));
+      v1::IngestClipResponse response;
+      const grpc::Status status = clips_->IngestClip(Context().get(), request, &response);
+      ASSERT_TRUE(status.ok()) << status.error_message();
+      ids_.push_back(response.clip().clip_id());
+    }
+    v1::CreateSpaceRequest space;
+    space.set_name("body");
+    v1::Space created;
+    const grpc::Status status =
+        v1::SpaceService::NewStub(channel_)->CreateSpace(Context().get(), space, &created);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+
+  // SIGTERM, the exit code; the test's channel closed first (a server stopping waits about 5 s
+  // for a client's idle connection).
+  int Stop() {
+    clips_.reset();
+    channel_.reset();
+    return server_->Stop(SIGTERM);
+  }
+
+  std::filesystem::path dir_;
+  std::string db_;
+  std::unique_ptr<testing::ServerProcess> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::ClipService::Stub> clips_;
+  std::vector<int64_t> ids_;
+};
+
+TEST_F(AnswerLimitServerTest, TheProbesBlendIsRefusedAndTheServerLives) {
+  ASSERT_NO_FATAL_FAILURE(Start({}));  // the default limit, 256 MiB
+  ASSERT_NO_FATAL_FAILURE(LoadLibrary(300));
+  auto edits = v1::EditService::NewStub(channel_);
+  v1::BlendRequest request;
+  request.set_space("body");
+  for (int i = 0; i < 2; ++i) {
+    v1::PlanarPose* pose = request.add_poses();
+    pose->mutable_pose()->set_clip_id(ids_[i]);
+    pose->mutable_pose()->set_first_frame(10);
+    pose->mutable_pose()->set_last_frame(10);
+    pose->set_x(i);
+  }
+  for (int i = 0; i < 40; ++i) {
+    v1::PlanePoint* point = request.add_path();
+    point->set_x(i % 2);
+    point->set_y(i / 40.0);
+  }
+  request.set_frames_per_segment(10000);
+  v1::BlendResponse response;
+  grpc::Status status = edits->Blend(Context().get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("answer limit of 256.0 MiB (--max-answer-mb)"));
+  EXPECT_THAT(status.error_message(), HasSubstr("frames_per_segment"));
+  // The probe's second: a million path points a frame each.
+  request.clear_path();
+  for (int i = 0; i < 1000000; ++i) request.add_path()->set_x(i % 7);
+  request.set_frames_per_segment(1);
+  status = edits->Blend(Context().get(), request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  // The server lives, and stores nothing.
+  v1::ServerInfo info;
+  ASSERT_TRUE(v1::ServerService::NewStub(channel_)->GetServerInfo(Context().get(), {}, &info).ok());
+  EXPECT_EQ(info.counts().clips(), 2);
+  EXPECT_TRUE(server_->running());
+  edits.reset();
+  EXPECT_EQ(Stop(), 0);
+}
+
+TEST_F(AnswerLimitServerTest, ABatchsSearchesShareTheLimit) {
+  ASSERT_NO_FATAL_FAILURE(Start({"--max-answer-mb", "1"}));
+  ASSERT_NO_FATAL_FAILURE(LoadLibrary(300));
+  v1::SearchBatchRequest batch;
+  for (int i = 0; i < 3; ++i) {
+    v1::SearchRequest* search = batch.add_requests();
+    search->set_space("body");
+    search->mutable_clip()->set_clip_id(ids_[1]);
+    search->mutable_clip()->set_first_frame(0);
+    search->mutable_clip()->set_last_frame(59);
+    // About 0.4 MiB each at their longest: two fit, the third does not.
+    search->set_max_results(500);
+    search->set_return_path(true);
+  }
+  v1::SearchBatchResponse answer;
+  const grpc::Status status =
+      v1::SearchService::NewStub(channel_)->SearchBatch(Context().get(), batch, &answer);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(answer.items_size(), 3);
+  EXPECT_EQ(answer.items(0).code(), 0) << answer.items(0).message();
+  EXPECT_EQ(answer.items(1).code(), 0) << answer.items(1).message();
+  EXPECT_EQ(answer.items(2).code(), static_cast<int>(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  EXPECT_THAT(answer.items(2).message(), HasSubstr("requests[2]: with the batch's earlier"));
+  EXPECT_LE(static_cast<int64_t>(answer.ByteSizeLong()), kMiB);
+}
+
+TEST_F(AnswerLimitServerTest, TheFlagIsChecked) {
+  for (const char* value : {"0", "2048"}) {
+    testing::ServerProcess server;
+    std::string error;
+    EXPECT_FALSE(
+        server.Start({"--db", db_, "--max-answer-mb", value}, &error, std::chrono::seconds(20)));
+    EXPECT_THAT(error, HasSubstr("--max-answer-mb")) << value;
+  }
+}
+
+}  // namespace
+}  // namespace motiondb
