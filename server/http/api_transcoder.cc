@@ -13,6 +13,7 @@
 #include "server/grpc/access_control.h"
 #include "server/grpc/request_logger.h"
 #include "server/http/http_status.h"
+#include "server/http/json_answer.h"
 #include "server/http/json_transcoding.h"
 #include "util/status_macros.h"
 
@@ -58,13 +59,16 @@ HttpReply FileReply(const Message& response) {
 
 }  // namespace
 
-ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s)
-    : stub_(std::move(channel)), call_timeout_(call_timeout_s) {}
+ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s,
+                             int64_t max_answer_bytes)
+    : stub_(std::move(channel)),
+      call_timeout_(call_timeout_s),
+      max_answer_bytes_(max_answer_bytes) {}
 
 absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
-    std::shared_ptr<grpc::Channel> channel, double call_timeout_s) {
-  auto transcoder =
-      std::unique_ptr<ApiTranscoder>(new ApiTranscoder(std::move(channel), call_timeout_s));
+    std::shared_ptr<grpc::Channel> channel, double call_timeout_s, int64_t max_answer_bytes) {
+  auto transcoder = std::unique_ptr<ApiTranscoder>(
+      new ApiTranscoder(std::move(channel), call_timeout_s, max_answer_bytes));
   for (const ApiRoute& route : ApiRoutes()) {
     const MethodDescriptor* method =
         google::protobuf::DescriptorPool::generated_pool()->FindMethodByName(route.rpc);
@@ -132,8 +136,16 @@ HttpReply ApiTranscoder::Call(const ApiRoute& route, const HttpCall& call) const
   const grpc::Status status = Invoke(method, *request, response.get(), call.peer, call.scope);
   if (!status.ok()) return ErrorReply(status.error_code(), status.error_message());
   if (route.bvh_file) return FileReply(*response);
+  absl::StatusOr<std::string> json = AnswerJson(*response, static_cast<size_t>(max_answer_bytes_));
+  if (!json.ok()) {
+    return ErrorReply(
+        grpc::StatusCode::RESOURCE_EXHAUSTED,
+        absl::StrCat(json.status().message(), ", the server's answer limit (--max-answer-mb), "
+                                              "though its gRPC answer is within it: ask for less "
+                                              "(a range, a smaller page), or call the gRPC method"));
+  }
   HttpReply reply;
-  reply.body = ToJson(*response);
+  reply.body = *std::move(json);
   return reply;
 }
 

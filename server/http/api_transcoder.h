@@ -7,6 +7,7 @@
 #define MOTIONDB_SERVER_HTTP_API_TRANSCODER_H_
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -43,14 +44,16 @@ struct HttpCall {
 
 class ApiTranscoder {
  public:
-  // Calls through `channel`, each with a deadline `call_timeout_s` from its start. INTERNAL when
-  // a route names a method that no linked service has.
+  // Calls through `channel`, each with a deadline `call_timeout_s` from its start; answers whose
+  // JSON would pass `max_answer_bytes` are refused. INTERNAL when a route names a method that no
+  // linked service has.
   static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
-      std::shared_ptr<grpc::Channel> channel, double call_timeout_s);
+      std::shared_ptr<grpc::Channel> channel, double call_timeout_s, int64_t max_answer_bytes);
 
   // The route's call: its request from the path values and the query parameters, or the body
   // (json_body); 400 with the error body for a request that does not convert, else the call's
-  // status mapped (server/http/http_status.h) with the answer or the error body.
+  // status mapped (server/http/http_status.h) with the answer or the error body (429,
+  // RESOURCE_EXHAUSTED, when the answer's JSON would pass the answer limit).
   HttpReply Call(const ApiRoute& route, const HttpCall& call) const;
 
   // Whether the server serves (the standard health service's overall status is SERVING).
@@ -60,7 +63,8 @@ class ApiTranscoder {
   using GenericStub =
       grpc::TemplatedGenericStub<google::protobuf::Message, google::protobuf::Message>;
 
-  ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s);
+  ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s,
+                int64_t max_answer_bytes);
   // Calls `method` in-process and waits for its answer.
   grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
                       const google::protobuf::Message& request, google::protobuf::Message* response,
@@ -70,6 +74,7 @@ class ApiTranscoder {
 
   mutable GenericStub stub_;  // UnaryCall is not const, but the stub keeps no per-call state
   const std::chrono::duration<double> call_timeout_;
+  const int64_t max_answer_bytes_;
   std::map<std::string, const google::protobuf::MethodDescriptor*> methods_;  // by rpc name
 };
 

@@ -170,16 +170,6 @@ std::string FieldName(absl::string_view path, const google::protobuf::Descriptor
   return name;
 }
 
-std::string ToJson(const Message& message) {
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  options.always_print_primitive_fields = true;
-  std::string json;
-  // Only a message with a malformed Any or invalid UTF-8 fails; ours have neither.
-  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
-  return json;
-}
-
 std::string ErrorJson(grpc::StatusCode code, absl::string_view message) {
   const nlohmann::json error = {{"code", static_cast<int>(code)}, {"message", message}};
   // A message may quote what a client sent (a parameter's name, a value, a path), which need

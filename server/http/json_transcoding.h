@@ -1,6 +1,6 @@
-// The one place where the HTTP face converts between proto messages and JSON or query
-// parameters: protobuf's own proto3 JSON mapping (field names as in the .proto files, int64 as
-// strings, bytes as base64, enums by name; input also in lowerCamelCase).
+// Where the HTTP face converts requests from JSON or query parameters: protobuf's own proto3
+// JSON mapping (field names as in the .proto files, int64 as strings, bytes as base64, enums by
+// name; input also in lowerCamelCase). Answers go out through server/http/json_answer.h.
 #ifndef MOTIONDB_SERVER_HTTP_JSON_TRANSCODING_H_
 #define MOTIONDB_SERVER_HTTP_JSON_TRANSCODING_H_
 
@@ -30,10 +30,6 @@ absl::Status SetField(absl::string_view path, absl::string_view text,
 // The field `path` names (as SetField takes it) by its fields' .proto names ("clip.clipId" ->
 // "clip.clip_id"); "" when it names none.
 std::string FieldName(absl::string_view path, const google::protobuf::Descriptor& type);
-
-// `message` as proto3 JSON, every field present (zero values too, so that clients need no
-// defaults of their own).
-std::string ToJson(const google::protobuf::Message& message);
 
 // The error body: {"code": <gRPC code number>, "message": "..."}.
 std::string ErrorJson(grpc::StatusCode code, absl::string_view message);
