@@ -210,27 +210,50 @@ struct ExportFlags {
   std::string out;
 };
 
+// ExportClipStream: the file written as its pieces arrive, so that a clip of any size exports
+// while the client holds a piece of it; renamed into place only once whole.
 absl::Status Export(const ExportFlags& flags, bool json, const ServerConnection& connection) {
   v1::ExportClipRequest request;
   request.mutable_clip()->set_clip_id(flags.id);
   if (flags.range.from) request.mutable_clip()->set_first_frame(*flags.range.from);
   if (flags.range.to) request.mutable_clip()->set_last_frame(*flags.range.to);
-  MOTIONDB_ASSIGN_OR_RETURN(
-      const v1::ExportClipResponse response,
-      CallUnary(connection, &v1::ClipService::Stub::ExportClip, request,
-                {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"}}));
-  MOTIONDB_RETURN_IF_ERROR(WriteFileAtomically(flags.out, response.bvh()));
+  v1::ClipService::Stub stub(connection.channel());
+  AtomicFileWriter file(flags.out);
+  absl::Status written;
+  v1::ExportClipResponse first, piece;
+  int64_t bytes = 0;
+  const absl::Status called =
+      Call(connection,
+           [&](grpc::ClientContext* context) {
+             const std::unique_ptr<grpc::ClientReader<v1::ExportClipResponse>> reader =
+                 stub.ExportClipStream(context, request);
+             for (bool at_first = true; reader->Read(&piece); at_first = false) {
+               if (at_first) {
+                 first.set_first_frame(piece.first_frame());
+                 first.set_last_frame(piece.last_frame());
+               }
+               bytes += static_cast<int64_t>(piece.bvh().size());
+               if (written.ok()) written = file.Append(piece.bvh());
+               if (!written.ok()) context->TryCancel();
+             }
+             return reader->Finish();
+           },
+           {{"clip.first_frame", "--from"}, {"clip.last_frame", "--to"}});
+  // A file that failed to write cancelled the call: its error is the one to tell.
+  MOTIONDB_RETURN_IF_ERROR(written);
+  MOTIONDB_RETURN_IF_ERROR(called);
+  MOTIONDB_RETURN_IF_ERROR(file.Commit());
   if (json) {
     std::cout << nlohmann::json{{"file", flags.out},
                                 {"clip_id", flags.id},
-                                {"first_frame", response.first_frame()},
-                                {"last_frame", response.last_frame()},
-                                {"bytes", response.bvh().size()}}
+                                {"first_frame", first.first_frame()},
+                                {"last_frame", first.last_frame()},
+                                {"bytes", bytes}}
                      .dump()
               << "\n";
   } else {
-    absl::PrintF("wrote %s: clip %d, frames %d-%d\n", flags.out, flags.id, response.first_frame(),
-                 response.last_frame());
+    absl::PrintF("wrote %s: clip %d, frames %d-%d\n", flags.out, flags.id, first.first_frame(),
+                 first.last_frame());
   }
   return absl::OkStatus();
 }

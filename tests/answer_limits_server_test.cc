@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <gmock/gmock.h>
+#include <google/protobuf/util/json_util.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
@@ -23,9 +24,13 @@
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "motiondb/v1/space_service.grpc.pb.h"
+#include "storage/database.h"
 #include "testing/server_process.h"
 #include "tests/synthetic_motion.h"
 #include "tests/test_data.h"
+
+// Last: httplib.h includes <resolv.h>, whose _res macro breaks the Eigen headers above.
+#include <httplib.h>
 
 namespace motiondb {
 namespace {
@@ -94,12 +99,31 @@ class AnswerLimitServerTest : public ::testing::Test {
     ASSERT_TRUE(status.ok()) << status.error_message();
   }
 
+  // The stored clip's WriteBvh text, read from the database once the server has stopped.
+  std::string StoredBvh(int64_t clip_id, std::optional<FrameRange> range = std::nullopt) {
+    auto database = storage::Database::Open(db_);
+    EXPECT_TRUE(database.ok()) << database.status();
+    if (!database.ok()) return "";
+    const absl::StatusOr<storage::StoredClip> stored = (*database)->GetClip(clip_id);
+    EXPECT_TRUE(stored.ok()) << stored.status();
+    if (!stored.ok()) return "";
+    const absl::StatusOr<std::string> text = WriteBvh(stored->clip, range);
+    EXPECT_TRUE(text.ok());
+    return text.value_or("");
+  }
+
   // SIGTERM, the exit code; the test's channel closed first (a server stopping waits about 5 s
   // for a client's idle connection).
   int Stop() {
     clips_.reset();
     channel_.reset();
     return server_->Stop(SIGTERM);
+  }
+
+  httplib::Client Http() {
+    httplib::Client client("127.0.0.1", server_->http_port());
+    client.set_read_timeout(60);
+    return client;
   }
 
   std::filesystem::path dir_;
@@ -109,6 +133,99 @@ class AnswerLimitServerTest : public ::testing::Test {
   std::unique_ptr<v1::ClipService::Stub> clips_;
   std::vector<int64_t> ids_;
 };
+
+TEST_F(AnswerLimitServerTest, AClipPastTheLimitExportsWholeByTheStreamOnEveryFace) {
+  ASSERT_NO_FATAL_FAILURE(Start({"--max-answer-mb", "1"}));
+  ASSERT_NO_FATAL_FAILURE(LoadLibrary());
+  const int64_t id = ids_[0];
+  v1::ServerInfo info;
+  ASSERT_TRUE(v1::ServerService::NewStub(channel_)->GetServerInfo(Context().get(), {}, &info).ok());
+  EXPECT_EQ(info.max_answer_bytes(), kMiB);
+
+  // Unary: refused, naming the limit, its flag and the stream.
+  v1::ExportClipRequest request;
+  request.mutable_clip()->set_clip_id(id);
+  v1::ExportClipResponse unary;
+  const grpc::Status refused = clips_->ExportClip(Context().get(), request, &unary);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("answer limit of 1.0 MiB (--max-answer-mb)"));
+  EXPECT_THAT(refused.error_message(), HasSubstr("ExportClipStream"));
+
+  // gRPC: the stream's pieces, each far below the limit, the first with the file's name.
+  std::string grpc_text;
+  int pieces = 0;
+  {
+    auto context = Context();
+    auto reader = clips_->ExportClipStream(context.get(), request);
+    v1::ExportClipResponse piece;
+    while (reader->Read(&piece)) {
+      if (pieces++ == 0) {
+        EXPECT_EQ(piece.file_name(), "take0.bvh");
+        EXPECT_EQ(piece.last_frame(), kLongFrames - 1);
+      }
+      EXPECT_LE(static_cast<int64_t>(piece.ByteSizeLong()), kMiB + 1024);
+      grpc_text += piece.bvh();
+    }
+    const grpc::Status status = reader->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+  EXPECT_GT(static_cast<int64_t>(grpc_text.size()), kMiB);
+  EXPECT_GE(pieces, 3);
+  // Errors come before any piece, as the unary export's.
+  request.mutable_clip()->set_last_frame(kLongFrames);
+  {
+    auto context = Context();
+    auto reader = clips_->ExportClipStream(context.get(), request);
+    v1::ExportClipResponse piece;
+    EXPECT_FALSE(reader->Read(&piece));
+    EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  }
+
+  // HTTP: chunked, the whole file, and a range; errors as JSON.
+  httplib::Client http = Http();
+  const httplib::Result whole = http.Get(absl::StrCat("/v1/clips/", id, "/bvh").c_str());
+  ASSERT_TRUE(whole);
+  EXPECT_EQ(whole->status, 200);
+  EXPECT_EQ(whole->get_header_value("Transfer-Encoding"), "chunked");
+  EXPECT_THAT(whole->get_header_value("Content-Disposition"),
+              HasSubstr("filename=\"take0.bvh\""));
+  const httplib::Result range =
+      http.Get(absl::StrCat("/v1/clips/", id, "/bvh?from=100&to=1999").c_str());
+  ASSERT_TRUE(range);
+  EXPECT_EQ(range->status, 200);
+  const httplib::Result missing = http.Get("/v1/clips/4242/bvh");
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->status, 404);
+  EXPECT_THAT(missing->body, HasSubstr("\"code\":5"));
+  const httplib::Result outside =
+      http.Get(absl::StrCat("/v1/clips/", id, "/bvh?to=", kLongFrames).c_str());
+  ASSERT_TRUE(outside);
+  EXPECT_EQ(outside->status, 400);
+
+  // The CLI: the stream written into the file, renamed into place once whole.
+  const std::string out = (dir_ / "exported.bvh").string();
+  const testing::CommandResult cli = testing::RunCli(
+      {"--server", server_->address(), "export", std::to_string(id), "-o", out, "--json"});
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_THAT(cli.out, HasSubstr(absl::StrCat("\"last_frame\":", kLongFrames - 1)));
+  EXPECT_FALSE(std::filesystem::exists(out + ".tmp"));
+  // A range outside the clip: the CLI's words for the field, and no file.
+  const std::string bad = (dir_ / "bad.bvh").string();
+  const testing::CommandResult refused_cli =
+      testing::RunCli({"--server", server_->address(), "export", std::to_string(id), "--to",
+                       std::to_string(kLongFrames), "-o", bad});
+  EXPECT_NE(refused_cli.exit_code, 0);
+  EXPECT_THAT(refused_cli.err, HasSubstr("--to"));
+  EXPECT_FALSE(std::filesystem::exists(bad));
+  EXPECT_FALSE(std::filesystem::exists(bad + ".tmp"));
+
+  ASSERT_EQ(Stop(), 0);
+  const std::string expected = StoredBvh(id);
+  EXPECT_EQ(grpc_text, expected);
+  EXPECT_EQ(whole->body, expected);
+  EXPECT_EQ(range->body, StoredBvh(id, FrameRange{100, 1999}));
+  EXPECT_EQ(testing::ReadFileOrDie(out), expected);
+}
 
 TEST_F(AnswerLimitServerTest, TheProbesBlendIsRefusedAndTheServerLives) {
   ASSERT_NO_FATAL_FAILURE(Start({}));  // the default limit, 256 MiB

@@ -2,9 +2,11 @@
 
 #include <cstdio>
 #include <fstream>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
 
 namespace motiondb {
 
@@ -25,23 +27,41 @@ absl::StatusOr<std::string> ReadFileBytes(const std::string& path, int64_t max_b
   return bytes;
 }
 
-absl::Status WriteFileAtomically(const std::string& path, absl::string_view bytes) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return absl::PermissionDeniedError(absl::StrCat(path, ": cannot create file"));
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) {
-      std::remove(temporary.c_str());
-      return absl::DataLossError(absl::StrCat(path, ": write failed"));
-    }
+AtomicFileWriter::AtomicFileWriter(std::string path)
+    : path_(std::move(path)),
+      temporary_(path_ + ".tmp"),
+      out_(temporary_, std::ios::binary | std::ios::trunc) {
+  if (!out_) status_ = absl::PermissionDeniedError(absl::StrCat(path_, ": cannot create file"));
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (committed_) return;
+  out_.close();
+  std::remove(temporary_.c_str());
+}
+
+absl::Status AtomicFileWriter::Append(absl::string_view bytes) {
+  if (!status_.ok()) return status_;
+  out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out_) status_ = absl::DataLossError(absl::StrCat(path_, ": write failed"));
+  return status_;
+}
+
+absl::Status AtomicFileWriter::Commit() {
+  if (!status_.ok()) return status_;
+  out_.close();
+  if (!out_) return status_ = absl::DataLossError(absl::StrCat(path_, ": write failed"));
+  if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    return status_ = absl::PermissionDeniedError(absl::StrCat(path_, ": cannot rename into place"));
   }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    return absl::PermissionDeniedError(absl::StrCat(path, ": cannot rename into place"));
-  }
+  committed_ = true;
   return absl::OkStatus();
+}
+
+absl::Status WriteFileAtomically(const std::string& path, absl::string_view bytes) {
+  AtomicFileWriter file(path);
+  MOTIONDB_RETURN_IF_ERROR(file.Append(bytes));
+  return file.Commit();
 }
 
 }  // namespace motiondb

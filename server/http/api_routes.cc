@@ -20,7 +20,7 @@ ApiRoute Post(std::string path, std::string rpc,
   return {"POST", std::move(path), std::move(rpc), std::move(fields), /*json_body=*/true};
 }
 
-// A route answered with a file rather than JSON.
+// A route answered with a file rather than JSON, chunked as its streaming call sends it.
 ApiRoute AsFile(ApiRoute route) {
   route.bvh_file = true;
   return route;
@@ -34,7 +34,7 @@ std::vector<ApiRoute> MakeRoutes() {
       Get("/v1/info", "motiondb.v1.ServerService.GetServerInfo"),
       Get("/v1/clips", absl::StrCat(kClipService, "ListClips")),
       Get("/v1/clips/{id}", absl::StrCat(kClipService, "GetClip"), {{"id", "clip_id"}}),
-      AsFile(Get("/v1/clips/{id}/bvh", absl::StrCat(kClipService, "ExportClip"),
+      AsFile(Get("/v1/clips/{id}/bvh", absl::StrCat(kClipService, "ExportClipStream"),
                  {{"id", "clip.clip_id"}, from, to})),
       Get("/v1/clips/{id}/poses", absl::StrCat(kClipService, "GetClipPoses"),
           {{"id", "clip.clip_id"}, from, to}),

@@ -19,7 +19,9 @@ struct ApiRoute {
   // ("id" -> "clip.clip_id"). Any other query parameter names a field itself ("clip.clip_id").
   std::vector<std::pair<std::string, std::string>> fields;
   bool json_body = false;  // the request message is the body's JSON (POST)
-  bool bvh_file = false;   // the answer is ExportClipResponse.bvh as a file, not JSON
+  // The answer is ExportClipStream's file, chunked as it arrives (server/http/chunked_file.h),
+  // not JSON.
+  bool bvh_file = false;
 
   // "GET /v1/clips/{id}": the route as metrics and errors name it.
   std::string Name() const { return http_method + " " + path; }

@@ -48,20 +48,84 @@ std::string Attachment(absl::string_view file_name) {
   return absl::StrCat("attachment; filename=\"", ascii, "\"; filename*=UTF-8''", encoded);
 }
 
-HttpReply FileReply(const Message& response) {
-  const auto& exported = dynamic_cast<const v1::ExportClipResponse&>(response);
-  HttpReply reply;
-  reply.content_type = "text/plain; charset=utf-8";
-  reply.body = exported.bvh();
-  reply.headers.push_back({"Content-Disposition", Attachment(exported.file_name())});
-  return reply;
-}
+// A file whose request did not convert: no call, the error its reply.
+class RefusedFile final : public FileStream {
+ public:
+  explicit RefusedFile(HttpReply error) : error_(std::move(error)) {}
+  const HttpReply& head() const override { return error_; }
+  bool Next(std::string*) override { return false; }
+  bool ok() const override { return false; }
+
+ private:
+  HttpReply error_;
+};
+
+class ExportStream final : public FileStream {
+ public:
+  // `context` prepared (deadline, peer); reads the first message.
+  ExportStream(std::unique_ptr<grpc::ClientContext> context, v1::ClipService::Stub& stub,
+               const v1::ExportClipRequest& request)
+      : context_(std::move(context)), reader_(stub.ExportClipStream(context_.get(), request)) {
+    if (!reader_->Read(&message_)) {
+      Finish();
+      const grpc::Status status =
+          status_.ok() ? grpc::Status(grpc::StatusCode::INTERNAL, "the export sent nothing")
+                       : status_;
+      head_ = ErrorReply(status.error_code(), status.error_message());
+      return;
+    }
+    head_.content_type = "text/plain; charset=utf-8";
+    head_.headers.push_back({"Content-Disposition", Attachment(message_.file_name())});
+    pending_ = std::move(*message_.mutable_bvh());
+  }
+
+  ~ExportStream() override {
+    if (finished_) return;
+    context_->TryCancel();
+    while (reader_->Read(&message_)) {
+    }
+    Finish();
+  }
+
+  const HttpReply& head() const override { return head_; }
+
+  bool Next(std::string* piece) override {
+    while (pending_.empty()) {
+      if (finished_ || !reader_->Read(&message_)) {
+        Finish();
+        return false;
+      }
+      pending_ = std::move(*message_.mutable_bvh());
+    }
+    *piece = std::move(pending_);
+    pending_.clear();
+    return true;
+  }
+
+  bool ok() const override { return finished_ && status_.ok(); }
+
+ private:
+  void Finish() {
+    if (finished_) return;
+    finished_ = true;
+    status_ = reader_->Finish();
+  }
+
+  std::unique_ptr<grpc::ClientContext> context_;
+  std::unique_ptr<grpc::ClientReader<v1::ExportClipResponse>> reader_;
+  v1::ExportClipResponse message_;
+  HttpReply head_;
+  std::string pending_;  // a piece read and not yet given
+  bool finished_ = false;
+  grpc::Status status_;
+};
 
 }  // namespace
 
 ApiTranscoder::ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s,
                              int64_t max_answer_bytes)
-    : stub_(std::move(channel)),
+    : stub_(channel),
+      clips_(v1::ClipService::NewStub(channel)),
       call_timeout_(call_timeout_s),
       max_answer_bytes_(max_answer_bytes) {}
 
@@ -80,15 +144,20 @@ absl::StatusOr<std::unique_ptr<ApiTranscoder>> ApiTranscoder::Create(
   return transcoder;
 }
 
+void ApiTranscoder::Prepare(grpc::ClientContext* context, absl::string_view peer,
+                            absl::string_view scope) const {
+  context->set_deadline(
+      std::chrono::system_clock::now() +
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(call_timeout_));
+  context->AddMetadata(kHttpPeerMetadata, std::string(peer));
+  if (!scope.empty()) context->AddMetadata(kHttpScopeMetadata, std::string(scope));
+}
+
 grpc::Status ApiTranscoder::Invoke(const MethodDescriptor& method, const Message& request,
                                    Message* response, absl::string_view peer,
                                    absl::string_view scope) const {
   grpc::ClientContext context;
-  context.set_deadline(
-      std::chrono::system_clock::now() +
-      std::chrono::duration_cast<std::chrono::system_clock::duration>(call_timeout_));
-  context.AddMetadata(kHttpPeerMetadata, std::string(peer));
-  if (!scope.empty()) context.AddMetadata(kHttpScopeMetadata, std::string(scope));
+  Prepare(&context, peer, scope);
   std::promise<grpc::Status> done;
   stub_.UnaryCall(&context, absl::StrCat("/", method.service()->full_name(), "/", method.name()),
                   grpc::StubOptions(), &request, response,
@@ -135,18 +204,29 @@ HttpReply ApiTranscoder::Call(const ApiRoute& route, const HttpCall& call) const
   const std::unique_ptr<Message> response = NewMessage(method.output_type());
   const grpc::Status status = Invoke(method, *request, response.get(), call.peer, call.scope);
   if (!status.ok()) return ErrorReply(status.error_code(), status.error_message());
-  if (route.bvh_file) return FileReply(*response);
   absl::StatusOr<std::string> json = AnswerJson(*response, static_cast<size_t>(max_answer_bytes_));
   if (!json.ok()) {
-    return ErrorReply(
-        grpc::StatusCode::RESOURCE_EXHAUSTED,
-        absl::StrCat(json.status().message(), ", the server's answer limit (--max-answer-mb), "
-                                              "though its gRPC answer is within it: ask for less "
-                                              "(a range, a smaller page), or call the gRPC method"));
+    return ErrorReply(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                      absl::StrCat(json.status().message(),
+                                   ", the server's answer limit (--max-answer-mb), "
+                                   "though its gRPC answer is within it: ask for less "
+                                   "(a range, a smaller page), or call the gRPC method"));
   }
   HttpReply reply;
   reply.body = *std::move(json);
   return reply;
+}
+
+std::unique_ptr<FileStream> ApiTranscoder::OpenFile(const ApiRoute& route,
+                                                    const HttpCall& call) const {
+  v1::ExportClipRequest request;
+  if (const absl::Status filled = FillRequest(route, call, &request); !filled.ok()) {
+    return std::make_unique<RefusedFile>(
+        ErrorReply(grpc::StatusCode::INVALID_ARGUMENT, filled.message()));
+  }
+  auto context = std::make_unique<grpc::ClientContext>();
+  Prepare(context.get(), call.peer, call.scope);
+  return std::make_unique<ExportStream>(std::move(context), *clips_, request);
 }
 
 bool ApiTranscoder::Ready(absl::string_view peer) const {

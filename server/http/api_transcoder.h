@@ -22,6 +22,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/http/api_routes.h"
 
 namespace motiondb::server {
@@ -42,6 +43,21 @@ struct HttpCall {
   std::string scope;  // what the caller's token holds ("read", ...), for GetServerInfo
 };
 
+// A file sent as a server-streaming call sends it (ExportClipStream): the reply's status and
+// headers from the call's first message (or, when the call fails first, the whole error reply),
+// then the file's pieces as they arrive. Destroyed before its end, it cancels the call, so that
+// the server stops writing.
+class FileStream {
+ public:
+  virtual ~FileStream() = default;
+  // Status 200 with the file's headers (and no body), or the error reply.
+  virtual const HttpReply& head() const = 0;
+  // The next piece of the file (never empty); false at the end, or when the call failed after
+  // its first message (ok() false: the file is cut short).
+  virtual bool Next(std::string* piece) = 0;
+  virtual bool ok() const = 0;
+};
+
 class ApiTranscoder {
  public:
   // Calls through `channel`, each with a deadline `call_timeout_s` from its start; answers whose
@@ -50,11 +66,14 @@ class ApiTranscoder {
   static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
       std::shared_ptr<grpc::Channel> channel, double call_timeout_s, int64_t max_answer_bytes);
 
-  // The route's call: its request from the path values and the query parameters, or the body
+  // The route's call (not a bvh_file route's): its request from the path values and the query parameters, or the body
   // (json_body); 400 with the error body for a request that does not convert, else the call's
   // status mapped (server/http/http_status.h) with the answer or the error body (429,
   // RESOURCE_EXHAUSTED, when the answer's JSON would pass the answer limit).
   HttpReply Call(const ApiRoute& route, const HttpCall& call) const;
+
+  // A bvh_file route's call, ExportClipStream, its request made as Call makes it.
+  std::unique_ptr<FileStream> OpenFile(const ApiRoute& route, const HttpCall& call) const;
 
   // Whether the server serves (the standard health service's overall status is SERVING).
   bool Ready(absl::string_view peer) const;
@@ -65,6 +84,10 @@ class ApiTranscoder {
 
   ApiTranscoder(std::shared_ptr<grpc::Channel> channel, double call_timeout_s,
                 int64_t max_answer_bytes);
+  // A call's context: its deadline, the HTTP peer for the request log, and the scope of the
+  // caller's token (empty: none) for the access check.
+  void Prepare(grpc::ClientContext* context, absl::string_view peer,
+               absl::string_view scope) const;
   // Calls `method` in-process and waits for its answer.
   grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
                       const google::protobuf::Message& request, google::protobuf::Message* response,
@@ -73,6 +96,7 @@ class ApiTranscoder {
                            google::protobuf::Message* request) const;
 
   mutable GenericStub stub_;  // UnaryCall is not const, but the stub keeps no per-call state
+  std::unique_ptr<v1::ClipService::Stub> clips_;  // the file routes' streaming calls
   const std::chrono::duration<double> call_timeout_;
   const int64_t max_answer_bytes_;
   std::map<std::string, const google::protobuf::MethodDescriptor*> methods_;  // by rpc name

@@ -19,6 +19,7 @@
 #include "server/grpc/status_conversion.h"
 #include "server/http/api_routes.h"
 #include "server/http/api_transcoder.h"
+#include "server/http/chunked_file.h"
 #include "server/http/head_checks.h"
 #include "server/http/http_exchange.h"
 #include "server/http/http_status.h"
@@ -224,6 +225,7 @@ void AddApiRoutes(const ApiTranscoder& api, httplib::Server& http) {
       call.body = request.body;
       call.peer = Peer(request);
       call.scope = std::string(TokenScopeName(exchange.scope));
+      if (route.bvh_file) return SendChunkedFile(api.OpenFile(route, call), response);
       Send(api.Call(route, call), response);
     };
     const std::string pattern = route.PathRegex();

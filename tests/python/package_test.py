@@ -249,6 +249,65 @@ class TokenTest(unittest.TestCase):
                     self.assertEqual(server.wait(timeout=30), 0)
 
 
+class AnswerLimitTest(unittest.TestCase):
+    """A server whose answers are at most 1 MiB (--max-answer-mb 1): export() streams a take whose
+    BVH is past the limit."""
+
+    def test_export_streams_past_the_limit(self):
+        import grpc
+        from motiondb.v1 import clip_service_pb2, clip_service_pb2_grpc, common_pb2
+        with tempfile.TemporaryDirectory() as folder:
+            log_path = os.path.join(folder, "server.log")
+            with open(log_path, "w") as log:
+                server = subprocess.Popen(
+                    [SERVER, "--db", os.path.join(folder, "t.sqlite"), "--listen", "127.0.0.1:0",
+                     "--http", "off", "--max-answer-mb", "1"],
+                    stdout=subprocess.DEVNULL, stderr=log)
+                try:
+                    address = f"127.0.0.1:{logged_port(log_path, server)}"
+                    with motiondb.connect(address) as client:
+                        frames = 40000  # about 5 MB of BVH, its bound 10 MB
+                        clip_id = client.ingest(arm_raise_bvh(frames).encode(),
+                                                name="long").clip.clip_id
+                        stub = clip_service_pb2_grpc.ClipServiceStub(
+                            grpc.insecure_channel(address))
+                        with self.assertRaises(grpc.RpcError) as raised:
+                            stub.ExportClip(clip_service_pb2.ExportClipRequest(
+                                clip=common_pb2.ClipRange(clip_id=clip_id)), timeout=30)
+                        self.assertEqual(raised.exception.code(),
+                                         grpc.StatusCode.RESOURCE_EXHAUSTED)
+                        self.assertIn("--max-answer-mb", raised.exception.details())
+
+                        path = pathlib.Path(folder) / "long.bvh"
+                        first = client.export("long", path)
+                        self.assertEqual((first.file_name, first.first_frame, first.last_frame),
+                                         ("long.bvh", 0, frames - 1))
+                        self.assertFalse(first.bvh)
+                        self.assertFalse(path.with_name("long.bvh.tmp").exists())
+                        text = path.read_text()
+                        self.assertGreater(len(text), 1 << 20)
+                        self.assertIn(f"Frames: {frames}\n", text)
+                        self.assertEqual(len(text.split("MOTION\n")[1].splitlines()), 2 + frames)
+                        # A range: the unary export's text, written by the stream.
+                        ranged = pathlib.Path(folder) / "range.bvh"
+                        client.export(clip_id, ranged, first=100, last=199)
+                        unary = stub.ExportClip(clip_service_pb2.ExportClipRequest(
+                            clip=common_pb2.ClipRange(clip_id=clip_id, first_frame=100,
+                                                      last_frame=199)), timeout=30)
+                        self.assertEqual(ranged.read_bytes(), unary.bvh)
+                        # A failed export leaves no file.
+                        with self.assertRaises(motiondb.Error) as failed:
+                            client.export(clip_id, pathlib.Path(folder) / "bad.bvh", last=frames)
+                        self.assertEqual(failed.exception.code, "INVALID_ARGUMENT")
+                        self.assertEqual(sorted(p.name for p in pathlib.Path(folder).iterdir()
+                                                if p.suffix in (".bvh", ".tmp")),
+                                         ["long.bvh", "range.bvh"])
+
+                finally:
+                    server.send_signal(signal.SIGTERM)
+                    self.assertEqual(server.wait(timeout=30), 0)
+
+
 class TlsTest(unittest.TestCase):
     def test_connects_with_the_servers_certificate(self):
         if shutil.which("openssl") is None:

@@ -193,6 +193,31 @@ class Client:
         self._call(self._clips.DeleteClip,
                    clip_service_pb2.DeleteClipRequest(clip_id=self.clip_id(clip)))
 
+    @_rpc
+    def export(self, clip: ClipRef, path: Union[str, os.PathLike], first: Optional[int] = None,
+               last: Optional[int] = None) -> clip_service_pb2.ExportClipResponse:
+        """Writes a clip, or its frames first..last, as a BVH file at path (ExportClipStream: a
+        clip of any size, written as its pieces arrive, into path + ".tmp" renamed into place
+        once whole). Returns the first message without its text: file_name (the server's
+        suggestion), first_frame, last_frame."""
+        request = clip_service_pb2.ExportClipRequest(clip=self._range(clip, first, last))
+        target = pathlib.Path(path)
+        partial = target.with_name(target.name + ".tmp")
+        header = None
+        try:
+            with open(partial, "wb") as out:
+                for piece in self._clips.ExportClipStream(request, metadata=self._metadata,
+                                                          timeout=self.timeout):
+                    if header is None:
+                        header = clip_service_pb2.ExportClipResponse(
+                            file_name=piece.file_name, first_frame=piece.first_frame,
+                            last_frame=piece.last_frame)
+                    out.write(piece.bvh)
+            os.replace(partial, target)
+        finally:
+            partial.unlink(missing_ok=True)
+        return header
+
     def clip_id(self, clip: ClipRef) -> int:
         """A clip's id: an int is one already; a str is looked up as the clip's exact name
         (Error NOT_FOUND when no clip has it)."""
