@@ -204,10 +204,14 @@ absl::StatusOr<int64_t> DeleteLabels(storage::Database& database, const LabelDel
   return database.DeleteLabels(deletion.label_ids, {.should_stop = should_stop});
 }
 
-absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id) {
+absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id,
+                                             const PageRequest& page, const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, LabelListingPage(page, answers));
   ClipTimeline timeline;
   MOTIONDB_ASSIGN_OR_RETURN(timeline.clip, Prefixed("clip_id", database.GetClipRecord(clip_id)));
-  MOTIONDB_ASSIGN_OR_RETURN(timeline.labels, database.ClipLabels(clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(storage::LabelPage labels, database.ClipLabels(clip_id, stored));
+  timeline.labels = std::move(labels.labels);
+  timeline.next_page_token = std::move(labels.next_page_token);
   return timeline;
 }
 

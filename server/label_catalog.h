@@ -72,12 +72,15 @@ struct LabelDeletion {
 absl::StatusOr<int64_t> DeleteLabels(storage::Database& database, const LabelDeletion& deletion,
                                      const std::function<bool()>& should_stop = {});
 
-// A clip and its labels by first frame; NOT_FOUND naming clip_id for an unknown clip.
+// A clip and a page of its labels by first frame, pages as ListLabels'; NOT_FOUND naming
+// clip_id for an unknown clip.
 struct ClipTimeline {
   storage::ClipRecord clip;
   std::vector<storage::LabelRecord> labels;
+  std::string next_page_token;  // empty on the last page
 };
-absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id);
+absl::StatusOr<ClipTimeline> GetClipTimeline(storage::Database& database, int64_t clip_id,
+                                             const PageRequest& page, const AnswerLimit& answers);
 
 }  // namespace motiondb::server
 

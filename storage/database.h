@@ -262,9 +262,10 @@ class Database {
   // then by clip and first frame. INVALID_ARGUMENT for an empty descriptor, a min_value
   // outside [0, 1], more than kMaxTags tags or a malformed page token.
   absl::StatusOr<LabelPage> FindLabels(const Page& page, const LabelQuery& query);
-  // Every label of a clip, by first frame (then last frame, id): its timeline. NOT_FOUND naming
-  // clip_id.
-  absl::StatusOr<std::vector<LabelRecord>> ClipLabels(int64_t clip_id);
+  // A clip's labels by first frame (then last frame, id), its timeline, a page at a time as
+  // ListLabels gives them (its token is the last label's first and last frames and id).
+  // NOT_FOUND naming clip_id.
+  absl::StatusOr<LabelPage> ClipLabels(int64_t clip_id, const Page& page);
   // Deletes the labels of these ids, and those propagated from them, in one transaction;
   // returns how many of the ids there were. NOT_FOUND naming label_ids[i] when an id is unknown,
   // and nothing is deleted.

@@ -136,6 +136,29 @@ absl::StatusOr<FindStart> ParseFindToken(const std::string& page_token) {
   return start;
 }
 
+// Where a page of a clip's timeline starts: after the label of this first frame, last frame and
+// id. The first page starts before every label.
+struct TimelineStart {
+  int64_t first_frame = -1, last_frame = -1, label_id = 0;
+};
+
+// "t:FIRST:LAST:ID".
+std::string TimelineToken(const LabelRecord& last) {
+  return absl::StrCat("t:", last.first_frame, ":", last.last_frame, ":", last.label_id);
+}
+
+absl::StatusOr<TimelineStart> ParseTimelineToken(const std::string& page_token) {
+  TimelineStart start;
+  if (page_token.empty()) return start;
+  const std::vector<std::string> parts = absl::StrSplit(page_token, ':');
+  if (parts.size() != 4 || parts[0] != "t" || !absl::SimpleAtoi(parts[1], &start.first_frame) ||
+      !absl::SimpleAtoi(parts[2], &start.last_frame) ||
+      !absl::SimpleAtoi(parts[3], &start.label_id)) {
+    return MalformedToken(page_token);
+  }
+  return start;
+}
+
 // NOT_FOUND naming `field` when no clip has `clip_id`.
 absl::Status CheckClipExists(SqliteConnection& db, int64_t clip_id, absl::string_view field) {
   MOTIONDB_ASSIGN_OR_RETURN(const bool exists,
@@ -330,19 +353,29 @@ absl::StatusOr<LabelPage> Database::FindLabels(const Page& page, const LabelQuer
   return result;
 }
 
-absl::StatusOr<std::vector<LabelRecord>> Database::ClipLabels(int64_t clip_id) {
-  std::vector<LabelRecord> labels;
+absl::StatusOr<LabelPage> Database::ClipLabels(int64_t clip_id, const Page& page) {
+  MOTIONDB_ASSIGN_OR_RETURN(const int page_size, CheckPageSize(page.page_size));
+  MOTIONDB_ASSIGN_OR_RETURN(const TimelineStart start, ParseTimelineToken(page.page_token));
+  LabelPage result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_RETURN_IF_ERROR(CheckClipExists(db, clip_id, "clip_id"));
+    // (first frame, last frame, id) orders every label of the clip once, so a page starts
+    // right after the last one of the page before.
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement query,
-        db.Prepare(
-            LabelSelect("WHERE l.clip_id = ? ORDER BY l.first_frame, l.last_frame, l.label_id")));
-    query.BindInt64(1, clip_id);
-    MOTIONDB_ASSIGN_OR_RETURN(labels, ReadLabels(query));
+        db.Prepare(LabelSelect("WHERE l.clip_id = ?1 AND (l.first_frame, l.last_frame, "
+                               "l.label_id) > (?2, ?3, ?4) ORDER BY l.first_frame, l.last_frame, "
+                               "l.label_id LIMIT ?5")));
+    query.BindInt64(1, clip_id)
+        .BindInt64(2, start.first_frame)
+        .BindInt64(3, start.last_frame)
+        .BindInt64(4, start.label_id)
+        .BindInt64(5, page_size + 1);
+    MOTIONDB_ASSIGN_OR_RETURN(std::vector<LabelRecord> labels, ReadLabels(query));
+    result = PageOf(std::move(labels), page_size, TimelineToken);
     return absl::OkStatus();
   }));
-  return labels;
+  return result;
 }
 
 absl::StatusOr<int64_t> Database::DeleteLabels(const std::vector<int64_t>& label_ids,

@@ -292,6 +292,98 @@ TEST_F(AnswerLimitServerTest, ABatchsSearchesShareTheLimit) {
   EXPECT_LE(static_cast<int64_t>(answer.ByteSizeLong()), kMiB);
 }
 
+TEST_F(AnswerLimitServerTest, TimelinesComeInPagesAndJsonPastTheLimitIsRefused) {
+  ASSERT_NO_FATAL_FAILURE(Start({"--max-answer-mb", "1"}));
+  ASSERT_NO_FATAL_FAILURE(LoadLibrary());
+  auto labels = v1::LabelService::NewStub(channel_);
+  constexpr int kLabels = 1500;
+  for (int first = 0; first < kLabels; first += 500) {
+    v1::AddLabelsRequest add;
+    for (int i = first; i < first + 500; ++i) {
+      v1::NewLabel* label = add.add_labels();
+      label->set_clip_id(ids_[0]);
+      label->set_first_frame(i);
+      label->set_last_frame(i + 10);
+      label->set_descriptor_name("step");
+    }
+    v1::AddLabelsResponse added;
+    const grpc::Status status = labels->AddLabels(Context().get(), add, &added);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+  // Pages of at most what 1 MiB holds, in timeline order, together every label once.
+  v1::GetClipLabelsRequest request;
+  request.set_clip_id(ids_[0]);
+  request.set_page_size(1000);
+  std::vector<int> firsts;
+  int pages = 0;
+  do {
+    v1::GetClipLabelsResponse page;
+    const grpc::Status status = labels->GetClipLabels(Context().get(), request, &page);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_LT(page.labels_size(), 1000);
+    for (const v1::Label& label : page.labels()) firsts.push_back(label.first_frame());
+    request.set_page_token(page.next_page_token());
+    ++pages;
+  } while (!request.page_token().empty());
+  EXPECT_EQ(pages, 3);
+  ASSERT_EQ(static_cast<int>(firsts.size()), kLabels);
+  for (int i = 0; i < kLabels; ++i) EXPECT_EQ(firsts[i], i);
+  // By default a page of 100.
+  v1::GetClipLabelsRequest first_page;
+  first_page.set_clip_id(ids_[0]);
+  v1::GetClipLabelsResponse page;
+  ASSERT_TRUE(labels->GetClipLabels(Context().get(), first_page, &page).ok());
+  EXPECT_EQ(page.labels_size(), 100);
+  httplib::Client http = Http();
+  const httplib::Result json =
+      http.Get(absl::StrCat("/v1/clips/", ids_[0], "/labels?page_size=2").c_str());
+  ASSERT_TRUE(json);
+  EXPECT_EQ(json->status, 200);
+  v1::GetClipLabelsResponse from_json;
+  ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(json->body, &from_json).ok());
+  EXPECT_EQ(from_json.labels_size(), 2);
+  EXPECT_FALSE(from_json.next_page_token().empty());
+
+  // Poses whose encoding fits the limit but whose JSON (base64, a third larger) does not: the
+  // gRPC answer, then HTTP's refusal; half as many frames pass both.
+  const auto poses_path = [&](int last) {
+    return absl::StrCat("/v1/clips/", ids_[0], "/poses?max_rate=0&from=0&to=", last);
+  };
+  v1::GetClipPosesRequest poses;
+  poses.mutable_clip()->set_clip_id(ids_[0]);
+  poses.mutable_clip()->set_first_frame(0);
+  poses.set_max_rate(0);
+  // The last frame of the longest range admitted, by bisection: `admitted` OK, `refused` not.
+  int admitted = 0, refused = kLongFrames - 1;
+  v1::ClipPoses answer;
+  while (refused - admitted > 1) {
+    const int last = admitted + (refused - admitted) / 2;
+    poses.mutable_clip()->set_last_frame(last);
+    const grpc::Status status = clips_->GetClipPoses(Context().get(), poses, &answer);
+    ASSERT_TRUE(status.ok() || status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED)
+        << status.error_message();
+    if (!status.ok()) {
+      EXPECT_THAT(status.error_message(), HasSubstr("max_rate"));
+    }
+    (status.ok() ? admitted : refused) = last;
+  }
+  poses.mutable_clip()->set_last_frame(admitted);
+  ASSERT_TRUE(clips_->GetClipPoses(Context().get(), poses, &answer).ok());
+  EXPECT_LE(static_cast<int64_t>(answer.ByteSizeLong()), kMiB);
+  EXPECT_GT(static_cast<int64_t>(answer.ByteSizeLong()), kMiB * 3 / 4);
+  const int last = admitted;
+  const httplib::Result too_long = http.Get(poses_path(last).c_str());
+  ASSERT_TRUE(too_long);
+  EXPECT_EQ(too_long->status, 429);
+  const std::string refusal = too_long->body.substr(0, 400);  // not a whole answer, if one came
+  EXPECT_THAT(refusal, HasSubstr("answer's JSON is longer than"));
+  EXPECT_THAT(refusal, HasSubstr("--max-answer-mb"));
+  const httplib::Result fits = http.Get(poses_path(last / 2).c_str());
+  ASSERT_TRUE(fits);
+  EXPECT_EQ(fits->status, 200);
+  EXPECT_LE(static_cast<int64_t>(fits->body.size()), kMiB);
+}
+
 TEST_F(AnswerLimitServerTest, TheFlagIsChecked) {
   for (const char* value : {"0", "2048"}) {
     testing::ServerProcess server;

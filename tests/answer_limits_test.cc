@@ -444,6 +444,20 @@ TEST_F(AnswerLimitTest, LabelPagesHoldWhatTheLimitAdmitsAndBatchesAreRefusedPast
               return FindLabels(*library->database, page, {.descriptor = "wave"}, answers);
             }),
             30);
+  EXPECT_EQ(read_all([&](const PageRequest& page) -> absl::StatusOr<storage::LabelPage> {
+              absl::StatusOr<ClipTimeline> timeline =
+                  GetClipTimeline(*library->database, library->ids[1], page, answers);
+              if (!timeline.ok()) return timeline.status();
+              return storage::LabelPage{timeline->labels, timeline->next_page_token};
+            }),
+            30);
+  // The timeline's pages are in its order: by first frame.
+  const absl::StatusOr<ClipTimeline> first =
+      GetClipTimeline(*library->database, library->ids[1], {0, ""}, AnswerLimit());
+  ASSERT_TRUE(first.ok());
+  ASSERT_EQ(first->labels.size(), 30u);
+  EXPECT_EQ(first->labels[0].first_frame, 0);
+  EXPECT_EQ(first->labels[29].first_frame, 29);
   ASSERT_TRUE(DeleteLabels(*library->database, {{}, {.clip_id = library->ids[1]}}).ok());
 }
 

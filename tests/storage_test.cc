@@ -1557,11 +1557,23 @@ TEST_F(StorageTest, LabelsAreListedFoundAndTimelinedAndPagedOnce) {
             (std::vector<int64_t>{(*ids)[1]}));
   EXPECT_TRUE(Db().FindLabels({}, {.descriptor = "jump"})->labels.empty());
 
-  // A clip's timeline, by first frame.
-  const absl::StatusOr<std::vector<LabelRecord>> timeline = Db().ClipLabels(walk);
+  // A clip's timeline, by first frame, a page at a time.
+  const absl::StatusOr<LabelPage> timeline = Db().ClipLabels(walk, {});
   ASSERT_TRUE(timeline.ok()) << timeline.status();
-  EXPECT_EQ(IdsOf(*timeline), (std::vector<int64_t>{(*ids)[2], (*ids)[3], (*ids)[0]}));
-  EXPECT_EQ(Db().ClipLabels(4242).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(IdsOf(timeline->labels), (std::vector<int64_t>{(*ids)[2], (*ids)[3], (*ids)[0]}));
+  EXPECT_TRUE(timeline->next_page_token.empty());
+  std::vector<int64_t> timeline_pages;
+  Page timeline_page{.page_size = 2, .page_token = ""};
+  do {
+    const absl::StatusOr<LabelPage> next = Db().ClipLabels(walk, timeline_page);
+    ASSERT_TRUE(next.ok()) << next.status();
+    for (const LabelRecord& label : next->labels) timeline_pages.push_back(label.label_id);
+    timeline_page.page_token = next->next_page_token;
+  } while (!timeline_page.page_token.empty());
+  EXPECT_EQ(timeline_pages, IdsOf(timeline->labels));
+  EXPECT_EQ(Db().ClipLabels(4242, {}).status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(Db().ClipLabels(walk, {.page_token = "f:1:2:3:4"}).status().code(),
+            absl::StatusCode::kInvalidArgument);
 
   // Tokens of another listing, and bad queries, are refused.
   EXPECT_EQ(Db().FindLabels({.page_token = "7"}, {.descriptor = "step"}).status().code(),
@@ -1638,7 +1650,7 @@ TEST_F(StorageTest, LabelQueriesRefuseTooManyTagsForgedTokensAndUnknownClips) {
   };
   names_clip(Db().ListLabels({}, {.clip_id = 4242}).status());
   names_clip(Db().DeleteLabels(LabelFilter{.clip_id = 4242}).status());
-  names_clip(Db().ClipLabels(4242).status());
+  names_clip(Db().ClipLabels(4242, {}).status());
   EXPECT_EQ(CountsNow().labels, 1);
 }
 

@@ -64,7 +64,8 @@ grpc::Status LabelServiceImpl::GetClipLabels(grpc::ServerContext* context,
                                              const v1::GetClipLabelsRequest* request,
                                              v1::GetClipLabelsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<ClipTimeline> timeline = GetClipTimeline(database_, request->clip_id());
+    const absl::StatusOr<ClipTimeline> timeline = GetClipTimeline(
+        database_, request->clip_id(), {request->page_size(), request->page_token()}, answers_);
     if (!timeline.ok()) return ToGrpcStatus(timeline.status());
     ToProto(*timeline, response);
     return grpc::Status::OK;

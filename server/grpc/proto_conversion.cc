@@ -580,6 +580,7 @@ void ToProto(const ClipTimeline& timeline, v1::GetClipLabelsResponse* response) 
   for (const storage::LabelRecord& record : timeline.labels) {
     ToProto(record, response->add_labels());
   }
+  response->set_next_page_token(timeline.next_page_token);
 }
 
 namespace {

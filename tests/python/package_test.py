@@ -251,9 +251,9 @@ class TokenTest(unittest.TestCase):
 
 class AnswerLimitTest(unittest.TestCase):
     """A server whose answers are at most 1 MiB (--max-answer-mb 1): export() streams a take whose
-    BVH is past the limit."""
+    BVH is past the limit, and clip_labels() reads every page of a timeline past it."""
 
-    def test_export_streams_past_the_limit(self):
+    def test_export_streams_past_the_limit_and_timelines_come_in_pages(self):
         import grpc
         from motiondb.v1 import clip_service_pb2, clip_service_pb2_grpc, common_pb2
         with tempfile.TemporaryDirectory() as folder:
@@ -303,6 +303,12 @@ class AnswerLimitTest(unittest.TestCase):
                                                 if p.suffix in (".bvh", ".tmp")),
                                          ["long.bvh", "range.bvh"])
 
+                        for start in range(0, 1500, 500):  # a batch's answer is bounded too
+                            client.add_labels([("long", f, f + 5, "step")
+                                               for f in range(start, start + 500)])
+                        timeline = client.clip_labels("long")
+                        self.assertEqual([label.first_frame for label in timeline],
+                                         list(range(1500)))
                 finally:
                     server.send_signal(signal.SIGTERM)
                     self.assertEqual(server.wait(timeout=30), 0)

@@ -388,11 +388,10 @@ class Client:
                 return
             request.page_token = response.next_page_token
 
-    @_rpc
-    def clip_labels(self, clip: ClipRef) -> List[Label]:
-        """A clip's label timeline: all its labels by first frame."""
-        return list(self._call(self._labels.GetClipLabels, label_service_pb2.GetClipLabelsRequest(
-            clip_id=self.clip_id(clip))).labels)
+    def clip_labels(self, clip: ClipRef, page_size: int = 1000) -> List[Label]:
+        """A clip's label timeline: all its labels by first frame (every page read)."""
+        return list(self._pages(self._labels.GetClipLabels, label_service_pb2.GetClipLabelsRequest(
+            clip_id=self.clip_id(clip), page_size=page_size)))
 
     @_rpc
     def delete_labels(self, ids: Iterable[int] = (), clip: Optional[ClipRef] = None,

@@ -31,6 +31,9 @@ export interface FrameRange {
 /** A search's query: a stored clip range or an uploaded BVH file (base64). */
 export type SearchQuery = { range: FrameRange } | { bvhBase64: string; fileName: string };
 
+// The server's largest page (fewer when its answer limit is below 2 MiB; the pages then follow).
+const LABEL_PAGE_SIZE = 1000;
+
 export const api = {
   info: () => call<ServerInfo>("GET", "/v1/info"),
 
@@ -56,7 +59,21 @@ export const api = {
       query: { clip: range.clipId, from: range.first, to: range.last, dims },
     }),
 
-  clipLabels: (clipId: string) => call<ClipLabels>("GET", `/v1/clips/${clipId}/labels`),
+  /** A clip's label timeline, every page of it. */
+  clipLabels: async (clipId: string): Promise<ClipLabels> => {
+    const page = (pageToken: string) =>
+      call<ClipLabels>("GET", `/v1/clips/${clipId}/labels`, {
+        query: { page_size: LABEL_PAGE_SIZE, page_token: pageToken },
+      });
+    const first = await page("");
+    const labels = [...first.labels];
+    for (let token = first.next_page_token; token; ) {
+      const next = await page(token);
+      labels.push(...next.labels);
+      token = next.next_page_token;
+    }
+    return { ...first, labels, next_page_token: "" };
+  },
 
   search: (space: string, query: SearchQuery, maxResults: number) =>
     call<SearchResponse>("POST", "/v1/search", {

@@ -89,6 +89,7 @@ export interface ClipLabels {
   frame_count: number;
   fps: number;
   labels: Label[];
+  next_page_token: string; // empty on the last page
 }
 
 export type JobState =
