@@ -5,7 +5,7 @@
 #   scripts/fuzz.sh [--seconds S] [TARGET...]   (default: every target, 60 s each)
 #
 # Targets (tests/fuzz/TARGET_fuzzer.cc): bvh_reader, search_request, page_token, space_request,
-# stream_ingest, http_route, label_file. Each keeps its corpus in build-fuzz/corpus/TARGET
+# stream_ingest, http_route, http_request, label_file. Each keeps its corpus in build-fuzz/corpus/TARGET
 # (build* is gitignored), seeded from tests/fuzz/seeds/TARGET/; the BVH-reading targets also from
 # ../shared/mocap/conformance/*.bvh when present (copied into the corpus only: their licence
 # forbids copying them into the repository). Prints each target's executions; exits non-zero at
@@ -23,7 +23,7 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]]; then
   exit 2
 fi
 targets=("$@")
-((${#targets[@]})) || targets=(bvh_reader search_request page_token space_request stream_ingest http_route
+((${#targets[@]})) || targets=(bvh_reader search_request page_token space_request stream_ingest http_route http_request
   label_file)
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

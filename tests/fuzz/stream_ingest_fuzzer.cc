@@ -32,7 +32,7 @@ struct Messages {
 };
 
 struct NoWatch {
-  void Touch() {}
+  void Touch(size_t) {}
   absl::Status Status() const { return absl::OkStatus(); }
 };
 
