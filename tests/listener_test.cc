@@ -45,9 +45,17 @@ bool ClosedByServer(const SocketFd& socket) {
   return ::recv(socket.get(), &byte, 1, 0) <= 0;
 }
 
+// Waits for `condition`; false if it has not held after a minute, far more than any of these
+// take on a loaded machine, so that a listener that never gets there fails the test rather than
+// hanging it.
 template <typename Condition>
-void WaitUntil(Condition condition) {
-  while (!condition()) std::this_thread::yield();
+[[nodiscard]] bool WaitUntil(Condition condition) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > give_up) return false;
+    std::this_thread::yield();
+  }
+  return true;
 }
 
 // Accepted connections, kept open (with their places) until the test clears them.
@@ -115,14 +123,14 @@ TEST(ListenerTest, RefusesBeyondThePerPeerLimitAndTakesAgainOncePlacesFree) {
   listener->Start(kept.Handler(), nullptr, nullptr);
   std::vector<SocketFd> clients;
   for (int i = 0; i < 3; ++i) clients.push_back(Connect(listener->port()));
-  WaitUntil([&] { return kept.count + listener->refused() == 3; });
+  ASSERT_TRUE(WaitUntil([&] { return kept.count + listener->refused() == 3; }));
   EXPECT_EQ(kept.count, 2);
   EXPECT_EQ(listener->refused(), 1);
   EXPECT_TRUE(ClosedByServer(clients[2]));
   EXPECT_TRUE(listener->accepting());  // only this address is at its limit
   kept.Clear();                        // the two accepted close: their places come back
   SocketFd again = Connect(listener->port());
-  WaitUntil([&] { return kept.count + listener->refused() == 4; });
+  ASSERT_TRUE(WaitUntil([&] { return kept.count + listener->refused() == 4; }));
   EXPECT_EQ(kept.count, 3);
 }
 
@@ -133,10 +141,10 @@ TEST(ListenerTest, ATotalLimitStopsAcceptingAndReadinessSaysSo) {
   listener->Start(
       kept.Handler(), [&](int, absl::string_view) { ++refusals_told; }, nullptr);
   SocketFd a = Connect(listener->port()), b = Connect(listener->port());
-  WaitUntil([&] { return kept.count == 2; });
+  ASSERT_TRUE(WaitUntil([&] { return kept.count == 2; }));
   EXPECT_FALSE(listener->accepting());
   SocketFd c = Connect(listener->port());
-  WaitUntil([&] { return listener->refused() == 1; });
+  ASSERT_TRUE(WaitUntil([&] { return listener->refused() == 1; }));
   EXPECT_EQ(refusals_told, 1);  // the refuser had its word before the close
   kept.Clear();
   EXPECT_TRUE(listener->accepting());
@@ -157,14 +165,14 @@ TEST(ListenerTest, ReclaimGivesBackThePlacesOfHandedOffConnectionsThatClosed) {
       },
       nullptr, [&] { handed_off.Sweep(); });
   SocketFd first = Connect(listener->port());
-  WaitUntil([&] { return handed == 1; });
+  ASSERT_TRUE(WaitUntil([&] { return handed == 1; }));
   EXPECT_EQ(handed_off.held(), 1);
   {
     std::lock_guard<std::mutex> lock(mutex);
     ::close(sockets[0]);  // the library closes it and tells nobody
   }
   SocketFd second = Connect(listener->port());
-  WaitUntil([&] { return handed + listener->refused() == 2; });
+  ASSERT_TRUE(WaitUntil([&] { return handed + listener->refused() == 2; }));
   EXPECT_EQ(handed, 2) << "the closed connection's place was not reclaimed";
   std::lock_guard<std::mutex> lock(mutex);
   for (size_t i = 1; i < sockets.size(); ++i) ::close(sockets[i]);
@@ -205,7 +213,7 @@ TEST(ListenerTest, SurvivesRunningOutOfDescriptors) {
     listener->Start(kept.Handler(), nullptr, nullptr);
     // One connection accepted, so the test's client has its own descriptor before the rest go.
     SocketFd client = Connect(listener->port());
-    WaitUntil([&] { return kept.count == 1; });
+    if (!WaitUntil([&] { return kept.count == 1; })) fail();
     const rlimit low{64, 64};
     ++step;
     if (setrlimit(RLIMIT_NOFILE, &low) != 0) fail();
@@ -217,7 +225,7 @@ TEST(ListenerTest, SurvivesRunningOutOfDescriptors) {
     SocketFd starved = Connect(listener->port());
     ++step;
     if (!starved.valid()) fail();
-    WaitUntil([&] { return listener->descriptor_shortages() > 0; });
+    if (!WaitUntil([&] { return listener->descriptor_shortages() > 0; })) fail();
     ++step;
     if (listener->accepting()) fail();
     if (!ClosedByServer(starved)) fail();  // taken off the backlog and closed
@@ -225,8 +233,8 @@ TEST(ListenerTest, SurvivesRunningOutOfDescriptors) {
     SocketFd after = Connect(listener->port());
     ++step;
     if (!after.valid()) fail();
-    WaitUntil([&] { return kept.count == 2; });
-    WaitUntil([&] { return listener->accepting(); });
+    if (!WaitUntil([&] { return kept.count == 2; })) fail();
+    if (!WaitUntil([&] { return listener->accepting(); })) fail();
     _exit(0);
   }
   int status = 0;

@@ -191,12 +191,13 @@ void Listener::AcceptReady(int listening) {
     socklen_t length = sizeof(address);
     SocketFd socket(::accept4(listening, reinterpret_cast<sockaddr*>(&address), &length,
                               SOCK_NONBLOCK | SOCK_CLOEXEC));
+    if (!socket.valid() &&
+        (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM)) {
+      socket = AcceptWithSpare(listening, &address, &length);
+      // The backlog is empty, or its connection was closed for want of descriptors.
+      if (!socket.valid()) return;
+    }
     if (!socket.valid()) {
-      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-        OutOfDescriptors(listening);
-        if (!spare_.valid()) return;  // nothing to drain the backlog with: wait for the tick
-        continue;
-      }
       // EAGAIN: the backlog is empty; ECONNABORTED, EINTR, a network error the connection
       // carried (EPROTO, ENETDOWN, ...): that connection only.
       if (errno == EAGAIN || errno == EWOULDBLOCK) return;
@@ -229,24 +230,40 @@ void Listener::Refuse(SocketFd socket, absl::string_view reason) {
   LogRefusals(/*force=*/false);
 }
 
-void Listener::OutOfDescriptors(int listening) {
+SocketFd Listener::AcceptWithSpare(int listening, sockaddr_storage* address, socklen_t* length) {
   const int error = errno;
-  const bool already = starved_.exchange(true);
-  ++shortages_;
-  if (!already && options_.log) {
-    options_.log(absl::StrCat(options_.face, ": cannot accept a connection: ", std::strerror(error),
-                              "; refusing connections until descriptors free up (raise "
-                              "`ulimit -n`, or lower the connection limits)"));
+  if (!spare_.valid()) spare_ = OpenSpare();
+  if (!spare_.valid()) {
+    Starved(error);
+    std::this_thread::sleep_for(kStarvedPause);
+    return SocketFd();
   }
-  // The waiting connection stays in the backlog and would wake the loop again at once: give up
-  // the spare descriptor to take it off and close it.
-  if (spare_.valid()) {
-    spare_.Reset();
-    SocketFd dropped(::accept4(listening, nullptr, nullptr, SOCK_CLOEXEC));
-    dropped.Reset();
+  // Linux takes the descriptor before it looks at the backlog, so the backlog may be empty, and
+  // a connection may have come as descriptors freed up: take it with the spare's descriptor, and
+  // keep it when the spare can be had again.
+  spare_.Reset();
+  SocketFd socket(::accept4(listening, reinterpret_cast<sockaddr*>(address), length,
+                            SOCK_NONBLOCK | SOCK_CLOEXEC));
+  spare_ = OpenSpare();
+  if (socket.valid() && spare_.valid()) return socket;
+  Starved(error);
+  if (socket.valid()) {
+    // Left in the backlog it would wake the loop again at once: closed.
+    socket.Reset();
     spare_ = OpenSpare();
   }
   if (!spare_.valid()) std::this_thread::sleep_for(kStarvedPause);
+  return SocketFd();
+}
+
+void Listener::Starved(int error) {
+  // starved_ before the count, so that a reader who sees the count sees the listener starved.
+  const bool already = starved_.exchange(true);
+  ++shortages_;
+  if (already || !options_.log) return;
+  options_.log(absl::StrCat(options_.face, ": cannot accept a connection: ", std::strerror(error),
+                            "; refusing connections until descriptors free up (raise "
+                            "`ulimit -n`, or lower the connection limits)"));
 }
 
 void Listener::MaybeReclaim(bool force) {

@@ -14,6 +14,8 @@
 #ifndef MOTIONDB_SERVER_NET_LISTENER_H_
 #define MOTIONDB_SERVER_NET_LISTENER_H_
 
+#include <sys/socket.h>
+
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -34,7 +36,7 @@ struct ListenerOptions {
   std::string listen;
   // The face's name in log lines and errors ("gRPC", "HTTP"), and the flag that sets `listen`.
   std::string face;
-  std::string flag;
+  std::string flag{};
   ConnectionLimits limits;
   // Free-form log lines (refusals, at most one a second with counts; descriptor exhaustion).
   std::function<void(absl::string_view)> log;
@@ -84,7 +86,11 @@ class Listener {
   void Run();
   void AcceptReady(int listening);
   void Refuse(SocketFd socket, absl::string_view reason);
-  void OutOfDescriptors(int listening);
+  // After an accept failed for want of a descriptor: the waiting connection, taken with the
+  // spare descriptor, when descriptors have freed up; else an invalid socket, the connection (if
+  // any) closed and the listener starved.
+  SocketFd AcceptWithSpare(int listening, sockaddr_storage* address, socklen_t* length);
+  void Starved(int error);
   void MaybeReclaim(bool force);
   void LogRefusals(bool force);
 
