@@ -187,8 +187,7 @@ TEST_F(AnswerLimitServerTest, AClipPastTheLimitExportsWholeByTheStreamOnEveryFac
   ASSERT_TRUE(whole);
   EXPECT_EQ(whole->status, 200);
   EXPECT_EQ(whole->get_header_value("Transfer-Encoding"), "chunked");
-  EXPECT_THAT(whole->get_header_value("Content-Disposition"),
-              HasSubstr("filename=\"take0.bvh\""));
+  EXPECT_THAT(whole->get_header_value("Content-Disposition"), HasSubstr("filename=\"take0.bvh\""));
   const httplib::Result range =
       http.Get(absl::StrCat("/v1/clips/", id, "/bvh?from=100&to=1999").c_str());
   ASSERT_TRUE(range);

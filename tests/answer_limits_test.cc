@@ -201,8 +201,10 @@ class AnswerLimitTest : public ::testing::Test {
   }
 
   static EditContext Context(int64_t limit) {
-    return EditContext{*library->database, *library->catalog, library->registry,
-                       AnswerLimit(limit)};
+    return EditContext{.database = *library->database,
+                       .catalog = *library->catalog,
+                       .registry = library->registry,
+                       .answers = AnswerLimit(limit)};
   }
 };
 
@@ -589,7 +591,7 @@ TEST_F(AnswerLimitTest, PoseModelsAndDetectionsAreRefusedPastTheLimit) {
     request.set_model("limit-pose");
     *request.mutable_clip() = Range(1, 0, frames - 1);
     return Serve<v1::DetectPoseResponse>(
-        request, kDetectLimit, [&](const DetectRequest& r) { return DetectPose(context, r); });
+        request, kDetectLimit, [&](const DetectRequest& r) { return DetectPose(context, r, {}); });
   });
   // A model's answer holds its request: its examples grow it.
   constexpr int64_t kModelLimit = kAnswerFixedBytes + (int64_t{4} << 10);

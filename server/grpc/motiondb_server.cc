@@ -127,8 +127,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.info = std::make_unique<ServerInfoServiceImpl>(*s.database, s.registry, s.options, *s.access,
                                                    *s.gate);
   s.edits = std::make_unique<EditServiceImpl>(
-      EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames, answers},
-      *s.gate);
+      EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames, answers}, *s.gate);
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,

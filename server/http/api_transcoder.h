@@ -66,10 +66,10 @@ class ApiTranscoder {
   static absl::StatusOr<std::unique_ptr<ApiTranscoder>> Create(
       std::shared_ptr<grpc::Channel> channel, double call_timeout_s, int64_t max_answer_bytes);
 
-  // The route's call (not a bvh_file route's): its request from the path values and the query parameters, or the body
-  // (json_body); 400 with the error body for a request that does not convert, else the call's
-  // status mapped (server/http/http_status.h) with the answer or the error body (429,
-  // RESOURCE_EXHAUSTED, when the answer's JSON would pass the answer limit).
+  // The route's call (not a bvh_file route's): its request from the path values and the query
+  // parameters, or the body (json_body); 400 with the error body for a request that does not
+  // convert, else the call's status mapped (server/http/http_status.h) with the answer or the error
+  // body (429, RESOURCE_EXHAUSTED, when the answer's JSON would pass the answer limit).
   HttpReply Call(const ApiRoute& route, const HttpCall& call) const;
 
   // A bvh_file route's call, ExportClipStream, its request made as Call makes it.
@@ -86,8 +86,7 @@ class ApiTranscoder {
                 int64_t max_answer_bytes);
   // A call's context: its deadline, the HTTP peer for the request log, and the scope of the
   // caller's token (empty: none) for the access check.
-  void Prepare(grpc::ClientContext* context, absl::string_view peer,
-               absl::string_view scope) const;
+  void Prepare(grpc::ClientContext* context, absl::string_view peer, absl::string_view scope) const;
   // Calls `method` in-process and waits for its answer.
   grpc::Status Invoke(const google::protobuf::MethodDescriptor& method,
                       const google::protobuf::Message& request, google::protobuf::Message* response,

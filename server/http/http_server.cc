@@ -312,9 +312,9 @@ absl::StatusOr<std::unique_ptr<HttpServer>> HttpServer::Start(const HttpOptions&
   MOTIONDB_ASSIGN_OR_RETURN(RequestChecks checks,
                             RequestChecks::Create(options.allowed_hosts, options.cors_origins));
   auto state = std::make_unique<State>(server);
-  MOTIONDB_ASSIGN_OR_RETURN(
-      state->api, ApiTranscoder::Create(server.InProcessChannel(), options.call_timeout_s,
-                                        int64_t{server.options().max_answer_mb} << 20));
+  MOTIONDB_ASSIGN_OR_RETURN(state->api,
+                            ApiTranscoder::Create(server.InProcessChannel(), options.call_timeout_s,
+                                                  int64_t{server.options().max_answer_mb} << 20));
   MOTIONDB_ASSIGN_OR_RETURN(state->tls, NewTlsContext(server.options()));
   HttpRouter& router = state->router;
   router.set_keep_alive_max_count(options.loop.max_requests_per_connection);

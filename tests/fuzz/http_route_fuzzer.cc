@@ -47,8 +47,8 @@ HttpFace& TheHttpFace() {
     made->server = *std::move(server);
     // A deadline as the server's default, shorter: large but valid parameters are slow, not
     // wrong.
-    auto transcoder = motiondb::server::ApiTranscoder::Create(
-        made->server->InProcessChannel(), 0.2, int64_t{options.max_answer_mb} << 20);
+    auto transcoder = motiondb::server::ApiTranscoder::Create(made->server->InProcessChannel(), 0.2,
+                                                              int64_t{options.max_answer_mb} << 20);
     if (!transcoder.ok()) std::abort();
     made->transcoder = *std::move(transcoder);
     for (const ApiRoute& route : motiondb::server::ApiRoutes()) {
