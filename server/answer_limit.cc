@@ -53,6 +53,14 @@ int64_t BvhFieldBytes(const Skeleton& skeleton, int64_t frames) {
   return TextFieldBytes(BvhTextBound(skeleton, frames));
 }
 
+int64_t ClipListItemBytes() {
+  // Ids, times, counts, rate, duration; the name, source file, hash, a tag each, and the
+  // provenance's operator, space, parameters and a framing each; the clip's own in its list.
+  constexpr int64_t kNumbers = 8;
+  constexpr int64_t kTextFields = 3 + static_cast<int64_t>(storage::kMaxTags) + 4;
+  return kNumbers * kNumberFieldBytes + (kTextFields + 1) * kFieldFramingBytes;
+}
+
 int64_t LabelAnswerBytes() {
   // Ids, frames, seconds, value, origin, score, creation time; the clip's name, the descriptor,
   // the space's name and the job's id; the label's own framing in its list.

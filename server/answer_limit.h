@@ -63,6 +63,11 @@ int64_t BvhFieldBytes(const Skeleton& skeleton, int64_t frames);
 // A label (LabelService's Label): every name at its longest.
 int64_t LabelAnswerBytes();
 
+// A clip in a listing (ClipService.ListClips) besides its text (names, hash, tags, provenance),
+// which the listing's page counts as it reads it (storage::ClipFilter::max_text_bytes): its
+// numbers and the framing of its text fields.
+int64_t ClipListItemBytes();
+
 // A clip's poses (ClipService.GetClipPoses): frames x joints x 3 float32, the joints' names and
 // parents.
 int64_t PosesAnswerBytes(const Skeleton& skeleton, int64_t frames);

@@ -33,12 +33,21 @@ absl::StatusOr<storage::Page> StoragePage(const PageRequest& page) {
 }
 
 absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database,
-                                            const ClipListRequest& request) {
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::Page stored, StoragePage(request.page));
+                                            const ClipListRequest& request,
+                                            const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(storage::Page stored, StoragePage(request.page));
+  stored.page_size =
+      static_cast<int>(std::min<int64_t>(stored.page_size, answers.MostItems(ClipListItemBytes())));
+  // The text's encoding is at most its length and a framing a field (counted above), but a
+  // provenance's sources are encoded from its JSON, where one takes at least 42 characters
+  // against at most kClipRangeBytes (43) encoded: half the rest leaves room for that.
+  const int64_t rest =
+      answers.max_bytes() - kAnswerFixedBytes - int64_t{stored.page_size} * ClipListItemBytes();
   storage::ClipFilter filter{.tag = request.tag,
                              .name_contains = request.name_contains,
                              .skeleton_id = request.skeleton_id,
-                             .descriptor = request.descriptor};
+                             .descriptor = request.descriptor,
+                             .max_text_bytes = std::max<int64_t>(1, rest / 2)};
   MOTIONDB_ASSIGN_OR_RETURN(filter.order, ClipOrderOf(request.sort));
   return database.ListClips(stored, filter);
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "server/answer_limit.h"
 #include "server/index_registry.h"
 #include "storage/database.h"
 
@@ -33,8 +34,11 @@ struct ClipListRequest {
   std::string descriptor;   // clips carrying a label of it; empty: any
 };
 
+// A page holds at most the clips an answer of `answers` holds: fewer than page_size when their
+// text (an operator's clip's provenance holds its request) would pass it.
 absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database,
-                                            const ClipListRequest& request);
+                                            const ClipListRequest& request,
+                                            const AnswerLimit& answers);
 
 // A skeleton's name for people: its root joint's and its first clip's, "Hips (01_01)"; the
 // root's alone when it has no clip.

@@ -143,6 +143,10 @@ struct ClipFilter {
   int64_t skeleton_id = 0;           // only clips of this skeleton; 0: any
   std::string descriptor{};          // only clips carrying a label of it; empty: any
   ClipOrder order = ClipOrder::kId;  // ties (created) in id order
+  // A page ends before the clip that would bring its clips' text (names, hash, tags,
+  // provenance) past this many bytes, and holds at least one clip; 0: no bound. An operator's
+  // clip's provenance holds its request, so a clip's text has no small bound of its own.
+  int64_t max_text_bytes = 0;
 };
 
 struct ClipPage {

@@ -111,15 +111,33 @@ absl::Status WriteRotations(SqliteConnection& db, int64_t clip_id, const RowMatr
 
 // The records, tags included, of the rows `query` returns: bound, and selecting
 // kClipRecordColumns of clips as `c`.
+// The text a clip's record holds: what ClipFilter::max_text_bytes counts.
+int64_t TextBytes(const ClipRecord& record) {
+  int64_t bytes = static_cast<int64_t>(record.name.size() + record.source_file.size() +
+                                       record.content_hash.size() + record.provenance.size());
+  for (const std::string& tag : record.tags) bytes += static_cast<int64_t>(tag.size());
+  return bytes;
+}
+
+// The records `query` (bound) selects, in its order; with `max_text_bytes` (> 0), only those
+// whose text fits it (at least one), `*cut` set when a record was left out for it.
 absl::StatusOr<std::vector<ClipRecord>> ReadClipRecords(SqliteConnection& db,
-                                                        SqliteStatement& query) {
+                                                        SqliteStatement& query,
+                                                        int64_t max_text_bytes = 0,
+                                                        bool* cut = nullptr) {
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
   std::vector<ClipRecord> records;
+  int64_t text_bytes = 0;
   while (true) {
     MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
     if (!row) return records;
     ClipRecord record = ReadClipRecord(query);
     MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, record.clip_id));
+    text_bytes += TextBytes(record);
+    if (max_text_bytes > 0 && text_bytes > max_text_bytes && !records.empty()) {
+      if (cut != nullptr) *cut = true;
+      return records;
+    }
     records.push_back(std::move(record));
   }
 }
@@ -446,6 +464,10 @@ absl::Status CheckClipFilter(const ClipFilter& filter) {
   if (!filter.descriptor.empty()) {
     MOTIONDB_RETURN_IF_ERROR(CheckDescriptor("descriptor", filter.descriptor));
   }
+  if (filter.max_text_bytes < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_text_bytes: ", filter.max_text_bytes, " is negative (0: no bound)"));
+  }
   if (filter.skeleton_id < 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("skeleton_id: ", filter.skeleton_id, " is negative (0: any skeleton)"));
@@ -495,11 +517,14 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter&
       }
       query.BindInt64(5, after_ms);
     }
-    MOTIONDB_ASSIGN_OR_RETURN(result.clips, ReadClipRecords(db, query));
+    bool cut = false;
+    MOTIONDB_ASSIGN_OR_RETURN(result.clips,
+                              ReadClipRecords(db, query, filter.max_text_bytes, &cut));
     if (static_cast<int>(result.clips.size()) > page_size) {
       result.clips.pop_back();
-      result.next_page_token = PageToken(filter.order, result.clips.back());
+      cut = true;
     }
+    if (cut) result.next_page_token = PageToken(filter.order, result.clips.back());
     // In the same read transaction: the total agrees with the page.
     MOTIONDB_ASSIGN_OR_RETURN(result.total_size, CountClips(db, filter));
     return absl::OkStatus();

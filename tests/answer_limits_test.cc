@@ -26,7 +26,9 @@
 #include "server/edit_transitions.h"
 #include "server/grpc/proto_conversion.h"
 #include "server/label_catalog.h"
+#include "server/listing.h"
 #include "server/pose_models.h"
+#include "server/provenance.h"
 #include "server/search_runner.h"
 #include "server/space_curve.h"
 #include "storage/database.h"
@@ -461,6 +463,51 @@ TEST_F(AnswerLimitTest, LabelPagesHoldWhatTheLimitAdmitsAndBatchesAreRefusedPast
   EXPECT_EQ(first->labels[0].first_frame, 0);
   EXPECT_EQ(first->labels[29].first_frame, 29);
   ASSERT_TRUE(DeleteLabels(*library->database, {{}, {.clip_id = library->ids[1]}}).ok());
+}
+
+// An operator's clip's provenance holds its request, so a clip's record has no small bound: a
+// listing's page ends before the clip whose text would take its answer past the limit.
+TEST_F(AnswerLimitTest, ClipPagesHoldWhatTheLimitAdmits) {
+  std::vector<int64_t> heavy;
+  for (int i = 0; i < 4; ++i) {
+    Provenance provenance{"blend", "body", {{library->ids[0], {0, 9}}, {library->ids[1], {0, 9}}}};
+    provenance.parameters_json =
+        absl::StrCat("{\"note\": \"", std::string(300 << 10, 'a' + i), "\"}");
+    storage::ClipRecord record;
+    record.name = absl::StrCat("heavy", i);
+    record.source_file = record.name;
+    record.provenance = ProvenanceJson(provenance);
+    const absl::StatusOr<IngestedClip> ingested =
+        library->catalog->IngestClip(record, Take(10 + i));
+    ASSERT_TRUE(ingested.ok()) << ingested.status();
+    heavy.push_back(ingested->record.clip_id);
+  }
+  const auto read_all = [](const AnswerLimit& answers, int* pages) {
+    int64_t total = 0;
+    ClipListRequest request{.page = {1000, ""}};
+    *pages = 0;
+    do {
+      const absl::StatusOr<storage::ClipPage> page =
+          ListClips(*library->database, request, answers);
+      EXPECT_TRUE(page.ok()) << page.status();
+      if (!page.ok()) break;
+      v1::ListClipsResponse response;
+      ToProto(*page, &response);
+      EXPECT_LE(static_cast<int64_t>(response.ByteSizeLong()), answers.max_bytes());
+      EXPECT_FALSE(page->clips.empty());
+      total += static_cast<int64_t>(page->clips.size());
+      ++*pages;
+      request.page.page_token = page->next_page_token;
+    } while (!request.page.page_token.empty());
+    return total;
+  };
+  int pages = 0;
+  // 1 MiB, the flag's least: the four heavy clips' 300 KiB provenances take four pages.
+  EXPECT_EQ(read_all(AnswerLimit(int64_t{1} << 20), &pages), ClipCount());
+  EXPECT_GE(pages, 4);
+  EXPECT_EQ(read_all(AnswerLimit(), &pages), ClipCount());
+  EXPECT_EQ(pages, 1);
+  for (const int64_t id : heavy) ASSERT_TRUE(library->database->DeleteClip(id).ok());
 }
 
 // ---------------------------------------------------------------------------------------------

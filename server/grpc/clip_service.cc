@@ -87,7 +87,7 @@ grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
                                         v1::ListClipsResponse* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
     const absl::StatusOr<storage::ClipPage> page =
-        server::ListClips(database_, FromProto(*request));
+        server::ListClips(database_, FromProto(*request), answers_);
     if (!page.ok()) return ToGrpcStatus(page.status());
     ToProto(*page, response);
     return grpc::Status::OK;

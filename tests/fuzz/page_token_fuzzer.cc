@@ -33,7 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!listed.ok()) break;
       next = listed->next_page_token;
     } else {
-      const absl::StatusOr<storage::ClipPage> listed = server::ListClips(*library.database, clips);
+      const absl::StatusOr<storage::ClipPage> listed =
+          server::ListClips(*library.database, clips, server::AnswerLimit());
       fuzz::CheckNotInternal(listed.status(), "ListClips");
       if (!listed.ok()) break;
       next = listed->next_page_token;
