@@ -1,6 +1,7 @@
 // The operators' figures (issue 16) on real capture: pose detection's precision and recall over
 // a labelled folder, MC-LERP against SLERP, smoothing of noisy clips by level, and the seams of
-// Hermite gap filling against linear. Not part of the test suite; numbers in bench/RESULTS.md.
+// Hermite gap filling against linear. Not part of the test suite; numbers in
+// bench/notes/2026-12-05-curve-operators.md and bench/RESULTS.md's table.
 //
 // usage: ops_measurements detect|interpolate|smooth|gap [--folder DIR] [options]
 //        ops_measurements speed [--calls N] [--fps F] [--only TEXT]  (every operator through a

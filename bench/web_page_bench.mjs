@@ -1,7 +1,7 @@
 // The web page's latency (issue 14): page ready with 1,000 clips in the library, and a search
 // from the page to rendered hits at the demo library, each beside a baseline measured in the
 // same run (the page on the 3-clip demo library; the same search as a bare POST /v1/search).
-// Not a test: the numbers go to bench/RESULTS.md.
+// Not a test: the numbers go to bench/RESULTS.md's table and a dated note in bench/notes/.
 //
 //   node bench/web_page_bench.mjs BUILD_DIR [--loads 10] [--searches 30]
 //

@@ -138,7 +138,8 @@ namespace {
 // The replaced snapshot itself is often still held, by the write that made the new one or by
 // searches, and its memory is returned at the next swap; so is whatever the last write freed.
 // With main.cc's allocator settings, a library grown by 16 ingesting clients went from 1.6-2.4x
-// the resident memory of the same library loaded fresh to 1.1x (bench/RESULTS.md, issue 15).
+// the resident memory of the same library loaded fresh to 1.1x
+// (bench/notes/2026-12-05-memory-growth.md).
 void Release(std::shared_ptr<const SpaceSnapshot> old) {
   old.reset();
 #ifdef __GLIBC__

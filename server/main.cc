@@ -241,12 +241,12 @@ int main(int argc, char** argv) {
   // malloc gets an arena of its own (up to 8 a core), every arena keeps what it frees, and
   // after the first large free glibc raises its mmap threshold (up to 32 MiB), so that upload
   // buffers and index copies come from the arenas too. One arena a core, and blocks from 2 MiB
-  // always mapped (returned when freed), with index_registry.cc's trimming: bench/RESULTS.md,
-  // issue 15. Up to 32 MiB free at the top of each arena (so up to 32 MiB a core when idle)
-  // stays mapped (128 KiB once the mmap threshold is set), so that an export's or an edit's buffers
-  // (0.5-2 MB for 10 s at 120 fps) are reused from call to call, not faulted in afresh: that was a
-  // fifth of their time (issue 16). MALLOC_ARENA_MAX, MALLOC_MMAP_THRESHOLD_ and
-  // MALLOC_TRIM_THRESHOLD_ in the environment still rule.
+  // always mapped (returned when freed), with index_registry.cc's trimming:
+  // bench/notes/2026-12-05-memory-growth.md. Up to 32 MiB free at the top of each arena (so up to
+  // 32 MiB a core when idle) stays mapped (128 KiB once the mmap threshold is set), so that an
+  // export's or an edit's buffers (0.5-2 MB for 10 s at 120 fps) are reused from call to call, not
+  // faulted in afresh: that was a fifth of their time (issue 16). MALLOC_ARENA_MAX,
+  // MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ in the environment still rule.
   if (std::getenv("MALLOC_ARENA_MAX") == nullptr) {
     mallopt(M_ARENA_MAX, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
   }

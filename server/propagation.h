@@ -70,13 +70,14 @@ double SimilarityFactor(double score, double scale);
 // rank whose score is taken. s0 was first the median k-th score of the job's own searches,
 // which moved with the job's max_results (its k), descriptors (which labels query) and tags
 // (which clips are searched), so that one score got different values in different jobs of one
-// space. bench/propagation_quality measured both on the Bandai clips (bench/RESULTS.md, "The
-// similarity factor's scale"): the job's own s0 ranged from 0.076 to 1.70 over the jobs of one
-// space (1, its fallback, when no list came back full), so that the clips whose label reached
-// 0.5 were 0.52 to 0.995 right depending on the job; with the space's (0.077 for every job) they
-// were 0.99 to 1.00 right in every experiment. Which labels a job keeps does not depend on s0.
-// The rank is kPropagationMaxResults, the results a job keeps by default; 2 s is about a
-// labelled action's length; 32 windows are 32 searches once per job and library version.
+// space. bench/propagation_quality measured both on the Bandai clips
+// (bench/notes/2026-12-02-propagation-quality.md, "The similarity factor's scale"): the job's own
+// s0 ranged from 0.076 to 1.70 over the jobs of one space (1, its fallback, when no list came back
+// full), so that the clips whose label reached 0.5 were 0.52 to 0.995 right depending on the job;
+// with the space's (0.077 for every job) they were 0.99 to 1.00 right in every experiment. Which
+// labels a job keeps does not depend on s0. The rank is kPropagationMaxResults, the results a job
+// keeps by default; 2 s is about a labelled action's length; 32 windows are 32 searches once per
+// job and library version.
 inline constexpr int kScaleWindows = 32;
 inline constexpr double kScaleWindowSeconds = 2.0;
 inline constexpr int kScaleRank = kPropagationMaxResults;

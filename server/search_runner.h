@@ -91,7 +91,7 @@ struct SearchOutcome {
 // otherwise (--max-query-frames). A query is an example of a motion: an action takes seconds,
 // and a query of several (characteristic_points) a minute at most; 4000 frames are 2 min 13 s at
 // the default 30 Hz, 33 s at 120 Hz. A search's memory grows with the square of its warps' rows
-// (docs/server-limits.md, "Deadlines and query length"; bench/RESULTS.md, issue 37).
+// (docs/server-limits.md, "Deadlines and query length"; bench/notes/2026-12-06-deadlines.md).
 inline constexpr int kDefaultMaxQueryFrames = 4000;
 
 // Thread-safe: searches run concurrently on immutable snapshots.

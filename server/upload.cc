@@ -8,7 +8,7 @@ namespace motiondb::server {
 namespace {
 
 // Bytes of BVH text parsed between two polls of a stop function: about a millisecond's parsing
-// (bench/RESULTS.md: bvh_parse_bench).
+// (bench/notes/2026-11-22-bvh-parse.md: bvh_parse_bench).
 constexpr size_t kUploadBytesPerStopPoll = size_t{256} << 10;
 
 }  // namespace

@@ -23,7 +23,8 @@ struct UploadLimits {
   int max_uploads = 32;
   // Bytes of text the ingests in progress may hold together (--max-upload-buffer-mb); a message
   // or chunk beyond fails its upload with RESOURCE_EXHAUSTED. An upload peaks at 1.9-4.2x its
-  // text (the parsed clip and its stored copy; bench/RESULTS.md), and no one upload's clip may
+  // text (the parsed clip and its stored copy;
+  // bench/notes/2026-12-03-upload-memory.md), and no one upload's clip may
   // take more than this either, so this is what bounds the server's memory under many uploads.
   int64_t max_buffered_bytes = int64_t{2} << 30;
   // An upload arriving slower than this on average, once `rate_grace` has passed, is ended

@@ -27,7 +27,7 @@ struct LabelledMotions {
 
 // The space of the detection measurements: the default weights with the arms' raised (upper and
 // lower arms x4, shoulders and hands x2, of Bandai's joints), as thesis 3.4 suggests for a pose
-// told by the arms (bench/RESULTS.md compares it with the defaults).
+// told by the arms (bench/notes/2026-12-05-curve-operators.md compares it with the defaults).
 SpaceOptions ArmsSpace();
 
 absl::StatusOr<LabelledMotions> LoadLabelledMotions(const std::filesystem::path& folder,

@@ -1,7 +1,8 @@
 // The operators on real capture (../shared/mocap/bandai2-normal; skipped when absent): pose
 // detection of raise-up-both-hands from five clips' peak poses (thesis 3.4), MC-LERP against
 // SLERP (4.1), smoothing of noisy clips (5.5.1) and Hermite gaps against linear ones (4.3).
-// bench/ops_measurements prints the same figures in full (bench/RESULTS.md).
+// bench/ops_measurements prints the same figures in full
+// (bench/notes/2026-12-05-curve-operators.md).
 #include <random>
 
 #include <gtest/gtest.h>

@@ -2,7 +2,8 @@
 // cancelled). A loop counts its work in units whose cost it knows (cells of a warp, frames of a
 // clip) and asks the caller's stop function once per `work_per_poll` units: often enough that a
 // stop is seen within about a millisecond of work, rarely enough that asking costs nothing
-// measurable (docs/server-limits.md, "Deadlines and query length"; bench/RESULTS.md).
+// measurable (docs/server-limits.md, "Deadlines and query length";
+// bench/notes/2026-12-06-deadlines.md).
 #ifndef MOTIONDB_UTIL_STOP_POLL_H_
 #define MOTIONDB_UTIL_STOP_POLL_H_
 

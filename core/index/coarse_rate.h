@@ -1,9 +1,10 @@
 // The rate, about 15 Hz, at which the fast search finds and warps its seeds: adjacent frames of
 // a held pose are near duplicates that take the seed budget (at 120 Hz, 1000 nearest frames
 // piled up in 9 of 75 instances), and a warp's cells grow with the square of the rate, while
-// refinement settles the kept candidates at the full rate anyway. Measured (bench/RESULTS.md,
-// issue 11; recall@10 against the exact search): 15 Hz against 30 Hz gave 0.98 against 0.90
-// on Bandai and 1.0 against 0.95 at 1 h, the same 0.95 at 10 h, in about the same time.
+// refinement settles the kept candidates at the full rate anyway. Measured
+// (bench/notes/2026-12-02-scale-seeds.md; recall@10 against the exact search): 15 Hz against 30 Hz
+// gave 0.98 against 0.90 on Bandai and 1.0 against 0.95 at 1 h, the same 0.95 at 10 h, in about the
+// same time.
 #ifndef MOTIONDB_CORE_INDEX_COARSE_RATE_H_
 #define MOTIONDB_CORE_INDEX_COARSE_RATE_H_
 

@@ -37,12 +37,13 @@ struct LibraryClip {
 // too, since a search over other dimensions cannot use the tree. The thesis's 10 (Table 6.2)
 // ranks seeds by dimensions the warp (5 by default) does not score: on 10 h of synthetic
 // capture the exact search's ten best lay up to 1,759th among distinct places by the
-// 10-dimensional pose distance and at most 170th by the 5-dimensional one (bench/RESULTS.md,
-// issue 11).
+// 10-dimensional pose distance and at most 170th by the 5-dimensional one
+// (bench/notes/2026-12-02-scale-seeds.md).
 inline constexpr int kDefaultAnnDims = 5;
 
 // Seed windows a quarter of a second either side of the frame. Measured by brute force on 10 h
-// of real capture (bench/RESULTS.md, issue 11; recall@10 against the exact search, 20 queries,
+// of real capture (bench/notes/2026-12-04-scale-settle-bound.md; recall@10 against the exact
+// search, 20 queries,
 // 500 seeds): one pose 0.885, windows of 0.13 s 0.940, 0.27 s 0.950, 0.5 s 0.895.
 inline constexpr double kDefaultSeedWindowS = 0.25;
 // Longer windows than this span whole actions rather than a pose's motion.

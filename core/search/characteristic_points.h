@@ -13,10 +13,10 @@ namespace motiondb {
 // The actions of a query (SearchParams::characteristic_points 0) are its runs of poses farther
 // from its first and last poses' mean (where a take starts and ends at rest) than this share of
 // the farthest, joined across dips shorter than kMinActionPauseS (a stride's or a wave's turn),
-// the shortest pause between two actions. Measured on compound queries (bench/RESULTS.md,
-// "Several characteristic points"): 0.35 missed a shrug beside an arm raise (P@N 0.72 where
-// points given one per action reach 0.91), 0.2 finds it; from the query's mean pose instead,
-// half of a raise's frames lie far from it on either side and one action gave two points.
+// the shortest pause between two actions. Measured on compound queries
+// (bench/notes/2026-12-04-characteristic-points.md): 0.35 missed a shrug beside an arm raise (P@N
+// 0.72 where points given one per action reach 0.91), 0.2 finds it; from the query's mean pose
+// instead, half of a raise's frames lie far from it on either side and one action gave two points.
 inline constexpr double kActionThreshold = 0.2;
 inline constexpr double kMinActionPauseS = 0.3;
 

@@ -23,12 +23,12 @@ using Clock = std::chrono::steady_clock;
 // Refinement lowers scores, so it considers this many candidates per result returned, per
 // thousand seeds (for fewer seeds, as for a thousand): a warp pinned to a seed in a held pose
 // can rank far below where its refined warp lands, and more seeds crowd it out of a small pool.
-// Measured (bench/RESULTS.md, issue 11; recall@10 against the exact search): 1 h at 30 Hz,
-// pools of 2 and 4 per result gave 0.81 and 0.95; 10 h, 4 and 8 gave 0.92 and 0.95; 100 h,
-// 2000 seeds, 16 and 24 gave 0.87 and 0.95.
+// Measured (bench/notes/2026-12-02-scale-seeds.md; recall@10 against the exact search):
+// 1 h at 30 Hz, pools of 2 and 4 per result gave 0.81 and 0.95; 10 h, 4 and 8 gave 0.92 and
+// 0.95; 100 h, 2000 seeds, 16 and 24 gave 0.87 and 0.95.
 constexpr double kRefinePoolPerThousandSeeds = 12;
 // Seed windows need half of it: their warps start nearer where refinement ends. Measured with
-// 500 windows (bench/RESULTS.md, issue 11, 2026-12-05; recall@10, p50), 12 / 6 / 4 per
+// 500 windows (bench/notes/2026-12-05-scale-window-seeds.md; recall@10, p50), 12 / 6 / 4 per
 // thousand: 10 h of real capture 0.945 / 0.945 / 0.945 (5.0 / 4.3 / 4.1 ms), 10 h at 30 Hz
 // 0.985 / 0.980 / 0.960 (3.8 / 2.9 / 2.8 ms), 10 h at 120 Hz 0.970 / 0.965 / 0.935 (6.5 / 4.7 /
 // 3.9 ms), 1 h 1.000 / 1.000 / 0.990, 70 s at 120 Hz 0.995 each.
@@ -40,24 +40,26 @@ double RefinePoolPerThousandSeeds(SeedSelection selection) {
 }
 // The best this share of the refined pool are settled at the full rate from the coarse rate:
 // coarse scores order nearly equal matches less surely the denser the library, and a settle
-// costs factor^2 times a coarse one. Measured over 20 queries each (bench/RESULTS.md, issue 11,
-// 2026-12-04; recall@10 against the exact search): at factor 2, two thirds gave 0.945 at 10 h and
-// 0.925 at 100 h, all of it 0.950 (2.8 ms) and 0.955 (9.2 ms); at 10 h / 120 Hz (factor 8) a
-// third gave 0.925 (3.4 ms), half 0.950 (4.1 ms), two thirds 0.960 (4.7 ms).
+// costs factor^2 times a coarse one. Measured over 20 queries each
+// (bench/notes/2026-12-04-scale-o3.md; recall@10 against the exact search): at factor 2, two
+// thirds gave 0.945 at 10 h and 0.925 at 100 h, all of it 0.950 (2.8 ms) and 0.955 (9.2 ms); at
+// 10 h / 120 Hz (factor 8) a third gave 0.925 (3.4 ms), half 0.950 (4.1 ms), two thirds 0.960
+// (4.7 ms).
 double FineShare(int factor) { return factor <= 2 ? 1.0 : 2.0 / 3.0; }
 
 // The default seeds are taken again, twice as many, at most this many times while they fall in
 // fewer than kClustersPerResult clusters a result, and while a doubling adds clusters. Measured
-// on 70 s at 120 Hz (one clip; 20 queries, bench/RESULTS.md, issue 11): 500 seed windows fell in
+// on 70 s at 120 Hz (one clip; 20 queries, bench/notes/2026-12-05-scale-window-seeds.md): 500 seed
+// windows fell in
 // 23 clusters and filled 16.1 of 20 results, 1000 in 40 clusters and 19.9.
 constexpr int kMostSeedDoublings = 3;
 constexpr size_t kClustersPerResult = 2;
 
 // Seed windows (SeedSelection::kNearestWindows) spread over more places than nearest frames do,
-// so fewer of them cover as much: on 10 h of real capture (bench/RESULTS.md, issue 11, 20
-// queries; recall@10 against the exact search) 250, 500 and 1000 gave 0.875, 0.945 and 0.975
-// (3.8, 5.5 and 8.7 ms with the nearest frames' refinement pool), where 1000 nearest frames
-// give 0.940 (6.5 ms).
+// so fewer of them cover as much: on 10 h of real capture
+// (bench/notes/2026-12-05-scale-window-seeds.md, 20 queries; recall@10 against the exact search)
+// 250, 500 and 1000 gave 0.875, 0.945 and 0.975 (3.8, 5.5 and 8.7 ms with the nearest frames'
+// refinement pool), where 1000 nearest frames give 0.940 (6.5 ms).
 constexpr int kWindowSeeds = 500;
 
 // The seeds of the nearest-frames selection when the search does not say: the thesis's 1000 up
@@ -165,7 +167,7 @@ void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
 // exact (RefineFromCoarse): over a run of the benchmark on 10 h of real capture, 42 of 19,000
 // settles were given up that would have settled under it (within 4% of it: the tail of the
 // results), at 100 h 3 of 32,000; recall@10 and the result counts the same in every scenario
-// (bench/RESULTS.md, issue 11), for settles that cost half as much.
+// (bench/notes/2026-12-04-scale-settle-bound.md), for settles that cost half as much.
 class ClipBestScores {
  public:
   explicit ClipBestScores(int k) : k_(k) {}

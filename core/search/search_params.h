@@ -26,7 +26,7 @@ enum class SeedSelection {
   // The thesis (6.2.2-6.2.3): the `neighbours` nearest frames, clustered in time. With seeds in
   // the warp's dimensions at about 15 Hz and a refinement pool of 8 per result, recall@10
   // against the exact search is 0.95-1.0 on synthetic capture from 70 s to 10 h and 0.98 on
-  // Bandai (bench/RESULTS.md, issue 11).
+  // Bandai (bench/notes/2026-12-02-scale-seeds.md).
   kNearestFrames,
   // The `places` nearest places to the characteristic pose, a quarter of the query's length
   // apart in a clip (LibraryIndex::NearestPlaces), one warp each: no better than the nearest
@@ -88,7 +88,8 @@ struct SearchParams {
   // each warp passing through its own seed's anchor. On 10 h of real capture (794 clusters from
   // 1000 seeds) recall@10 against the exact search rose from 0.85 to 0.94 (20 queries) for about
   // 0.6 ms more at the median; synthetic capture (at most 175 clusters) does not reach it, and
-  // Bandai's figures are unchanged (bench/RESULTS.md, issue 11). 0: one anchor always.
+  // Bandai's figures are unchanged (bench/notes/2026-12-04-scale-second-anchor.md). 0: one anchor
+  // always.
   double second_anchor_scatter = 0.5;
   // Seeds of one clip closer than this in time join one cluster.
   double cluster_gap_s = 0.1;

@@ -4,7 +4,8 @@
 // search's seeds and warps use, carry the most variance in the new metric: an LDA-like ratio of
 // the examples' spread to the groups' spread. Measured on bandai1's 15 styles (each style's
 // queries in a metric fitted on the other 14): leave-style-out precision@5 0.648 -> 0.806 at 5
-// warp dimensions and 0.828 at 10 (bench/RESULTS.md "A metric learned from the labels").
+// warp dimensions and 0.828 at 10 (bench/notes/2026-12-06-across-styles.md, "A metric learned
+// from the labels").
 #ifndef MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 #define MOTIONDB_CORE_SPACE_LEARNED_METRIC_H_
 

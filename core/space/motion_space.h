@@ -64,7 +64,7 @@ struct SpaceOptions {
   // walk at two leg lengths a second count like a joint of weight 1 bent by 1 rad. Measured of
   // 0.2-2: 0.5 raised bandai1's leave-style-out precision@5 from 0.360 to 0.648 and keeps
   // bandai2-normal's leave-one-out 0.988 and recall 0.972; 1 and more cost that recall (0.945)
-  // (bench/RESULTS.md "Retrieval across styles"). Finite and positive; unused without it.
+  // (bench/notes/2026-12-06-across-styles.md). Finite and positive; unused without it.
   double root_velocity_weight = 0.5;
   // The metric the space's distances use.
   SpaceMetric metric = SpaceMetric::kUnit;

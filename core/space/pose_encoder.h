@@ -28,7 +28,7 @@ struct PoseOptions {
   // With the facing removed, also append the pelvis's horizontal velocity in the facing's frame
   // (two numbers, in the clip's leg lengths a second, smoothed like the yaw rate): it tells a
   // walk from a walk backwards or a run in another style, where limbs alone mislead
-  // (root_velocity.h; bench/RESULTS.md "Retrieval across styles"). Ignored with the facing kept.
+  // (root_velocity.h; bench/notes/2026-12-06-across-styles.md). Ignored with the facing kept.
   bool root_velocity = true;
 };
 

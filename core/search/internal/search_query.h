@@ -34,7 +34,8 @@ std::vector<SearchResult> FinishResults(const LibraryIndex& library,
 // search's scan (other work is counted as the cells it costs about as much as). A cell costs
 // about a nanosecond, but the first touch of a fresh page of a warp's table costs as much as a
 // thousand cells on this machine's virtual memory: so that a stop is seen within a few
-// milliseconds even then, a poll every quarter million cells (bench/RESULTS.md, issue 37).
+// milliseconds even then, a poll every quarter million cells
+// (bench/notes/2026-12-06-deadlines.md).
 inline constexpr int64_t kCellsPerStopPoll = int64_t{1} << 18;
 
 // A search's poll of its should_stop, counting cells.

@@ -13,7 +13,7 @@ namespace {
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // Rows between looks at whether a band warp can still end under its bound. A look costs about
 // half a row's step at the default slope limit: looking at every row, and also without a bound,
-// took 70 s at 120 Hz from 0.88 to 1.13 ms a search (bench/RESULTS.md, issue 11).
+// took 70 s at 120 Hz from 0.88 to 1.13 ms a search (bench/notes/2026-12-04-scale-settle-bound.md).
 constexpr int64_t kRowsPerAbandonLook = 4;
 
 // One row of the band from the previous one, padding included: `prev` and `row` point at state
