@@ -1,21 +1,26 @@
 #!/usr/bin/python3
-"""Runs every command block of README.md as written, so that the README cannot drift.
+"""Runs every command block of README.md and docs/*.md as written, so that the docs cannot drift.
 
     readme_examples_test.py REPO BUILD_DIR
+    readme_examples_test.py --list REPO    # which blocks would run, from which page, in order
 
 The README's first command starts the server: this test runs scripts/start.sh itself (on free
 loopback ports for gRPC and HTTP, a fresh database and log in a temporary folder), then each
-```sh block in order in a temporary working folder (with build/, client/, scripts/ and proto/
-linked to the real ones), with the built `motiondb` on PATH and MOTIONDB_SERVER naming the
-test's server; the README's default addresses (127.0.0.1:50051, and 127.0.0.1:8080 for HTTP)
-are replaced by the test server's. A block preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must say which other
-check runs it. `<!-- readme-test: requires: TOOL -->` runs the block when TOOL is on PATH and
-says so when it is not; TOOL `npm-registry` means npm and a reachable npm registry (a machine
-that reaches only Debian's archive has neither the page's packages nor Buf's). Last,
-`scripts/start.sh --demo` must load its demo library into a fresh database, say where its web
-page is, and serve it there; without the npm registry start.sh serves the JSON API instead, as
-it documents, and says where. MOTIONDB_REQUIRE_NPM=1 (set by .ci/run) makes an unreachable
-registry a failure rather than a reason not to run.
+```sh block of each page in order in one temporary working folder (with build/, client/,
+scripts/ and proto/ linked to the real ones), against the one server, with the built `motiondb`
+on PATH and MOTIONDB_SERVER naming the test's server; the default addresses (127.0.0.1:50051,
+and 127.0.0.1:8080 for HTTP) are replaced by the test server's. The pages run in PAGE_ORDER
+(README.md first, then the docs pages that build on its library, each on the state the pages
+before it left: clips ingested, the space `body`, labels.csv), then any other docs/*.md page in
+name order, so that no page's blocks go unrun; a failure names its page, line and first
+command. A block preceded by `<!-- readme-test: skip: REASON -->` is not run; the reason must
+say which other check runs it. `<!-- readme-test: requires: TOOL -->` runs the block when TOOL
+is on PATH and says so when it is not; TOOL `npm-registry` means npm and a reachable npm
+registry (a machine that reaches only Debian's archive has neither the page's packages nor
+Buf's). Last, `scripts/start.sh --demo` must load its demo library into a fresh database, say
+where its web page is, and serve it there; without the npm registry start.sh serves the JSON
+API instead, as it documents, and says where. MOTIONDB_REQUIRE_NPM=1 (set by .ci/run) makes an
+unreachable registry a failure rather than a reason not to run.
 """
 import os
 import pathlib
@@ -32,6 +37,50 @@ BLOCK = re.compile(r"(?:<!--\s*readme-test:\s*(?P<directive>.*?)\s*-->\s*\n)?```
                    re.S)
 DEFAULT_ADDRESS = "127.0.0.1:50051"
 DEFAULT_HTTP_ADDRESS = "127.0.0.1:8080"
+# The order the pages run in: each page's blocks find what the pages before it made.
+PAGE_ORDER = ("README.md", "docs/user-guide.md", "docs/api.md", "docs/operations.md",
+              "docs/search-tuning.md")
+
+
+def pages(repo):
+    """README.md and every docs/*.md page: PAGE_ORDER's first, then the others by name."""
+    found = ["README.md"] + sorted(str(p.relative_to(repo)) for p in (repo / "docs").glob("*.md"))
+    ordered = [page for page in PAGE_ORDER if page in found]
+    return ordered + [page for page in found if page not in ordered]
+
+
+class Block:
+    """One ```sh block: its page, its line there, its readme-test directive (or None), its body."""
+
+    def __init__(self, page, text, match):
+        self.page = page
+        self.line = text.count("\n", 0, match.start("body")) + 1  # its first line
+        self.directive = match.group("directive")
+        self.body = match.group("body")
+
+    def first_line(self):
+        return self.body.strip().splitlines()[0]
+
+    def where(self):
+        return f"{self.page}:{self.line}: {self.first_line()}"
+
+
+def blocks(repo):
+    """Every ```sh block of every page, in the order they run."""
+    found = []
+    for page in pages(repo):
+        text = (repo / page).read_text()
+        found += [Block(page, text, match) for match in BLOCK.finditer(text)]
+    return found
+
+
+def list_blocks(repo):
+    """Prints which blocks would run, from which page, in order (no server needed)."""
+    for block in blocks(repo):
+        if block.directive:
+            print(f"{block.where()}    [{block.directive}]")
+        else:
+            print(block.where())
 
 
 def free_port():
@@ -99,9 +148,12 @@ def run_block(body, env, work):
 
 
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--list":
+        list_blocks(pathlib.Path(sys.argv[2]).resolve())
+        return 0
     repo, build = pathlib.Path(sys.argv[1]).resolve(), pathlib.Path(sys.argv[2]).resolve()
-    blocks = list(BLOCK.finditer((repo / "README.md").read_text()))
-    if not blocks:
+    every_block = blocks(repo)
+    if not any(block.page == "README.md" for block in every_block):
         raise SystemExit("README.md has no ```sh blocks")
     work = pathlib.Path(tempfile.mkdtemp(prefix="motiondb_readme_"))
     try:
@@ -114,25 +166,26 @@ def main():
                    PATH=f"{build / 'client'}:{os.environ.get('PATH', '')}")
         failed, ran, skipped = [], 0, 0
         try:
-            for match in blocks:
-                directive, body = match.group("directive"), match.group("body")
+            for block in every_block:
+                directive, body = block.directive, block.body
                 if directive and directive.startswith("requires:"):
                     tool = directive.split(":", 1)[1].strip()
                     if not tool_available(tool):
-                        print(f"not run here ({tool} is not available):\n{body}")
+                        print(f"{block.page}: not run here ({tool} is not available):\n{body}")
                         skipped += 1
                         continue
                 elif directive:
                     if not directive.startswith("skip:") or len(directive) < 12:
-                        raise SystemExit(f"bad readme-test directive: {directive!r}")
-                    print(f"not run here ({directive}):\n{body}")
+                        raise SystemExit(f"{block.page}: bad readme-test directive: {directive!r}")
+                    print(f"{block.page}: not run here ({directive}):\n{body}")
                     skipped += 1
                     continue
                 ran += 1
+                print(f"--- {block.page}, line {block.line}", flush=True)
                 body = body.replace(DEFAULT_ADDRESS, server.address)
                 if run_block(body.replace(DEFAULT_HTTP_ADDRESS, server.http_address), env,
                              work) != 0:
-                    failed.append(body.strip().splitlines()[0])
+                    failed.append(block.where())
         finally:
             server.stop()
 
@@ -161,9 +214,9 @@ def main():
                 failed.append("scripts/start.sh --demo")
         finally:
             demo.stop()
-        print(f"README blocks: {ran} run, {skipped} not run here, {len(failed)} failed")
-        for first_line in failed:
-            print(f"FAILED: {first_line}")
+        print(f"README and docs blocks: {ran} run, {skipped} not run here, {len(failed)} failed")
+        for where in failed:
+            print(f"FAILED: {where}")
         return 1 if failed else 0
     finally:
         shutil.rmtree(work, ignore_errors=True)
