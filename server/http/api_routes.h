@@ -1,4 +1,4 @@
-// The JSON API's routes (README "HTTP and the web UI"): each an HTTP method and path over one
+// The JSON API's routes (docs/api.md, "HTTP"): each an HTTP method and path over one
 // gRPC method of the motiondb.v1 services, and the request fields its path and query
 // parameters fill.
 #ifndef MOTIONDB_SERVER_HTTP_API_ROUTES_H_
@@ -31,7 +31,7 @@ struct ApiRoute {
   std::string PathRegex() const;
 };
 
-// Every route, in the README's order.
+// Every route, in docs/api.md's order.
 const std::vector<ApiRoute>& ApiRoutes();
 
 }  // namespace motiondb::server
