@@ -33,8 +33,10 @@ import sys
 import tempfile
 import time
 
-BLOCK = re.compile(r"(?:<!--\s*readme-test:\s*(?P<directive>.*?)\s*-->\s*\n)?```sh\n(?P<body>.*?)```",
-                   re.S)
+# A directive is one line, so that a page that names one in its text does not take the text up to
+# the next block's directive for a directive.
+BLOCK = re.compile(r"(?:<!--[ \t]*readme-test:[ \t]*(?P<directive>[^\n]*?)[ \t]*-->[ \t]*\n)?"
+                   r"```sh\n(?P<body>.*?)```", re.S)
 DEFAULT_ADDRESS = "127.0.0.1:50051"
 DEFAULT_HTTP_ADDRESS = "127.0.0.1:8080"
 # The order the pages run in: each page's blocks find what the pages before it made.
