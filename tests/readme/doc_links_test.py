@@ -3,7 +3,8 @@
 
     doc_links_test.py REPO
 
-Reads README.md, ARCHITECTURE.md, docs/*.md and server/README.md; each Markdown link or image
+Reads README.md, ARCHITECTURE.md, docs/*.md, server/README.md, bench/RESULTS.md and
+bench/notes/*.md; each Markdown link or image
 `[text](target)` whose target is not a URL must name a file or folder of the repository, and its
 `#anchor`, if any, a heading of the Markdown file it names (GitHub's anchors: lower case,
 punctuation dropped, spaces as hyphens, a repeated heading numbered -1, -2, ...). Links inside
@@ -22,7 +23,9 @@ CODE_SPAN = re.compile(r"(`+)(?:(?!\1).)+?\1")
 
 def pages(repo):
     found = [repo / "README.md", repo / "ARCHITECTURE.md", repo / "server" / "README.md"]
-    return [page for page in found if page.exists()] + sorted((repo / "docs").glob("*.md"))
+    found.append(repo / "bench" / "RESULTS.md")
+    return ([page for page in found if page.exists()] + sorted((repo / "docs").glob("*.md")) +
+            sorted((repo / "bench" / "notes").glob("*.md")))
 
 
 def unfenced(text):
