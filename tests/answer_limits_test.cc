@@ -484,7 +484,8 @@ TEST_F(AnswerLimitTest, ClipPagesHoldWhatTheLimitAdmits) {
   }
   const auto read_all = [](const AnswerLimit& answers, int* pages) {
     int64_t total = 0;
-    ClipListRequest request{.page = {1000, ""}};
+    ClipListRequest request;
+    request.page = {1000, ""};
     *pages = 0;
     do {
       const absl::StatusOr<storage::ClipPage> page =

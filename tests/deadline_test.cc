@@ -447,9 +447,12 @@ TEST_F(DeadlineTest, CurvesStop) {
   request.clip = {clip_ids_->front(), std::nullopt, std::nullopt};
   StopAfter stop(0);
   EXPECT_TRUE(absl::IsCancelled(
-      server::ReadCurve(*registry_, *database_, request, {}, stop.function()).status()));
+      server::ReadCurve(*registry_, *database_, request, server::AnswerLimit(), stop.function())
+          .status()));
   EXPECT_EQ(stop.polls(), 1);
-  EXPECT_TRUE(server::ReadCurve(*registry_, *database_, request, {}, [] { return false; }).ok());
+  EXPECT_TRUE(server::ReadCurve(*registry_, *database_, request, server::AnswerLimit(), [] {
+                return false;
+              }).ok());
 }
 
 // The overlap of FillGap is a warp's query: its table is held to a search query's.
