@@ -202,8 +202,7 @@ class Database {
   // The clip's frames `frames` handed to `consume` in batches of at most `batch_frames`, in
   // order, each a clip of those frames sharing one skeleton (the clip's own), read from the
   // stored blobs piece by piece in one read snapshot: memory holds a batch whatever the clip's
-  // length (GetClip of a range reads the whole blobs), and the clip stays as it was until the
-  // last batch. The snapshot is held while `consume` runs, so a slow consumer keeps the
+  // length, and the clip stays as it was until the last batch. The snapshot is held while `consume` runs, so a slow consumer keeps the
   // write-ahead log from being checkpointed past it. consume's first error ends the read and is
   // returned. NOT_FOUND for an unknown clip; OUT_OF_RANGE when `frames` is empty or not inside
   // it; INVALID_ARGUMENT for a batch_frames below 1.

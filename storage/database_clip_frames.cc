@@ -3,10 +3,12 @@
 // export reads without holding the clip.
 #include <algorithm>
 #include <optional>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "storage/database.h"
+#include "storage/internal/clip_frames.h"
 #include "storage/internal/database_impl.h"
 #include "storage/internal/record_rows.h"
 #include "storage/sqlite_blob.h"
@@ -52,6 +54,53 @@ absl::StatusOr<SqliteBlob> OpenFrameBlob(SqliteConnection& db, const ClipRecord&
   return blob;
 }
 
+// A clip's frames read from its blobs a range at a time, only the range's bytes each (a blob's
+// substr() reads the whole blob, however short the range).
+class FrameReader {
+ public:
+  // For the frames `frames` of the clip of `layout`: OUT_OF_RANGE when they are not inside it.
+  static absl::StatusOr<FrameReader> Open(SqliteConnection& db, const ClipLayout& layout,
+                                          FrameRange frames) {
+    const ClipRecord& record = layout.record;
+    MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("stored clip ", record.clip_id),
+                                      CheckFrameRange(frames, record.frame_count)));
+    FrameReader reader(layout);
+    MOTIONDB_ASSIGN_OR_RETURN(reader.rotations_,
+                              OpenFrameBlob(db, record, "rotations", reader.rotation_bytes_));
+    // A skeleton without translation channels stores no positions (and an empty blob, which
+    // need not open).
+    if (reader.position_bytes_ > 0) {
+      MOTIONDB_ASSIGN_OR_RETURN(reader.positions_,
+                                OpenFrameBlob(db, record, "positions", reader.position_bytes_));
+    }
+    return reader;
+  }
+
+  // `count` frames from frame `first`, inside the range Open was given.
+  absl::StatusOr<Clip> Read(int64_t first, int64_t count) {
+    MOTIONDB_RETURN_IF_ERROR(
+        rotations_->Read(first * rotation_bytes_, count * rotation_bytes_, rotation_piece_));
+    if (positions_) {
+      MOTIONDB_RETURN_IF_ERROR(
+          positions_->Read(first * position_bytes_, count * position_bytes_, position_piece_));
+    }
+    return Prefixed(absl::StrCat("stored clip ", layout_.record.clip_id, " at frame ", first),
+                    DecodeClipFrames(layout_.skeleton, layout_.record.frame_time, rotation_piece_,
+                                     position_piece_, count));
+  }
+
+ private:
+  explicit FrameReader(const ClipLayout& layout)
+      : layout_(layout),
+        rotation_bytes_(kRotationBytes * layout.record.joint_count),
+        position_bytes_(kPositionBytes * layout.skeleton->position_joint_count()) {}
+
+  const ClipLayout& layout_;
+  int64_t rotation_bytes_, position_bytes_;
+  std::optional<SqliteBlob> rotations_, positions_;
+  std::string rotation_piece_, position_piece_;  // reused from range to range
+};
+
 }  // namespace
 
 absl::StatusOr<ClipLayout> Database::GetClipLayout(int64_t clip_id) {
@@ -71,36 +120,21 @@ absl::Status Database::ReadClipFrames(int64_t clip_id, FrameRange frames, int ba
   }
   return impl_->Read([&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(const ClipLayout layout, ReadLayout(db, clip_id));
-    const ClipRecord& record = layout.record;
-    MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("stored clip ", clip_id),
-                                      CheckFrameRange(frames, record.frame_count)));
-    const int64_t rotation_bytes = kRotationBytes * record.joint_count;
-    const int64_t position_bytes = kPositionBytes * layout.skeleton->position_joint_count();
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteBlob rotations,
-                              OpenFrameBlob(db, record, "rotations", rotation_bytes));
-    // A skeleton without translation channels stores no positions (and an empty blob, which
-    // need not open).
-    std::optional<SqliteBlob> positions;
-    if (position_bytes > 0) {
-      MOTIONDB_ASSIGN_OR_RETURN(positions, OpenFrameBlob(db, record, "positions", position_bytes));
-    }
-    std::string rotation_piece, position_piece;
+    MOTIONDB_ASSIGN_OR_RETURN(FrameReader reader, FrameReader::Open(db, layout, frames));
     for (int64_t first = frames.first; first <= frames.last; first += batch_frames) {
       const int64_t count = std::min<int64_t>(batch_frames, frames.last - first + 1);
-      MOTIONDB_RETURN_IF_ERROR(
-          rotations.Read(first * rotation_bytes, count * rotation_bytes, rotation_piece));
-      if (positions) {
-        MOTIONDB_RETURN_IF_ERROR(
-            positions->Read(first * position_bytes, count * position_bytes, position_piece));
-      }
-      MOTIONDB_ASSIGN_OR_RETURN(const Clip batch,
-                                Prefixed(absl::StrCat("stored clip ", clip_id, " at frame ", first),
-                                         DecodeClipFrames(layout.skeleton, record.frame_time,
-                                                          rotation_piece, position_piece, count)));
+      MOTIONDB_ASSIGN_OR_RETURN(const Clip batch, reader.Read(first, count));
       MOTIONDB_RETURN_IF_ERROR(consume(batch));
     }
     return absl::OkStatus();
   });
+}
+
+absl::StatusOr<StoredClip> ReadClipRange(SqliteConnection& db, int64_t clip_id, FrameRange frames) {
+  MOTIONDB_ASSIGN_OR_RETURN(ClipLayout layout, ReadLayout(db, clip_id));
+  MOTIONDB_ASSIGN_OR_RETURN(FrameReader reader, FrameReader::Open(db, layout, frames));
+  MOTIONDB_ASSIGN_OR_RETURN(Clip clip, reader.Read(frames.first, frames.size()));
+  return StoredClip{std::move(layout.record), std::move(clip)};
 }
 
 }  // namespace motiondb::storage

@@ -14,6 +14,7 @@
 #include "storage/blob_codec.h"
 #include "storage/content_hash.h"
 #include "storage/database.h"
+#include "storage/internal/clip_frames.h"
 #include "storage/internal/database_impl.h"
 #include "storage/internal/record_checks.h"
 #include "storage/internal/record_rows.h"
@@ -333,23 +334,20 @@ absl::StatusOr<std::vector<int64_t>> Database::ClipsOfSkeleton(int64_t skeleton_
 absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id, std::optional<FrameRange> frames) {
   std::optional<StoredClip> result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
+    if (frames) {
+      MOTIONDB_ASSIGN_OR_RETURN(result, ReadClipRange(db, clip_id, *frames));
+      return absl::OkStatus();
+    }
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement query,
-        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ",
-                                frames ? kClipFrameRangeColumns : kClipFrameColumns,
+        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ", kClipFrameColumns,
                                 " FROM clips c WHERE c.clip_id = ?1")));
     query.BindInt64(1, clip_id);
-    if (frames) query.BindInt64(2, frames->first).BindInt64(3, frames->size());
     MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.Step());
     if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
     ClipRecord record = ReadClipRecord(query);
-    if (frames) {
-      MOTIONDB_RETURN_IF_ERROR(Prefixed(absl::StrCat("stored clip ", clip_id),
-                                        CheckFrameRange(*frames, record.frame_count)));
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(
-        Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id),
-                            ReadClip(query, record, frames ? frames->size() : record.frame_count)));
+    MOTIONDB_ASSIGN_OR_RETURN(Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id),
+                                                  ReadClip(query, record, record.frame_count)));
     MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
     MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
     result.emplace(StoredClip{std::move(record), std::move(clip)});

@@ -122,12 +122,13 @@ grpc::Status ClipServiceImpl::ListSkeletons(grpc::ServerContext* context,
 grpc::Status ClipServiceImpl::GetClip(grpc::ServerContext* context,
                                       const v1::GetClipRequest* request, v1::Clip* response) {
   return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<storage::StoredClip> stored = database_.GetClip(request->clip_id());
-    if (!stored.ok()) return ToGrpcStatus(stored.status());
-    ToProto(stored->record, response);
+    // The record and skeleton only: the frames are not shown.
+    const absl::StatusOr<storage::ClipLayout> layout = database_.GetClipLayout(request->clip_id());
+    if (!layout.ok()) return ToGrpcStatus(layout.status());
+    ToProto(layout->record, response);
     // Joint names an older version stored unchecked may not be UTF-8, which protobuf cannot
     // carry: shown with U+FFFD (util/name_text.h).
-    for (const Joint& joint : stored->clip.skeleton().joints())
+    for (const Joint& joint : layout->skeleton->joints())
       response->add_joint_names(ValidUtf8(joint.name));
     return grpc::Status::OK;
   });

@@ -35,21 +35,14 @@ inline constexpr absl::string_view kClipLayoutColumns = "c.position_joint_count,
 // the frames' blobs.
 inline constexpr absl::string_view kClipFrameColumns =
     "c.position_joint_count, c.layout, c.rotations, c.positions";
-// kClipFrameColumns of `?3` frames from frame `?2` only: those frames' bytes of the blobs (16 a
-// joint a frame, 12 a position joint a frame). substr() reads the whole blob, however short the
-// range: a long clip read in many ranges is read by ReadClipFrames instead.
-inline constexpr absl::string_view kClipFrameRangeColumns =
-    "c.position_joint_count, c.layout, "
-    "substr(c.rotations, 1 + ?2 * 16 * c.joint_count, ?3 * 16 * c.joint_count), "
-    "substr(c.positions, 1 + ?2 * 12 * c.position_joint_count, ?3 * 12 * c.position_joint_count)";
 // The columns ReadSpaceRecord reads, of the spaces table.
 inline constexpr absl::string_view kSpaceRecordColumns =
     "space_id, name, skeleton_id, version, created_unix_ms, build_report_json";
 
 // The record of a row that starts with kClipRecordColumns; its tags are read with LoadTags.
 ClipRecord ReadClipRecord(const SqliteStatement& row);
-// The `frames` frames of a row of kClipRecordColumns then kClipFrameColumns (record.frame_count)
-// or kClipFrameRangeColumns (the range's), whose record is `record`. DATA_LOSS when the stored
+// The `frames` (record.frame_count) frames of a row of kClipRecordColumns then
+// kClipFrameColumns, whose record is `record`. DATA_LOSS when the stored
 // bytes no longer decode into the clip the row describes.
 absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record, int64_t frames);
 // The skeleton of a row of kClipRecordColumns then kClipLayoutColumns (or kClipFrameColumns),
