@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 
 #include "absl/strings/str_cat.h"
 
@@ -19,6 +20,17 @@ int64_t FrameConversion::ToSpace(int original_frame) const {
 
 std::pair<int64_t, int64_t> FrameConversion::ToSpace(FrameRange range) const {
   return {ToSpace(range.first), std::max(ToSpace(range.first), ToSpace(range.last))};
+}
+
+std::pair<int64_t, int64_t> FrameConversion::SpaceFramesWithin(FrameRange range) const {
+  const auto frames = std::views::iota(int64_t{0}, space_frames_);
+  const int64_t first =
+      std::ranges::partition_point(frames, [&](int64_t s) { return ToOriginal(s) < range.first; }) -
+      frames.begin();
+  const int64_t after =
+      std::ranges::partition_point(frames, [&](int64_t s) { return ToOriginal(s) <= range.last; }) -
+      frames.begin();
+  return {first, after - 1};
 }
 
 absl::StatusOr<FrameRange> ResolveFrameRange(std::optional<int> first, std::optional<int> last,

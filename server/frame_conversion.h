@@ -26,6 +26,11 @@ class FrameConversion {
   int64_t ToSpace(int original_frame) const;
   // An original range to the space frames it covers (at least one).
   std::pair<int64_t, int64_t> ToSpace(FrameRange range) const;
+  // The space frames whose original frames lie inside `range`: first..last, with last = first - 1
+  // when none does (the range falls between two space frames). A range of space frames a..b
+  // reaches into `range` (ToOriginal(a) <= range.last and ToOriginal(b) >= range.first)
+  // exactly when a <= last and b >= first: ToOriginal never decreases.
+  std::pair<int64_t, int64_t> SpaceFramesWithin(FrameRange range) const;
 
  private:
   double fps_;

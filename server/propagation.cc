@@ -32,11 +32,7 @@ absl::Status CheckSearch(const SearchRequest& search, int dims) {
   if (search.params.return_path) {
     return absl::InvalidArgumentError("search.return_path: a propagation keeps no paths");
   }
-  SearchParams params = search.params;
-  const SearchParams defaults;
-  params.ann_dims = search.ann_dims.value_or(std::min(defaults.ann_dims, dims));
-  params.dtw_dims = search.dtw_dims.value_or(std::min(defaults.dtw_dims, dims));
-  return ValidateSearchParams(params, dims);
+  return ValidateSearchParams(WithSearchDims(search, dims), dims);
 }
 
 // Whether `a` and `b` (same clip) share more than half of the shorter one's frames: a long

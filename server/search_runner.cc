@@ -145,10 +145,7 @@ absl::StatusOr<int> QueryRow(const Query& query, int frame, absl::string_view fi
 
 absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Query& query,
                                            int dims) {
-  SearchParams params = request.params;
-  const SearchParams defaults;
-  params.ann_dims = request.ann_dims.value_or(std::min(defaults.ann_dims, dims));
-  params.dtw_dims = request.dtw_dims.value_or(std::min(defaults.dtw_dims, dims));
+  SearchParams params = WithSearchDims(request, dims);
   params.characteristic_frame = -1;
   if (request.characteristic_frame) {
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -192,23 +189,11 @@ SearchHit HitOf(const SearchResult& result, const SpaceSnapshot& snapshot) {
   return hit;
 }
 
-// A stored query's own clip and range, for exclude_query.
-struct OwnRange {
-  int64_t clip_id = 0;
-  FrameRange frames;  // at the clip's rate
-
-  bool Overlaps(const SearchHit& hit) const {
-    return hit.clip_id == clip_id && hit.start_frame <= frames.last &&
-           hit.end_frame >= frames.first;
-  }
-};
-
 // What Hits needs beyond the query: how to search and what to add to each hit.
 struct HitOptions {
   bool exact = false;
   bool explain = false;
   bool keep_paths = false;  // the caller asked for the paths
-  std::optional<OwnRange> own;
 };
 
 // `result` as a hit, explained when asked.
@@ -225,36 +210,31 @@ absl::StatusOr<SearchHit> FullHit(const SpaceSnapshot& snapshot, const Query& qu
   return hit;
 }
 
-// Runs the search, without the hits overlapping `options.own` when given. The query's own range
-// and its near shifts rank first, so the search is asked for more results than wanted, and
-// asked again for yet more while what is left falls short and the search had more to give.
+// A stored query's own range (at its clip's rate) as the search leaves it out: the space frames
+// of the hits that would overlap it, which are exactly those whose own frames would
+// (FrameConversion::SpaceFramesWithin).
+std::optional<ExcludedRange> OwnRange(const SpaceSnapshot& snapshot, int64_t clip_id,
+                                      FrameRange frames) {
+  if (!snapshot.index || snapshot.index->FindClip(clip_id) < 0) return std::nullopt;
+  const auto [first, last] = snapshot.Conversion(clip_id).SpaceFramesWithin(frames);
+  return ExcludedRange{clip_id, first, last};
+}
+
+// Runs the search once and makes its results hits.
 absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const Query& query,
                                             SearchParams params, const HitOptions& options,
                                             SearchStats* stats) {
-  const int wanted = params.max_results;
-  int extra = options.own ? 4 : 0;
   params.return_path = params.return_path || options.explain;
-  while (true) {
-    params.max_results = std::min(wanted + extra, kMaxSearchResults);
-    MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
-                              options.exact ? ExactSearch(*snapshot.index, query.rows(), params)
-                                            : Search(*snapshot.index, query.rows(), params));
-    *stats = found.stats;
-    std::vector<SearchHit> hits;
-    hits.reserve(found.results.size());
-    for (const SearchResult& result : found.results) {
-      if (static_cast<int>(hits.size()) == wanted) break;
-      MOTIONDB_ASSIGN_OR_RETURN(SearchHit hit, FullHit(snapshot, query, result, options));
-      if (!options.own || !options.own->Overlaps(hit)) hits.push_back(std::move(hit));
-    }
-    const bool exhausted = static_cast<int>(found.results.size()) < params.max_results;
-    // At most a few rounds: the query's overlaps are few after overlap suppression.
-    if (static_cast<int>(hits.size()) >= wanted || exhausted || extra >= 256 ||
-        params.max_results == kMaxSearchResults) {
-      return hits;
-    }
-    extra *= 4;
+  MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
+                            options.exact ? ExactSearch(*snapshot.index, query.rows(), params)
+                                          : Search(*snapshot.index, query.rows(), params));
+  *stats = found.stats;
+  std::vector<SearchHit> hits;
+  hits.reserve(found.results.size());
+  for (const SearchResult& result : found.results) {
+    MOTIONDB_ASSIGN_OR_RETURN(hits.emplace_back(), FullHit(snapshot, query, result, options));
   }
+  return hits;
 }
 
 // The answer's size at most (SearchAnswerBytes), checked with what the batch's earlier answers
@@ -277,6 +257,14 @@ absl::StatusOr<int64_t> CheckAnswer(const SearchRequest& request, const SearchPa
 
 }  // namespace
 
+SearchParams WithSearchDims(const SearchRequest& request, int dims) {
+  SearchParams params = request.params;
+  const SearchParams defaults;
+  params.ann_dims = request.ann_dims.value_or(std::min(defaults.ann_dims, dims));
+  params.dtw_dims = request.dtw_dims.value_or(std::min(defaults.dtw_dims, dims));
+  return params;
+}
+
 absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                                                 const std::function<bool()>& should_stop) const {
   const auto start = std::chrono::steady_clock::now();
@@ -285,12 +273,12 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                             FindSpace(registry_, request.space));
   const int dims = snapshot->space->dims();
   Query query;
-  HitOptions options{request.exact, request.explain, request.params.return_path, std::nullopt};
+  const HitOptions options{request.exact, request.explain, request.params.return_path};
+  std::optional<ExcludedRange> own;
   if (const auto* stored = std::get_if<ClipSelection>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(query, StoredQuery(*stored, *snapshot, database_, max_query_frames_));
-    if (request.exclude_query.value_or(true)) {
-      options.own = OwnRange{stored->clip_id, query.range};
-    }
+    if (request.exclude_query.value_or(true))
+      own = OwnRange(*snapshot, stored->clip_id, query.range);
   } else if (const auto* upload = std::get_if<UploadedQuery>(&request.query)) {
     MOTIONDB_ASSIGN_OR_RETURN(
         query, QueryOfUpload(*upload, *snapshot, limits_, max_query_frames_, should_stop));
@@ -298,6 +286,7 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
     return absl::InvalidArgumentError("query: give a stored clip (clip) or a BVH file (bvh)");
   }
   MOTIONDB_ASSIGN_OR_RETURN(SearchParams params, ResolveParams(request, query, dims));
+  params.excluded = own;
   {
     SearchParams searched = params;
     searched.return_path = params.return_path || request.explain;  // as Hits asks

@@ -61,6 +61,10 @@ struct SearchRequest {
   int64_t answers_used = 0;
 };
 
+// The request's params with its ann_dims and dtw_dims, or where unset SearchParams' defaults
+// capped at a space of `dims` dimensions: the one place the default dimensions are chosen.
+SearchParams WithSearchDims(const SearchRequest& request, int dims);
+
 // A ranked time range, in the clip's own frames (inclusive).
 struct SearchHit {
   int64_t clip_id = 0;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <limits>
 #include <random>
+#include <string>
 #include <thread>
 #include <tuple>
 
@@ -444,6 +445,60 @@ TEST_F(SearchTest, FiltersByClipIdAndTag) {
   params.tags.clear();
   params.clip_ids = {999};
   EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kNotFound);
+}
+
+// The excluded range is left out inside the search, before the ranking: no result overlaps it,
+// and the search still fills max_results with the others, in one run of each kind of search.
+TEST_F(SearchTest, AnExcludedRangeIsLeftOutAndTheResultsStillFill) {
+  const Planted& own = planted_.front();  // the copy a stored query of it would find first
+  SearchParams params;
+  params.max_results = 12;
+  params.excluded = ExcludedRange{100, own.first, own.last};
+  const auto overlaps = [&](const SearchResult& r) {
+    return r.clip_id == 100 && r.first_frame <= own.last && r.last_frame >= own.first;
+  };
+  const RowMatrixXf pose = testing::Pattern(40, kDims).row(20);
+  const RowMatrixXf two_actions = [&] {
+    RowMatrixXf rows(80, kDims);
+    rows << query_, query_;
+    return rows;
+  }();
+  for (const char* kind : {"fast", "exact", "pose", "two points"}) {
+    SCOPED_TRACE(kind);
+    SearchParams searched = params;
+    if (std::string(kind) == "two points") searched.characteristic_frames = {20, 60};
+    const RowMatrixXf& rows = std::string(kind) == "pose"         ? pose
+                              : std::string(kind) == "two points" ? two_actions
+                                                                  : query_;
+    const absl::StatusOr<SearchResponse> found =
+        std::string(kind) == "exact" ? ExactSearch(*library_, CoordinateView::Of(rows), searched)
+                                     : Search(*library_, CoordinateView::Of(rows), searched);
+    ASSERT_TRUE(found.ok()) << found.status();
+    // Chains of two parts are as many as the library holds.
+    if (std::string(kind) != "two points") {
+      EXPECT_EQ(found->results.size(), 12u);
+    }
+    EXPECT_FALSE(found->results.empty());
+    EXPECT_TRUE(std::none_of(found->results.begin(), found->results.end(), overlaps));
+    // Without it, the range's copy is found.
+    searched.excluded.reset();
+    const absl::StatusOr<SearchResponse> all =
+        std::string(kind) == "exact" ? ExactSearch(*library_, CoordinateView::Of(rows), searched)
+                                     : Search(*library_, CoordinateView::Of(rows), searched);
+    ASSERT_TRUE(all.ok()) << all.status();
+    EXPECT_TRUE(std::any_of(all->results.begin(), all->results.end(), overlaps));
+  }
+  // A range between two frames (last = first - 1) leaves out what spans the gap; a reversed one
+  // is refused.
+  params.excluded = ExcludedRange{100, own.first + 5, own.first + 4};
+  const absl::StatusOr<SearchResponse> gap = Search(*library_, query(), params);
+  ASSERT_TRUE(gap.ok()) << gap.status();
+  for (const SearchResult& r : gap->results) {
+    EXPECT_FALSE(r.clip_id == 100 && r.first_frame <= own.first + 4 &&
+                 r.last_frame >= own.first + 5);
+  }
+  params.excluded = ExcludedRange{100, own.first + 5, own.first + 3};
+  EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 // A one-frame query: the nearest distinct places, one frame each, scored by the pose distance.

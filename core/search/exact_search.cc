@@ -46,8 +46,8 @@ class ClipScan {
   // `bound()` is a cost that no result of other clips at or above it can rank with: paths
   // that cannot stay below it and below the clip's own k-th best are dropped. `stop` is told
   // each column's cells (a column of a long query costs as much as many short ones).
-  absl::Status Run(int clip_index, StopPoll& stop, absl::FunctionRef<float()> bound,
-                   StreamingTopResults& top, SearchStats& stats) {
+  absl::Status Run(int clip_index, const SearchFilter& filter, StopPoll& stop,
+                   absl::FunctionRef<float()> bound, StreamingTopResults& top, SearchStats& stats) {
     const auto threshold = [&] { return std::min(top.threshold(), bound()); };
     for (int64_t j = 0; j < clip_.rows; ++j) {
       // Every column is cleared, m x s cells, whatever it then fills.
@@ -66,9 +66,9 @@ class ClipScan {
         }
       }
       const float end_cost = FillColumn(j, threshold(), stats);
-      if (end_cost < kInfinity) {
-        const Warp warp{
-            ring_[j % ring_.size()].best_start, j, end_cost / static_cast<double>(m_), {}};
+      const int64_t best_start = ring_[j % ring_.size()].best_start;
+      if (end_cost < kInfinity && filter.Admits(clip_index, best_start, j)) {
+        const Warp warp{best_start, j, end_cost / static_cast<double>(m_), {}};
         top.Offer(MakeResult(clip_index, warp, -1));
       }
     }
@@ -264,7 +264,7 @@ absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const S
 absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, CoordinateView query,
                                            const SearchParams& params) {
   const auto start = std::chrono::steady_clock::now();
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, query, params));
+  MOTIONDB_ASSIGN_OR_RETURN(const SearchFilter filter, PrepareQuery(library, query, params));
   SearchResponse response;
   const auto warps = std::chrono::steady_clock::now();
   FinishedClips finished(params.max_results, query.rows);
@@ -273,14 +273,14 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
       library.clip_count(), static_cast<int>(stats.size()),
       [&](int64_t index, int thread) -> absl::Status {
         const int c = static_cast<int>(index);
-        if (!allowed.empty() && !allowed[c]) return absl::OkStatus();
+        if (!filter.allowed.empty() && !filter.allowed[c]) return absl::OkStatus();
         // Each thread polls on its own; every one of them stops within a poll's work.
         StopPoll stop = SearchStop(params);
         if (stop.Done(query.rows)) return SearchStopped();
         StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
         ClipScan scan(query, library.clip_coordinates(c), params.slope_limit, params.dtw_dims);
         MOTIONDB_RETURN_IF_ERROR(scan.Run(
-            c, stop, [&] { return finished.bound(); }, top, stats[thread]));
+            c, filter, stop, [&] { return finished.bound(); }, top, stats[thread]));
         // Most clips hold nothing under the bound: adding nothing would only take the lock.
         std::vector<SearchResult> results = top.Take();
         if (!results.empty()) finished.Add(std::move(results));
@@ -293,7 +293,7 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   response.stats.warps_ms = MillisecondsSince(warps);
   std::vector<SearchResult> best = finished.Take();
   if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, best));
-  response.results = FinishResults(library, std::move(best), params);
+  response.results = FinishResults(library, filter, std::move(best), params);
   response.stats.total_ms = MillisecondsSince(start);
   return response;
 }

@@ -1,9 +1,7 @@
-// Query-by-example search in a library (thesis chapter 6, Algorithm 3): find the query's
-// characteristic pose, take its nearest library frames as seeds, cluster the seeds in time per
-// clip, warp the query through each cluster's best seed, and rank the warps by mean pose
-// distance with overlap suppression. One step beyond the thesis (SearchParams::refine): the
-// best warps are freed from their seeds, each moved to the best warp near it
-// (core/warp_refinement.h), so that nearly equal matches are ordered by their true scores.
+// Query-by-example search in a library (thesis chapter 6): a query of one frame is a pose query
+// (pose_search.h), one with one characteristic point the thesis's search
+// (internal/single_point_search.h), one with several a search through each
+// (internal/multi_point_search.h).
 #ifndef MOTIONDB_CORE_SEARCH_MOTION_SEARCH_H_
 #define MOTIONDB_CORE_SEARCH_MOTION_SEARCH_H_
 

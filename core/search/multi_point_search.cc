@@ -1,4 +1,4 @@
-#include "core/search/multi_point_search.h"
+#include "core/search/internal/multi_point_search.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,8 +8,9 @@
 #include <utility>
 
 #include "absl/container/flat_hash_map.h"
+#include "core/search/internal/pose_search.h"
 #include "core/search/internal/search_query.h"
-#include "core/search/motion_search.h"
+#include "core/search/internal/single_point_search.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -295,6 +296,7 @@ void AddStageStats(const SearchStats& part, SearchStats& total) {
 
 absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, CoordinateView query,
                                                 const std::vector<int>& anchors,
+                                                const SearchFilter& filter,
                                                 const SearchParams& params) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<Part> parts = QueryParts(query, anchors, params.dtw_dims, library.rate());
@@ -313,10 +315,12 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
 
   std::vector<std::vector<SearchResult>> matches(parts.size());
   for (size_t k = 0; k < parts.size(); ++k) {
-    part_params.characteristic_frame = parts[k].anchor;
+    const CoordinateView part_query = query.middle_rows(parts[k].first, parts[k].rows);
     MOTIONDB_ASSIGN_OR_RETURN(
         SearchResponse part,
-        Search(library, query.middle_rows(parts[k].first, parts[k].rows), part_params));
+        part_query.rows == 1
+            ? PoseSearch(library, part_query, filter, part_params)
+            : SinglePointSearch(library, part_query, parts[k].anchor, filter, part_params));
     AddStageStats(part.stats, stats);
     matches[k] = std::move(part.results);
     // A part of one frame is a pose query, whose matches are one frame with no path.
@@ -345,7 +349,7 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
     candidates.push_back(
         ChainResult(matches, links, parts, static_cast<int>(i), query.rows, params.return_path));
   }
-  response.results = FinishResults(library, std::move(candidates), params);
+  response.results = FinishResults(library, filter, std::move(candidates), params);
   stats.ranking_ms += MillisecondsSince(stage);
   stats.total_ms = MillisecondsSince(start);
   return response;

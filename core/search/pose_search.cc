@@ -1,4 +1,4 @@
-#include "core/search/pose_search.h"
+#include "core/search/internal/pose_search.h"
 
 #include <algorithm>
 #include <cmath>
@@ -37,10 +37,9 @@ SearchResult NearestFrameAround(const LibraryIndex& library, const float* pose, 
 }  // namespace
 
 absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, CoordinateView pose,
-                                          const SearchParams& params) {
+                                          const SearchFilter& filter, const SearchParams& params) {
   const auto start = std::chrono::steady_clock::now();
   if (pose.rows != 1) return absl::InvalidArgumentError("a pose query has one frame");
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<bool> allowed, PrepareQuery(library, pose, params));
   // One look: the work after it is bounded by max_results (a few milliseconds at most).
   if (SearchStop(params).Done(1)) return SearchStopped();
   SearchResponse response;
@@ -52,7 +51,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
                         std::llround(kPoseSeparationS * library.rate()));
   const std::vector<Neighbour> places =
       library.NearestPlaces(pose.row(0), params.ann_dims, kPlacesPerResult * params.max_results,
-                            separation, params.epsilon, allowed);
+                            separation, params.epsilon, filter.allowed);
   stats.seeds = stats.clusters = static_cast<int64_t>(places.size());
   stats.seeds_ms = MillisecondsSince(start);
 
@@ -62,8 +61,12 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   candidates.reserve(places.size());
   for (const Neighbour& place : places) {
     const auto [clip, frame] = library.Locate(place.frame);
-    candidates.push_back(
-        NearestFrameAround(library, pose.row(0), params.dtw_dims, clip, frame, reach));
+    SearchResult candidate =
+        NearestFrameAround(library, pose.row(0), params.dtw_dims, clip, frame, reach);
+    // A result is its one frame (the range below only serves the overlap rule).
+    if (filter.Admits(clip, candidate.seed_frame, candidate.seed_frame)) {
+      candidates.push_back(std::move(candidate));
+    }
   }
   stats.refine_ms = MillisecondsSince(stage);
   // One-frame results overlap only when equal: as `separation` frames from each, two overlap
@@ -73,7 +76,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   for (SearchResult& candidate : candidates) {
     candidate.last_frame = candidate.seed_frame + separation - 1;
   }
-  response.results = FinishResults(library, std::move(candidates), ranking);
+  response.results = FinishResults(library, SearchFilter{}, std::move(candidates), ranking);
   for (SearchResult& result : response.results) {
     result.first_frame = result.last_frame = result.seed_frame;
     result.start_s = result.end_s = result.seed_frame / library.rate();

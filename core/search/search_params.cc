@@ -35,6 +35,12 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (params.dtw_dims < 1 || params.dtw_dims > dims) {
     return OutOfRange("dtw_dims", params.dtw_dims, dims_range);
   }
+  if (params.excluded && (params.excluded->first_frame < 0 ||
+                          params.excluded->last_frame < params.excluded->first_frame - 1)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "excluded: frames ", params.excluded->first_frame, "..", params.excluded->last_frame,
+        " are not a range (0 <= first, first - 1 <= last)"));
+  }
   if (params.neighbours < 0 || params.neighbours > 1'000'000) {
     return OutOfRange("neighbours", params.neighbours, "0..1000000 (0: by the library's size)");
   }

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,16 @@ enum class SeedSelection {
   // side, LibraryIndex::NearestWindows) are nearest to the query's around the characteristic
   // frame, clustered in time as the nearest frames are.
   kNearestWindows,
+};
+
+// A clip's range, in frames at the library's rate, that no result may overlap: a result over
+// frames a..b overlaps it when a <= last_frame and b >= first_frame. last_frame may be
+// first_frame - 1, a range that falls between two library frames, which the results spanning
+// that gap overlap.
+struct ExcludedRange {
+  int64_t clip_id = 0;
+  int64_t first_frame = 0;
+  int64_t last_frame = 0;
 };
 
 // The most results one search returns (max_results' upper bound).
@@ -107,6 +118,10 @@ struct SearchParams {
   std::vector<int64_t> clip_ids;
   // Only clips carrying at least one of these tags (empty: no tag filter).
   std::vector<std::string> tags;
+  // No result overlapping this range (a stored query's own range and its near shifts, which
+  // would rank first): left out inside the search, before the ranking and its overlap rule, as
+  // the filters above leave clips out, so that the search runs once for max_results others.
+  std::optional<ExcludedRange> excluded;
   // Polled inside long loops; returning true stops the search with CANCELLED.
   std::function<bool()> should_stop;
 };

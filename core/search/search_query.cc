@@ -8,8 +8,8 @@
 
 namespace motiondb {
 
-absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
-                                               const SearchParams& params) {
+absl::StatusOr<SearchFilter> PrepareQuery(const LibraryIndex& library, CoordinateView query,
+                                          const SearchParams& params) {
   MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, library.dims()));
   if (query.rows < 1) return absl::InvalidArgumentError("the query has no frames");
   if (query.stride < library.dims()) {
@@ -40,8 +40,16 @@ absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, Coor
                                                      params.characteristic_frames[i - 1]));
     }
   }
-  if (params.clip_ids.empty() && params.tags.empty()) return std::vector<bool>();
-  std::vector<bool> allowed(library.clip_count(), false);
+  SearchFilter filter;
+  if (params.excluded) {
+    // A clip outside the library has no results to leave out.
+    filter.excluded_clip = library.FindClip(params.excluded->clip_id);
+    filter.excluded_first = params.excluded->first_frame;
+    filter.excluded_last = params.excluded->last_frame;
+  }
+  if (params.clip_ids.empty() && params.tags.empty()) return filter;
+  std::vector<bool>& allowed = filter.allowed;
+  allowed.assign(library.clip_count(), false);
   for (int64_t id : params.clip_ids) {
     const int index = library.FindClip(id);
     if (index < 0) return absl::NotFoundError(absl::StrCat("clip ", id, " is not in the library"));
@@ -56,7 +64,7 @@ absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, Coor
       });
     }
   }
-  return allowed;
+  return filter;
 }
 
 SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame) {
@@ -70,9 +78,11 @@ SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame) {
   return result;
 }
 
-std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+std::vector<SearchResult> FinishResults(const LibraryIndex& library, const SearchFilter& filter,
                                         std::vector<SearchResult> candidates,
                                         const SearchParams& params) {
+  // Refinement and the exact search's paths may move a candidate that was admitted.
+  std::erase_if(candidates, [&](const SearchResult& c) { return !filter.Admits(c); });
   std::vector<SearchResult> results =
       RankResults(std::move(candidates), params.max_overlap, params.max_results);
   for (SearchResult& result : results) {

@@ -225,15 +225,13 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
 
 absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& request) {
   const v1::SearchRequest& search = request.search();
-  // The fields a job sets per query, or that it does not do.
+  // The fields a job sets per query, or that it does not do (the application refuses the
+  // others: server/propagation.cc).
   const std::pair<bool, const char*> refused[] = {
       {!search.space().empty(), "search.space: give the space as space"},
       {search.query_case() != v1::SearchRequest::QUERY_NOT_SET,
        "search.query: the job's queries are its manual labels"},
-      {search.clip_ids_size() > 0,
-       "search.clip_ids: a propagation searches every clip of the space (filter by tags)"},
       {search.tags_size() > 0, "search.tags: give the tags as tags"},
-      {search.return_path(), "search.return_path: a propagation keeps no paths"},
       {search.explain(), "search.explain: a propagation keeps no explanations"},
       {search.has_exclude_query(), "search.exclude_query: a query's own range is always excluded"},
       {search.has_characteristic_frame(), "search.characteristic_frame: each query finds its own"},

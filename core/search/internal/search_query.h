@@ -16,17 +16,35 @@
 
 namespace motiondb {
 
+// SearchParams' filters resolved against a library: the clips a search looks in, and the range
+// of one that no result may overlap.
+struct SearchFilter {
+  std::vector<bool> allowed;  // by clip index; empty: every clip
+  int excluded_clip = -1;     // the excluded range's clip index; -1: none
+  int64_t excluded_first = 0, excluded_last = -1;
+
+  // Whether a result in the clip of index `clip` over frames first..last may be returned.
+  bool Admits(int clip, int64_t first, int64_t last) const {
+    return clip != excluded_clip || last < excluded_first || first > excluded_last;
+  }
+  bool Admits(const SearchResult& result) const {
+    return Admits(result.clip_index, result.first_frame, result.last_frame);
+  }
+};
+
 // Checks the parameters and that the query has frames, the library's dimensions, and finite
-// coordinates; returns the allowed-clip mask of the filters (empty: every clip).
-absl::StatusOr<std::vector<bool>> PrepareQuery(const LibraryIndex& library, CoordinateView query,
-                                               const SearchParams& params);
+// coordinates; returns the filters resolved. The one check of a search's parameters: the
+// searches it dispatches to take its filter and do not check again.
+absl::StatusOr<SearchFilter> PrepareQuery(const LibraryIndex& library, CoordinateView query,
+                                          const SearchParams& params);
 
 // A candidate: the clip by index, the warp's frames and score. Its clip id, name and times are
 // filled by FinishResults, only for the results kept.
 SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame);
 
-// RankResults, then each kept result's clip id, name and start and end in seconds.
-std::vector<SearchResult> FinishResults(const LibraryIndex& library,
+// The candidates `filter` admits, ranked (RankResults), then each kept result's clip id, name
+// and start and end in seconds.
+std::vector<SearchResult> FinishResults(const LibraryIndex& library, const SearchFilter& filter,
                                         std::vector<SearchResult> candidates,
                                         const SearchParams& params);
 
