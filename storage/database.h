@@ -202,10 +202,10 @@ class Database {
   // The clip's frames `frames` handed to `consume` in batches of at most `batch_frames`, in
   // order, each a clip of those frames sharing one skeleton (the clip's own), read from the
   // stored blobs piece by piece in one read snapshot: memory holds a batch whatever the clip's
-  // length, and the clip stays as it was until the last batch. The snapshot is held while `consume` runs, so a slow consumer keeps the
-  // write-ahead log from being checkpointed past it. consume's first error ends the read and is
-  // returned. NOT_FOUND for an unknown clip; OUT_OF_RANGE when `frames` is empty or not inside
-  // it; INVALID_ARGUMENT for a batch_frames below 1.
+  // length, and the clip stays as it was until the last batch. The snapshot is held while `consume`
+  // runs, so a slow consumer keeps the write-ahead log from being checkpointed past it. consume's
+  // first error ends the read and is returned. NOT_FOUND for an unknown clip; OUT_OF_RANGE when
+  // `frames` is empty or not inside it; INVALID_ARGUMENT for a batch_frames below 1.
   absl::Status ReadClipFrames(int64_t clip_id, FrameRange frames, int batch_frames,
                               const std::function<absl::Status(const Clip& batch)>& consume);
   absl::StatusOr<ClipRecord> GetClipRecordByName(const std::string& name);  // NOT_FOUND
