@@ -11,7 +11,6 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -48,14 +47,10 @@ std::unique_ptr<grpc::ClientContext> Context() {
   return context;
 }
 
-// Median and p95 (nearest rank) of `ms`, in milliseconds.
-std::string Summary(std::vector<double> ms) {
-  std::sort(ms.begin(), ms.end());
-  const auto rank = [&](double q) {
-    return ms[std::min(ms.size() - 1, static_cast<size_t>(q * static_cast<double>(ms.size())))];
-  };
-  return absl::StrCat(absl::SixDigits(rank(0.5)), " ms median, ", absl::SixDigits(rank(0.95)),
-                      " ms p95");
+// Median and p95 of `ms`, in milliseconds.
+std::string Summary(const std::vector<double>& ms) {
+  return absl::StrCat(absl::SixDigits(bench::Percentile(ms, 0.5)), " ms median, ",
+                      absl::SixDigits(bench::Percentile(ms, 0.95)), " ms p95");
 }
 
 absl::Status Run(const Flags& flags) {
