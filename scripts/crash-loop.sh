@@ -9,7 +9,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
-BUILD_DIR="$build_dir" "$root/scripts/build.sh" server_test motiondb-server >/dev/null
+BUILD_DIR="$build_dir" "$root/scripts/build.sh" server_crash_test motiondb-server >/dev/null
 MOTIONDB_CRASH_ROUNDS="${1:-20}" MOTIONDB_CRASH_SEED="${2:-1}" \
-  "$build_dir/tests/server_test" \
+  "$build_dir/tests/server_crash_test" \
   --gtest_filter='ServerTest.KillAtRandomPointsLosesNoAcknowledgedWriteAndLeavesNoHalfWrite'

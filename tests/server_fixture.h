@@ -1,13 +1,16 @@
-// The fixture of the server's integration tests (server_test.cc, server_fault_test.cc): a
-// synthetic library, a client of one server over the generated stubs, and a temporary folder
-// whose database the real motiondb-server binary is started on.
+// The fixture of the server's integration tests (server_*_test.cc, server_fault_test.cc and
+// others): a synthetic library, a client of one server over the generated stubs, a temporary
+// folder whose database the real motiondb-server binary is started on, and the helpers of labels,
+// searches and propagation jobs that more than one of those files uses.
 #ifndef MOTIONDB_TESTS_SERVER_FIXTURE_H_
 #define MOTIONDB_TESTS_SERVER_FIXTURE_H_
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -190,6 +193,37 @@ class ServerTest : public ::testing::Test {
   std::string db_;
   std::vector<std::unique_ptr<testing::ServerProcess>> servers_;
 };
+
+// ---------------------------------------------------------------------------------------------
+// Labels, searches and propagation jobs (the calls of a test, with failed expectations).
+
+// A manual label on frames `first`..`last` of a clip (both unset: the whole clip).
+v1::NewLabel FrameLabel(int64_t clip_id, std::optional<int> first, std::optional<int> last,
+                        const std::string& descriptor, std::optional<double> value = 1.0);
+
+// The same results, place and score, in the same order.
+void ExpectSameResults(const v1::SearchResponse& after, const v1::SearchResponse& before);
+
+// Adds `labels` (manual); returns them as stored.
+std::vector<v1::Label> AddLabelsOrFail(Client& client, const std::vector<v1::NewLabel>& labels);
+
+v1::StartPropagationRequest Propagation(const std::vector<std::string>& descriptors,
+                                        int max_results = 8);
+
+// The job as started; an empty job after a failed expectation.
+v1::Job StartOrFail(Client& client, const v1::StartPropagationRequest& request);
+
+bool Ended(const v1::Job& job);
+
+// Polls the job until `done(job)` (the job then) or 120 s (a failed expectation).
+v1::Job PollJob(Client& client, const std::string& job_id,
+                const std::function<bool(const v1::Job&)>& done = Ended);
+
+// Every propagated label, in id order.
+std::vector<v1::Label> Propagated(Client& client);
+
+// Many manual labels of "long" over the humanoid library, so that a job runs for a while.
+std::vector<v1::Label> LabelManyRanges(Client& client, const std::vector<int64_t>& ids, int count);
 
 }  // namespace motiondb
 
