@@ -35,6 +35,9 @@ namespace motiondb {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 struct Flags {
   int repetitions = 20;

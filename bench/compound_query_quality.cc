@@ -51,6 +51,12 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticActionName;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+
 struct Flags {
   std::vector<std::string> sources = {"synthetic", "real"};
   std::vector<std::string> cases;  // empty: every case of the sources

@@ -44,6 +44,9 @@ namespace {
 
 using bench::Clock;
 using bench::SecondsSince;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 // The edits' take: 20 minutes at 120 fps of the 21-joint humanoid, whose BVH (144,000 frames of
 // 66 channels, up to 20 bytes a value as the answer limit counts it: 181 MiB) is about as long

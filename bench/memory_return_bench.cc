@@ -37,6 +37,9 @@ namespace {
 using bench::Clock;
 using bench::SecondsSince;
 using bench::StatusMiB;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 struct Flags {
   double seconds = 75;

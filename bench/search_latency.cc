@@ -38,6 +38,10 @@ using bench::MocapRoot;
 using bench::Percentile;
 using bench::SecondsSince;
 using bench::StatusMiB;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+using testing::SyntheticSegment;
 
 struct Query {
   RowMatrixXf coordinates;

@@ -35,6 +35,10 @@
 namespace motiondb {
 namespace {
 
+using testing::EvaluateRetrieval;
+using testing::RetrievalOptions;
+using testing::RetrievalReport;
+
 // The flags, with the defaults of the space and the search.
 struct QualityFlags {
   std::vector<std::string> folders = {(bench::MocapRoot() / "bandai2-normal").string()};

@@ -66,6 +66,9 @@ using bench::Percentile;
 using bench::SecondsSince;
 using bench::StatusMiB;
 using bench::Throughput;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 // `server_ms`: the latencies the server logged for the same calls (empty in process).
 void PrintThroughput(const std::string& label, const Throughput& t,

@@ -51,6 +51,9 @@ namespace {
 using bench::Clock;
 using bench::SecondsSince;
 using bench::StatusMiB;
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 struct Flags {
   double seconds = 600;

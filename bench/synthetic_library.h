@@ -31,10 +31,11 @@ struct StoredLibrary {
 // at `db` (created when absent) and creates the space `space` over it, trained on the first clip.
 inline absl::StatusOr<StoredLibrary> StoreSyntheticLibrary(const std::string& db, double hours,
                                                            double fps, const std::string& space) {
-  SyntheticCorpusOptions options;
+  testing::SyntheticCorpusOptions options;
   options.fps = fps;
   options.target_duration_s = hours * 3600;
-  MOTIONDB_ASSIGN_OR_RETURN(SyntheticCorpus generated, GenerateSyntheticCorpus(options));
+  MOTIONDB_ASSIGN_OR_RETURN(testing::SyntheticCorpus generated,
+                            testing::GenerateSyntheticCorpus(options));
   MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<storage::Database> database,
                             storage::Database::Open(db));
   server::IndexRegistry registry;

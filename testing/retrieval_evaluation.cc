@@ -6,7 +6,7 @@
 #include "core/search/motion_search.h"
 #include "util/status_macros.h"
 
-namespace motiondb {
+namespace motiondb::testing {
 namespace {
 
 double Percentile(std::vector<double> values, double p) {
@@ -127,4 +127,4 @@ absl::StatusOr<RetrievalReport> EvaluateRetrieval(const LibraryIndex& library,
   return report;
 }
 
-}  // namespace motiondb
+}  // namespace motiondb::testing

@@ -13,7 +13,7 @@
 #include "core/index/library_index.h"
 #include "core/search/search_params.h"
 
-namespace motiondb {
+namespace motiondb::testing {
 
 struct RetrievalOptions {
   // Search parameters of every query (filters are set by the evaluation).
@@ -55,6 +55,6 @@ absl::StatusOr<RetrievalReport> EvaluateRetrieval(const LibraryIndex& library,
                                                   const std::vector<std::string>& labels,
                                                   const RetrievalOptions& options);
 
-}  // namespace motiondb
+}  // namespace motiondb::testing
 
 #endif  // MOTIONDB_TESTING_RETRIEVAL_EVALUATION_H_

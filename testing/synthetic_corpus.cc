@@ -15,7 +15,7 @@
 // of every draw and the clips' layout (synthetic_plan.h), and the rendering of the frames
 // (synthetic_render.h).
 
-namespace motiondb {
+namespace motiondb::testing {
 namespace {
 
 using synthetic::ClipPlan;
@@ -171,4 +171,4 @@ absl::StatusOr<SyntheticCorpus> GenerateSyntheticCorpus(const SyntheticCorpusOpt
   return library;
 }
 
-}  // namespace motiondb
+}  // namespace motiondb::testing

@@ -23,7 +23,7 @@
 #include "core/motion/clip.h"
 #include "core/motion/skeleton.h"
 
-namespace motiondb {
+namespace motiondb::testing {
 
 enum class SyntheticAction { kRightArmRaise, kLeftArmRaise, kBothArmsRaise, kShrug, kSlouch };
 
@@ -108,6 +108,6 @@ struct SyntheticCorpus {
 // Generates the library. INVALID_ARGUMENT names the offending option.
 absl::StatusOr<SyntheticCorpus> GenerateSyntheticCorpus(const SyntheticCorpusOptions& options);
 
-}  // namespace motiondb
+}  // namespace motiondb::testing
 
 #endif  // MOTIONDB_TESTING_SYNTHETIC_CORPUS_H_

@@ -12,7 +12,7 @@
 
 #include "core/motion/skeleton.h"
 
-namespace motiondb {
+namespace motiondb::testing {
 namespace synthetic {
 namespace {
 
@@ -170,4 +170,4 @@ std::shared_ptr<const Skeleton> SyntheticSkeleton() {
   return skeleton;
 }
 
-}  // namespace motiondb
+}  // namespace motiondb::testing

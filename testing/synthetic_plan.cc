@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace motiondb::synthetic {
+namespace motiondb::testing::synthetic {
 namespace {
 
 // At least 3 frames, so that rise, hold and fall each get one.
@@ -120,4 +120,4 @@ std::vector<SyntheticSegment> Segments(const std::vector<PlannedAction>& plans,
   return segments;
 }
 
-}  // namespace motiondb::synthetic
+}  // namespace motiondb::testing::synthetic

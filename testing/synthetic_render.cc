@@ -10,7 +10,7 @@
 
 #include "absl/status/status.h"
 
-namespace motiondb::synthetic {
+namespace motiondb::testing::synthetic {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
@@ -227,4 +227,4 @@ absl::StatusOr<std::vector<Clip>> RenderClips(const SwayPhases& sway, double fps
   return clips;
 }
 
-}  // namespace motiondb::synthetic
+}  // namespace motiondb::testing::synthetic

@@ -13,7 +13,10 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
 using ::testing::HasSubstr;
+using testing::SyntheticAction;
+using testing::SyntheticCorpusOptions;
 
 // One instance of `action` at `fps`, with half a second of rest either side.
 Clip OneAction(SyntheticAction action, uint64_t seed, double fps = 30) {

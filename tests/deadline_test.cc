@@ -41,7 +41,10 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
 using ::testing::HasSubstr;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
 
 constexpr int64_t kNever = std::numeric_limits<int64_t>::max();
 

@@ -9,6 +9,10 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticCorpusOptions;
+
 Clip ShortClip() {
   SyntheticCorpusOptions options;
   options.fps = 30;

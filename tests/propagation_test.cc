@@ -20,6 +20,12 @@
 namespace motiondb::server {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+using testing::SyntheticSegment;
+
 storage::LabelRecord Range(int64_t first, int64_t last, double value, double score = 0.1) {
   storage::LabelRecord label;
   label.clip_id = 1;

@@ -17,6 +17,15 @@
 namespace motiondb {
 namespace {
 
+using testing::EvaluateRetrieval;
+using testing::GenerateSyntheticCorpus;
+using testing::RetrievalOptions;
+using testing::RetrievalReport;
+using testing::SyntheticAction;
+using testing::SyntheticActionName;
+using testing::SyntheticCorpus;
+using testing::SyntheticSegment;
+
 class SyntheticValidation : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {

@@ -23,6 +23,7 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::ServerProcess;
+using testing::SyntheticSegment;
 
 // A tmpfs of a given size mounted on a folder for the life of the object.
 class ScratchFileSystem {

@@ -7,6 +7,12 @@
 
 namespace motiondb {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+using testing::SyntheticSegment;
+
 const SyntheticCorpus& Humanoid() {
   static const SyntheticCorpus* const library = [] {
     SyntheticCorpusOptions options;

@@ -34,9 +34,9 @@ namespace v1 = ::motiondb::v1;
 
 // A small library of the synthetic humanoid (21 joints) with arm raises and shrugs at 50 fps,
 // in clips of about 20 s; generated once.
-const SyntheticCorpus& Humanoid();
+const testing::SyntheticCorpus& Humanoid();
 // The first right-arm raise of the humanoid library: its clip index and frames (50 fps).
-const SyntheticSegment& FirstRaise();
+const testing::SyntheticSegment& FirstRaise();
 
 std::string BvhText(const Clip& clip);
 // A 3-joint chain (another skeleton than the humanoid's) turning slowly, 61 frames at 30 fps.
@@ -170,7 +170,7 @@ class ServerTest : public ::testing::Test {
   // returns the clip ids.
   std::vector<int64_t> IngestHumanoid(Client& client) {
     std::vector<int64_t> ids;
-    const SyntheticCorpus& library = Humanoid();
+    const testing::SyntheticCorpus& library = Humanoid();
     for (size_t i = 0; i < library.clips.size(); ++i) {
       ids.push_back(client.IngestOrFail("humanoid_" + std::to_string(i) + ".bvh",
                                         BvhText(library.clips[i]),

@@ -22,9 +22,13 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using testing::ServerProcess;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+using testing::SyntheticSegment;
 
 // A database file damaged on disk, truncated or with zeroed pages, is refused at start with a
 // message that says so and exit code 1, never a crash; the file is left as it was.

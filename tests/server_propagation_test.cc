@@ -18,6 +18,8 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::ServerProcess;
+using testing::SyntheticAction;
+using testing::SyntheticSegment;
 
 bool Overlap(int64_t first, int64_t last, const SyntheticSegment& segment) {
   return first <= segment.last_frame && last >= segment.first_frame;

@@ -17,6 +17,8 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing::ServerProcess;
+using testing::SyntheticAction;
+using testing::SyntheticSegment;
 
 TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   ServerProcess* server = StartServer();

@@ -15,6 +15,17 @@
 namespace motiondb {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticActionName;
+using testing::SyntheticActionNominalDuration;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+using testing::SyntheticScriptStep;
+using testing::SyntheticSegment;
+using testing::SyntheticSkeleton;
+using testing::ThesisSyntheticScript;
+
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 SyntheticCorpus Generate(const SyntheticCorpusOptions& options) {

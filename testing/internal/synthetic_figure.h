@@ -11,7 +11,7 @@
 #include "core/motion/rotation.h"
 #include "testing/synthetic_corpus.h"
 
-namespace motiondb::synthetic {
+namespace motiondb::testing::synthetic {
 
 inline constexpr double kDeg = std::numbers::pi / 180.0;
 
@@ -69,6 +69,6 @@ struct PoseDraws {
 // The pose `action` peaks at, from `rest` with this instance's draws.
 Pose PeakPose(SyntheticAction action, const PoseDraws& draws, const Pose& rest);
 
-}  // namespace motiondb::synthetic
+}  // namespace motiondb::testing::synthetic
 
 #endif  // MOTIONDB_TESTING_INTERNAL_SYNTHETIC_FIGURE_H_

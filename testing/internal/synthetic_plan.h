@@ -13,7 +13,7 @@
 #include "testing/internal/synthetic_figure.h"
 #include "testing/synthetic_corpus.h"
 
-namespace motiondb::synthetic {
+namespace motiondb::testing::synthetic {
 
 // Nominal phases of each action in seconds: rising to the peak pose, holding it, returning.
 struct Phases {
@@ -83,6 +83,6 @@ std::vector<ClipPlan> LayoutClips(const std::vector<PlannedAction>& plans, int f
 std::vector<SyntheticSegment> Segments(const std::vector<PlannedAction>& plans,
                                        const std::vector<ClipPlan>& layout);
 
-}  // namespace motiondb::synthetic
+}  // namespace motiondb::testing::synthetic
 
 #endif  // MOTIONDB_TESTING_INTERNAL_SYNTHETIC_PLAN_H_

@@ -10,7 +10,7 @@
 #include "core/motion/clip.h"
 #include "testing/internal/synthetic_plan.h"
 
-namespace motiondb::synthetic {
+namespace motiondb::testing::synthetic {
 
 // The idle sway's seeded phases (radians): breathing, weight shift, head turn.
 struct SwayPhases {
@@ -28,6 +28,6 @@ absl::StatusOr<std::vector<Clip>> RenderClips(const SwayPhases& sway, double fps
                                               const std::vector<PlannedAction>& plans,
                                               const std::vector<ClipPlan>& layout, int threads);
 
-}  // namespace motiondb::synthetic
+}  // namespace motiondb::testing::synthetic
 
 #endif  // MOTIONDB_TESTING_INTERNAL_SYNTHETIC_RENDER_H_

@@ -14,6 +14,11 @@
 namespace motiondb::fuzz {
 namespace {
 
+using testing::GenerateSyntheticCorpus;
+using testing::SyntheticAction;
+using testing::SyntheticCorpus;
+using testing::SyntheticCorpusOptions;
+
 [[noreturn]] void Die(const absl::Status& status) {
   std::fprintf(stderr, "fuzz library: %s\n", status.ToString().c_str());
   std::abort();
