@@ -514,7 +514,7 @@ const v1::Label* Strongest(const std::vector<const v1::Label*>& labels, int64_t 
   return best;
 }
 
-// server/propagation.h's factor, for examples of value 1.
+// server/jobs/propagation.h's factor, for examples of value 1.
 double Factor(double score, double scale) { return std::exp2(-std::pow(score / scale, 2)); }
 
 // The s0 of a job whose examples have value 1: each propagated label of value v < 1 and score s

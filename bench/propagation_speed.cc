@@ -42,7 +42,7 @@
 #include "motiondb/v1/job_service.grpc.pb.h"
 #include "motiondb/v1/label_service.grpc.pb.h"
 #include "motiondb/v1/search_service.grpc.pb.h"
-#include "server/propagation.h"
+#include "server/jobs/propagation.h"
 #include "testing/server_process.h"
 #include "util/cli_conventions.h"
 #include "util/status_macros.h"

@@ -10,7 +10,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "server/catalog.h"
-#include "server/upload.h"
+#include "server/upload/upload.h"
 #include "storage/database.h"
 
 namespace motiondb::server {

@@ -19,7 +19,7 @@
 #include "server/frame_conversion.h"
 #include "server/index_registry.h"
 #include "server/search_explanation.h"
-#include "server/upload.h"
+#include "server/upload/upload.h"
 #include "storage/database.h"
 
 namespace motiondb::server {

@@ -68,7 +68,7 @@ struct ClipRecord {
   int joint_count = 0;
   std::string content_hash;
   // Where a clip made by an operator came from, as JSON text the application writes and reads
-  // (server/provenance.h); empty for an ingested clip. Stored as given.
+  // (server/edit/provenance.h); empty for an ingested clip. Stored as given.
   std::string provenance;
 };
 

@@ -1,6 +1,6 @@
-// Propagation (server/propagation.h): which candidate ranges are kept, and the space's score
+// Propagation (server/jobs/propagation.h): which candidate ranges are kept, and the space's score
 // scale behind the similarity factor, on a real library and space.
-#include "server/propagation.h"
+#include "server/jobs/propagation.h"
 
 #include <cmath>
 #include <filesystem>

@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "server/grpc/proto_conversion.h"
+#include "server/grpc/space_conversion.h"
 #include "tests/synthetic_motion.h"
 
 namespace motiondb::server {

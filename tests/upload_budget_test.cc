@@ -1,6 +1,6 @@
 // The upload budget shared by the ingests in progress: admission, bytes held across uploads,
 // and what a finished upload gives back.
-#include "server/upload_budget.h"
+#include "server/upload/upload_budget.h"
 
 #include <optional>
 #include <string>

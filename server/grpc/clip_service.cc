@@ -8,11 +8,11 @@
 #include "server/clip_ingest.h"
 #include "server/clip_poses.h"
 #include "server/grpc/call_context.h"
-#include "server/grpc/proto_conversion.h"
+#include "server/grpc/clip_conversion.h"
+#include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
 #include "server/listing.h"
-#include "util/name_text.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -20,21 +20,15 @@ namespace motiondb::server {
 grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
                                          const v1::IngestClipRequest* request,
                                          v1::IngestClipResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<IngestRequest> ingest = FromProto(*request);
-    if (!ingest.ok()) return ToGrpcStatus(ingest.status());
-    absl::StatusOr<UploadBudget::Ticket> ticket = budget_.Admit();
-    if (!ticket.ok()) return ToGrpcStatus(ticket.status());
-    if (const absl::Status reserved = ticket->Reserve(static_cast<int64_t>(request->bvh().size()));
-        !reserved.ok()) {
-      return ToGrpcStatus(reserved);
-    }
-    const absl::StatusOr<IngestOutcome> outcome =
-        IngestUpload(catalog_, *ingest, request->bvh(), limits_, StopWhenCallEnds(context));
-    if (!outcome.ok()) return ToGrpcStatus(ExplainStop(outcome.status(), context));
-    metrics_.CountIngest(*outcome);
-    ToProto(*outcome, response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const IngestRequest ingest, FromProto(*request));
+    MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
+    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(request->bvh().size())));
+    MOTIONDB_ASSIGN_OR_RETURN(const IngestOutcome outcome,
+                              IngestUpload(catalog_, ingest, request->bvh(), limits_, should_stop));
+    metrics_.CountIngest(outcome);
+    ToProto(outcome, response);
+    return absl::OkStatus();
   });
 }
 
@@ -53,11 +47,10 @@ absl::StatusOr<ClipServiceImpl::ReadUpload> ClipServiceImpl::ReadStream(
   return ReadUpload{std::move(ticket), std::move(upload)};
 }
 
-absl::Status ClipServiceImpl::IngestStreamed(grpc::ServerContext* context, ReadUpload read,
+absl::Status ClipServiceImpl::IngestStreamed(ReadUpload read, const ShouldStop& should_stop,
                                              v1::IngestClipResponse* response) {
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
-  const std::function<bool()> should_stop = StopWhenCallEnds(context);
   if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
   MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult parsed, read.upload.bvh.Finish());
   MOTIONDB_ASSIGN_OR_RETURN(
@@ -77,99 +70,90 @@ grpc::Status ClipServiceImpl::IngestClipStream(
   if (grpc::Status allowed = gate_.Allowed(context); !allowed.ok()) return allowed;
   absl::StatusOr<ReadUpload> read = ReadStream(context, reader);
   if (!read.ok()) return ToGrpcStatus(ExplainStop(read.status(), context));
-  return gate_.Run(context, [&]() -> grpc::Status {
-    return ToGrpcStatus(ExplainStop(IngestStreamed(context, *std::move(read), response), context));
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) {
+    return IngestStreamed(*std::move(read), should_stop, response);
   });
 }
 
 grpc::Status ClipServiceImpl::ListClips(grpc::ServerContext* context,
                                         const v1::ListClipsRequest* request,
                                         v1::ListClipsResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<storage::ClipPage> page =
-        server::ListClips(database_, FromProto(*request), answers_);
-    if (!page.ok()) return ToGrpcStatus(page.status());
-    ToProto(*page, response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipPage page,
+                              server::ListClips(database_, FromProto(*request), answers_));
+    ToProto(page, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::GetClipPoses(grpc::ServerContext* context,
                                            const v1::GetClipPosesRequest* request,
                                            v1::ClipPoses* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<ClipPoses> poses = ReadClipPoses(database_, FromProto(*request), answers_);
-    if (!poses.ok()) return ToGrpcStatus(poses.status());
-    ToProto(*poses, response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const ClipPoses poses,
+                              ReadClipPoses(database_, FromProto(*request), answers_));
+    ToProto(poses, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::ListSkeletons(grpc::ServerContext* context,
                                             const v1::ListSkeletonsRequest* /*request*/,
                                             v1::ListSkeletonsResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<std::vector<storage::SkeletonSummary>> skeletons =
-        database_.ListSkeletons();
-    if (!skeletons.ok()) return ToGrpcStatus(skeletons.status());
-    for (const storage::SkeletonSummary& skeleton : *skeletons) {
-      ToProto(skeleton, response->add_skeletons());
-    }
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<storage::SkeletonSummary> skeletons,
+                              database_.ListSkeletons());
+    ToProto(skeletons, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::GetClip(grpc::ServerContext* context,
                                       const v1::GetClipRequest* request, v1::Clip* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
     // The record and skeleton only: the frames are not shown.
-    const absl::StatusOr<storage::ClipLayout> layout = database_.GetClipLayout(request->clip_id());
-    if (!layout.ok()) return ToGrpcStatus(layout.status());
-    ToProto(layout->record, response);
-    // Joint names an older version stored unchecked may not be UTF-8, which protobuf cannot
-    // carry: shown with U+FFFD (util/name_text.h).
-    for (const Joint& joint : layout->skeleton->joints())
-      response->add_joint_names(ValidUtf8(joint.name));
-    return grpc::Status::OK;
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipLayout layout,
+                              database_.GetClipLayout(request->clip_id()));
+    ToProto(layout, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::DeleteClip(grpc::ServerContext* context,
                                          const v1::DeleteClipRequest* request,
                                          v1::DeleteClipResponse* /*response*/) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    return ToGrpcStatus(
-        ExplainStop(catalog_.DeleteClip(request->clip_id(), StopWhenCallEnds(context)), context));
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) {
+    return catalog_.DeleteClip(request->clip_id(), should_stop);
   });
 }
 
 grpc::Status ClipServiceImpl::UpdateClip(grpc::ServerContext* context,
                                          const v1::UpdateClipRequest* request, v1::Clip* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<storage::ClipRecord> updated =
-        catalog_.UpdateClip(request->clip_id(), FromProto(*request), StopWhenCallEnds(context));
-    if (!updated.ok()) return ToGrpcStatus(ExplainStop(updated.status(), context));
-    ToProto(*updated, response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const storage::ClipRecord updated,
+        catalog_.UpdateClip(request->clip_id(), FromProto(*request), should_stop));
+    ToProto(updated, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
                                          const v1::ExportClipRequest* request,
                                          v1::ExportClipResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    absl::StatusOr<ExportedBvh> exported = server::ExportClip(database_, FromProto(request->clip()),
-                                                              answers_, StopWhenCallEnds(context));
-    if (!exported.ok()) return ToGrpcStatus(ExplainStop(exported.status(), context));
-    ToProto(*std::move(exported), response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        ExportedBvh exported,
+        server::ExportClip(database_, FromProto(request->clip()), answers_, should_stop));
+    ToProto(std::move(exported), response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status ClipServiceImpl::ExportClipStream(grpc::ServerContext* context,
                                                const v1::ExportClipRequest* request,
                                                grpc::ServerWriter<v1::ExportClipResponse>* writer) {
-  return gate_.Run(context, [&]() -> grpc::Status {
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) {
     // Write blocks while the client's window is full, so a client that stops reading holds a
     // piece here, not the clip; it returns false once the call has ended.
     const auto send = [&](ExportedBvh piece) -> absl::Status {
@@ -178,9 +162,7 @@ grpc::Status ClipServiceImpl::ExportClipStream(grpc::ServerContext* context,
       if (!writer->Write(message)) return absl::CancelledError("the client stopped reading");
       return absl::OkStatus();
     };
-    return ToGrpcStatus(ExplainStop(
-        StreamClipExport(database_, FromProto(request->clip()), send, StopWhenCallEnds(context)),
-        context));
+    return StreamClipExport(database_, FromProto(request->clip()), send, should_stop);
   });
 }
 

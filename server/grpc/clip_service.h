@@ -2,6 +2,7 @@
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
+#include <functional>
 #include <string>
 
 #include "absl/status/status.h"
@@ -13,16 +14,16 @@
 #include "server/grpc/call_gate.h"
 #include "server/grpc/stream_upload.h"
 #include "server/grpc/stream_watchdog.h"
-#include "server/server_metrics.h"
-#include "server/upload.h"
-#include "server/upload_budget.h"
+#include "server/metrics/server_metrics.h"
+#include "server/upload/upload.h"
+#include "server/upload/upload_budget.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
 
 class ClipServiceImpl final : public v1::ClipService::Service {
  public:
-  // `budget` and `watchdog` bound the ingests in progress (server/upload_budget.h,
+  // `budget` and `watchdog` bound the ingests in progress (server/upload/upload_budget.h,
   // server/grpc/stream_watchdog.h); `answers` the exports and poses.
   ClipServiceImpl(storage::Database& database, Catalog& catalog, const UploadLimits& limits,
                   const AnswerLimit& answers, UploadBudget& budget, StreamWatchdog& watchdog,
@@ -66,7 +67,7 @@ class ClipServiceImpl final : public v1::ClipService::Service {
   };
   absl::StatusOr<ReadUpload> ReadStream(grpc::ServerContext* context,
                                         grpc::ServerReader<v1::IngestClipStreamRequest>* reader);
-  absl::Status IngestStreamed(grpc::ServerContext* context, ReadUpload read,
+  absl::Status IngestStreamed(ReadUpload read, const std::function<bool()>& should_stop,
                               v1::IngestClipResponse* response);
 
   storage::Database& database_;

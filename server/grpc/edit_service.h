@@ -1,10 +1,10 @@
 // motiondb.v1.EditService: the Motion Curve operators on stored clips (issue 16), each a thin
-// handler over server/edit_*.h and server/pose_models.h.
+// handler over server/edit/.
 #ifndef MOTIONDB_SERVER_GRPC_EDIT_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_EDIT_SERVICE_H_
 
 #include "motiondb/v1/edit_service.grpc.pb.h"
-#include "server/edit_context.h"
+#include "server/edit/context.h"
 #include "server/grpc/call_gate.h"
 
 namespace motiondb::server {
@@ -40,10 +40,11 @@ class EditServiceImpl final : public v1::EditService::Service {
                           v1::DetectPoseResponse* response) override;
 
  private:
-  // Converts `request`, runs `operation` on it and converts its outcome into `response`.
+  // Converts `request`, runs `operation` on it and converts its outcome into `response`: every
+  // operator's handler is this.
   template <typename Request, typename Response, typename Operation>
-  grpc::Status Serve(grpc::ServerContext* context, const Request& request, Response* response,
-                     const Operation& operation);
+  grpc::Status Operate(grpc::ServerContext* context, const Request& request, Response* response,
+                       const Operation& operation);
 
   EditContext context_;
   CallGate& gate_;

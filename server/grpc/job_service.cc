@@ -4,8 +4,10 @@
 
 #include "absl/strings/str_cat.h"
 
-#include "server/grpc/proto_conversion.h"
+#include "server/grpc/job_conversion.h"
+#include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
+#include "util/status_macros.h"
 
 namespace motiondb::server {
 namespace {
@@ -14,45 +16,47 @@ namespace {
 // does not wake a handler when its client goes.
 constexpr std::chrono::milliseconds kWatchPoll{200};
 
-// The call's answer: `job` in `response`, or its status.
-grpc::Status Reply(const absl::StatusOr<storage::JobRecord>& job, v1::Job* response) {
-  if (!job.ok()) return ToGrpcStatus(job.status());
-  ToProto(*job, response);
-  return grpc::Status::OK;
-}
-
 }  // namespace
 
 grpc::Status JobServiceImpl::StartPropagation(grpc::ServerContext* context,
                                               const v1::StartPropagationRequest* request,
                                               v1::Job* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    absl::StatusOr<PropagationRequest> propagation = FromProto(*request);
-    if (!propagation.ok()) return ToGrpcStatus(propagation.status());
-    return Reply(jobs_.StartPropagation(*std::move(propagation)), response);
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(PropagationRequest propagation, FromProto(*request));
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::JobRecord job,
+                              jobs_.StartPropagation(std::move(propagation)));
+    ToProto(job, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const v1::GetJobRequest* request,
                                     v1::Job* response) {
-  return gate_.Run(context, [&] { return Reply(jobs_.Get(request->job_id()), response); });
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::JobRecord job, jobs_.Get(request->job_id()));
+    ToProto(job, response);
+    return absl::OkStatus();
+  });
 }
 
 grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context,
                                       const v1::ListJobsRequest* request,
                                       v1::ListJobsResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<storage::JobPage> page =
-        jobs_.List({request->page_size(), request->page_token()});
-    if (!page.ok()) return ToGrpcStatus(page.status());
-    ToProto(*page, response);
-    return grpc::Status::OK;
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::JobPage page,
+                              jobs_.List({request->page_size(), request->page_token()}));
+    ToProto(page, response);
+    return absl::OkStatus();
   });
 }
 
 grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
                                        const v1::CancelJobRequest* request, v1::Job* response) {
-  return gate_.Run(context, [&] { return Reply(jobs_.Cancel(request->job_id()), response); });
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::JobRecord job, jobs_.Cancel(request->job_id()));
+    ToProto(job, response);
+    return absl::OkStatus();
+  });
 }
 
 grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context,
@@ -70,9 +74,9 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context,
     ~Release() { count.fetch_sub(1); }
   } release{watches_};
   absl::StatusOr<storage::JobRecord> job;
-  const grpc::Status admitted = gate_.Run(context, [&]() -> grpc::Status {
+  const grpc::Status admitted = Serve(gate_, context, [&](const ShouldStop&) {
     job = jobs_.Get(request->job_id());
-    return job.ok() ? grpc::Status::OK : ToGrpcStatus(job.status());
+    return job.status();
   });
   if (!admitted.ok()) return admitted;
   v1::Job message;

@@ -1,5 +1,5 @@
 // motiondb.v1.JobService: start, look at, list, cancel and watch background jobs
-// (server/job_runner.h runs them).
+// (server/jobs/job_runner.h runs them).
 #ifndef MOTIONDB_SERVER_GRPC_JOB_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_JOB_SERVICE_H_
 
@@ -7,7 +7,7 @@
 
 #include "motiondb/v1/job_service.grpc.pb.h"
 #include "server/grpc/call_gate.h"
-#include "server/job_runner.h"
+#include "server/jobs/job_runner.h"
 
 namespace motiondb::server {
 

@@ -20,7 +20,7 @@
 #include "server/grpc/server_info_service.h"
 #include "server/grpc/space_service.h"
 #include "server/index_registry.h"
-#include "server/job_runner.h"
+#include "server/jobs/job_runner.h"
 #include "server/net/handed_off_sockets.h"
 #include "server/net/listener.h"
 #include "server/search_runner.h"

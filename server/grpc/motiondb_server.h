@@ -14,8 +14,8 @@
 #include "server/grpc/access_control.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
-#include "server/server_metrics.h"
-#include "server/upload_budget.h"
+#include "server/metrics/server_metrics.h"
+#include "server/upload/upload_budget.h"
 
 namespace motiondb::server {
 

@@ -1,5 +1,6 @@
 // Every call, told once: a line on stderr (unless --quiet) and the server's metrics
-// (server/server_metrics.h). A line holds the time, method, status code name, latency and peer:
+// (server/metrics/server_metrics.h). A line holds the time, method, status code name, latency and
+// peer:
 //   2024-05-01T12:00:00.123Z /motiondb.v1.SearchService/Search OK 3.21ms ipv4:127.0.0.1:53422
 // and, for a failure of the server's own (a full disk, say), the status message in quotes.
 // A call of the HTTP face (server/http/) reaches the services in-process; its peer is shown as
@@ -15,7 +16,7 @@
 #include <grpcpp/support/status.h>
 
 #include "absl/strings/string_view.h"
-#include "server/server_metrics.h"
+#include "server/metrics/server_metrics.h"
 
 namespace motiondb::server {
 

@@ -3,9 +3,8 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "server/grpc/call_context.h"
-#include "server/grpc/proto_conversion.h"
-#include "server/grpc/status_conversion.h"
+#include "server/grpc/search_conversion.h"
+#include "server/grpc/serve.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -32,34 +31,28 @@ absl::StatusOr<v1::SearchResponse> SearchServiceImpl::SearchOne(
 grpc::Status SearchServiceImpl::Search(grpc::ServerContext* context,
                                        const v1::SearchRequest* request,
                                        v1::SearchResponse* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
     int64_t answers_used = 0;
-    absl::StatusOr<v1::SearchResponse> found =
-        SearchOne(*request, StopWhenCallEnds(context), &answers_used);
-    if (!found.ok()) return ToGrpcStatus(ExplainStop(found.status(), context));
-    *response = *std::move(found);
-    return grpc::Status::OK;
+    MOTIONDB_ASSIGN_OR_RETURN(*response, SearchOne(*request, should_stop, &answers_used));
+    return absl::OkStatus();
   });
 }
 
 absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
-                                      grpc::ServerContext* context,
+                                      const std::function<bool()>& should_stop,
                                       v1::SearchBatchResponse* response) {
   if (request.requests_size() > kMaxBatch) {
     return absl::InvalidArgumentError(absl::StrCat("requests: ", request.requests_size(),
                                                    " searches; at most ", kMaxBatch, " per batch"));
   }
-  const std::function<bool()> should_stop = StopWhenCallEnds(context);
   // The items' answers share the answer limit: each is checked with those before it.
   int64_t answers_used = 0;
   for (int i = 0; i < request.requests_size(); ++i) {
-    if (should_stop()) {
-      return ExplainStop(absl::CancelledError(absl::StrCat("before requests[", i, "]")), context);
-    }
+    if (should_stop()) return absl::CancelledError(absl::StrCat("before requests[", i, "]"));
     absl::StatusOr<v1::SearchResponse> found =
         SearchOne(request.requests(i), should_stop, &answers_used);
     // A stop ends the whole batch; any other failure belongs to its item alone.
-    if (absl::IsCancelled(found.status())) return ExplainStop(found.status(), context);
+    if (absl::IsCancelled(found.status())) return found.status();
     v1::SearchBatchItem* item = response->add_items();
     if (found.ok()) {
       *item->mutable_response() = *std::move(found);
@@ -76,8 +69,9 @@ absl::Status SearchServiceImpl::Batch(const v1::SearchBatchRequest& request,
 grpc::Status SearchServiceImpl::SearchBatch(grpc::ServerContext* context,
                                             const v1::SearchBatchRequest* request,
                                             v1::SearchBatchResponse* response) {
-  return gate_.Run(
-      context, [&]() -> grpc::Status { return ToGrpcStatus(Batch(*request, context, response)); });
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) {
+    return Batch(*request, should_stop, response);
+  });
 }
 
 }  // namespace motiondb::server

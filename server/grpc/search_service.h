@@ -8,8 +8,8 @@
 #include "motiondb/v1/search_service.grpc.pb.h"
 #include "server/answer_limit.h"
 #include "server/grpc/call_gate.h"
+#include "server/metrics/server_metrics.h"
 #include "server/search_runner.h"
-#include "server/server_metrics.h"
 
 namespace motiondb::server {
 
@@ -25,8 +25,8 @@ class SearchServiceImpl final : public v1::SearchService::Service {
                            v1::SearchBatchResponse* response) override;
 
  private:
-  absl::Status Batch(const v1::SearchBatchRequest& request, grpc::ServerContext* context,
-                     v1::SearchBatchResponse* response);
+  absl::Status Batch(const v1::SearchBatchRequest& request,
+                     const std::function<bool()>& should_stop, v1::SearchBatchResponse* response);
 
   // One search through the runner, as the response message, its answer checked with the
   // `answers_used` before it (a batch's), which its own then joins.

@@ -1,8 +1,10 @@
 #include "server/grpc/server_info_service.h"
 
 #include "server/database_backup.h"
-#include "server/grpc/proto_conversion.h"
-#include "server/grpc/status_conversion.h"
+#include "server/grpc/serve.h"
+#include "server/grpc/server_info_conversion.h"
+#include "server/grpc/space_conversion.h"
+#include "util/status_macros.h"
 
 #ifndef MOTIONDB_VERSION
 #error "MOTIONDB_VERSION must be defined by the build (server/grpc/CMakeLists.txt)"
@@ -13,13 +15,12 @@ namespace motiondb::server {
 grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* context,
                                                   const v1::GetServerInfoRequest* /*request*/,
                                                   v1::ServerInfo* response) {
-  return gate_.Run(context, [&]() -> grpc::Status {
-    const absl::StatusOr<storage::Counts> counts = database_.GetCounts();
-    if (!counts.ok()) return ToGrpcStatus(counts.status());
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::Counts counts, database_.GetCounts());
     response->set_version(MOTIONDB_VERSION);
     response->set_uptime_s(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
-    ToProto(*counts, response->mutable_counts());
+    ToProto(counts, response->mutable_counts());
     int64_t index_bytes = 0;
     for (const auto& snapshot : registry_.All()) {
       v1::SpaceIndexInfo* info = response->add_indices();
@@ -34,7 +35,7 @@ grpc::Status ServerInfoServiceImpl::GetServerInfo(grpc::ServerContext* context,
     response->set_auth_required(!options_.auth_tokens.empty());
     response->set_scope(std::string(TokenScopeName(access_.VerdictOf(context).scope)));
     response->set_tls(!options_.tls_cert_pem.empty());
-    return grpc::Status::OK;
+    return absl::OkStatus();
   });
 }
 
@@ -43,24 +44,22 @@ grpc::Status ServerInfoServiceImpl::CreateBackup(grpc::ServerContext* context,
                                                  grpc::ServerWriter<v1::BackupChunk>* writer) {
   // Large enough that per-message costs vanish, far below any message limit.
   constexpr size_t kChunkBytes = size_t{1} << 20;
-  return gate_.Run(context, [&]() -> grpc::Status {
-    absl::StatusOr<DatabaseBackup> backup = DatabaseBackup::Create(database_, options_.db_path);
-    if (!backup.ok()) return ToGrpcStatus(backup.status());
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(DatabaseBackup backup,
+                              DatabaseBackup::Create(database_, options_.db_path));
     // A database file is never empty, so the first chunk carries the size and counts.
     for (bool first = true;; first = false) {
-      absl::StatusOr<std::string> data = backup->ReadChunk(kChunkBytes);
-      if (!data.ok()) return ToGrpcStatus(data.status());
-      if (data->empty()) return grpc::Status::OK;
+      MOTIONDB_ASSIGN_OR_RETURN(std::string data, backup.ReadChunk(kChunkBytes));
+      if (data.empty()) return absl::OkStatus();
       v1::BackupChunk chunk;
       if (first) {
-        chunk.set_total_bytes(backup->size_bytes());
-        ToProto(backup->counts(), chunk.mutable_counts());
+        chunk.set_total_bytes(backup.size_bytes());
+        ToProto(backup.counts(), chunk.mutable_counts());
       }
-      chunk.set_data(*std::move(data));
+      chunk.set_data(std::move(data));
       // False once the client has gone: the copy is dropped with `backup`.
-      if (!writer->Write(chunk)) {
-        return grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading the backup");
-      }
+      if (!writer->Write(chunk))
+        return absl::CancelledError("the client stopped reading the backup");
     }
   });
 }

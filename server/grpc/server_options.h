@@ -9,7 +9,7 @@
 #include "server/answer_limit.h"
 #include "server/net/connection_counter.h"
 #include "server/search_runner.h"
-#include "server/upload.h"
+#include "server/upload/upload.h"
 #include "util/token_file.h"
 
 namespace motiondb::server {

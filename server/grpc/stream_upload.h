@@ -16,10 +16,10 @@
 #include "absl/status/statusor.h"
 #include "motiondb/v1/clip_service.pb.h"
 #include "server/clip_ingest.h"
-#include "server/grpc/proto_conversion.h"
-#include "server/streamed_upload.h"
-#include "server/upload.h"
-#include "server/upload_budget.h"
+#include "server/grpc/clip_conversion.h"
+#include "server/upload/streamed_upload.h"
+#include "server/upload/upload.h"
+#include "server/upload/upload_budget.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {

@@ -6,7 +6,8 @@
 // anything:
 // - the head within `head_timeout` of its first byte, at most 64 KiB and 100 fields
 //   (server/http/request_head.h), then `Hooks::check_head` (the token, the body's rules);
-// - a body only with a Content-Length, counted in the uploads' budget (server/upload_budget.h)
+// - a body only with a Content-Length, counted in the uploads' budget
+// (server/upload/upload_budget.h)
 //   from before it is read until it is whole, arriving at `min_body_rate` or faster (after a
 //   grace of `head_timeout`);
 // - `idle_timeout` between a connection's requests, `handshake_timeout` for TLS;
@@ -39,7 +40,7 @@
 #include "server/http/worker_pool.h"
 #include "server/net/listener.h"
 #include "server/net/socket_fd.h"
-#include "server/upload_budget.h"
+#include "server/upload/upload_budget.h"
 
 namespace motiondb::server {
 

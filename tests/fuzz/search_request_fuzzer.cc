@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "motiondb/v1/search_service.pb.h"
-#include "server/grpc/proto_conversion.h"
+#include "server/grpc/search_conversion.h"
 #include "server/search_runner.h"
 #include "tests/fuzz/fuzz_library.h"
 

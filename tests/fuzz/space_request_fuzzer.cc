@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "motiondb/v1/space_service.pb.h"
-#include "server/grpc/proto_conversion.h"
+#include "server/grpc/space_conversion.h"
 #include "server/space_builder.h"
 #include "tests/fuzz/fuzz_library.h"
 

@@ -1,3 +1,4 @@
-// Compiled only by the Layering test, which expects it to fail: the search engine may not see
-// the server's headers, and the build must say so rather than let the include through.
-#include "server/catalog.h"
+// Compiled only by the Layering tests, which expect it to fail: a layer may not see the headers
+// of a layer above it, and the build must say so rather than let the include through. The
+// header is the test's (MOTIONDB_WRONG_WAY_HEADER, a quoted path).
+#include MOTIONDB_WRONG_WAY_HEADER

@@ -1,0 +1,173 @@
+#include "server/grpc/clip_conversion.h"
+
+#include <string>
+#include <utility>
+
+#include "server/edit/provenance.h"
+#include "server/grpc/internal/field_conversion.h"
+#include "util/byte_coding.h"
+#include "util/name_text.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+absl::StatusOr<OnConflict> FromProto(v1::OnConflict on_conflict) {
+  switch (on_conflict) {
+    case v1::ON_CONFLICT_UNSPECIFIED:
+      return OnConflict::kSkipIdentical;
+    case v1::ON_CONFLICT_ERROR:
+      return OnConflict::kError;
+    case v1::ON_CONFLICT_SKIP:
+      return OnConflict::kSkip;
+    case v1::ON_CONFLICT_REPLACE:
+      return OnConflict::kReplace;
+    default:
+      return UnknownValue("on_conflict", on_conflict);
+  }
+}
+
+v1::IngestResult ToProto(IngestResult result) {
+  switch (result) {
+    case IngestResult::kStored:
+      return v1::INGEST_RESULT_STORED;
+    case IngestResult::kSkipped:
+      return v1::INGEST_RESULT_SKIPPED;
+    case IngestResult::kReplaced:
+      return v1::INGEST_RESULT_REPLACED;
+  }
+  return v1::INGEST_RESULT_UNSPECIFIED;
+}
+
+// IngestClipRequest and the first IngestClipStreamRequest carry the same fields.
+template <typename Message>
+absl::StatusOr<IngestRequest> IngestRequestOf(const Message& message) {
+  IngestRequest request;
+  request.file_name = message.file_name();
+  request.name = message.name();
+  request.tags.assign(message.tags().begin(), message.tags().end());
+  MOTIONDB_ASSIGN_OR_RETURN(request.on_conflict, FromProto(message.on_conflict()));
+  return request;
+}
+
+void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton) {
+  skeleton->set_skeleton_id(summary.skeleton_id);
+  skeleton->set_name(ValidUtf8(SkeletonName(summary)));
+  skeleton->set_joint_count(summary.joint_count);
+  skeleton->set_clip_count(summary.clip_count);
+  skeleton->set_root_joint(ValidUtf8(summary.root_joint));
+}
+
+}  // namespace
+
+ClipSelection FromProto(const v1::ClipRange& range) {
+  return {range.clip_id(), Optional(range.has_first_frame(), range.first_frame()),
+          Optional(range.has_last_frame(), range.last_frame())};
+}
+
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipRequest& request) {
+  return IngestRequestOf(request);
+}
+
+absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipStreamRequest& first) {
+  return IngestRequestOf(first);
+}
+
+storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request) {
+  storage::ClipUpdate update;
+  if (request.has_name()) update.name = request.name();
+  update.add_tags.assign(request.add_tags().begin(), request.add_tags().end());
+  update.remove_tags.assign(request.remove_tags().begin(), request.remove_tags().end());
+  return update;
+}
+
+ClipListRequest FromProto(const v1::ListClipsRequest& request) {
+  return {.page = {request.page_size(), request.page_token()},
+          .tag = request.tag(),
+          .name_contains = request.name_contains(),
+          .sort = request.sort(),
+          .skeleton_id = request.skeleton_id(),
+          .descriptor = request.descriptor_name()};
+}
+
+PosesRequest FromProto(const v1::GetClipPosesRequest& request) {
+  return {FromProto(request.clip()), Optional(request.has_max_rate(), request.max_rate())};
+}
+
+void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
+  const double fps = record.frame_time > 0 ? 1.0 / record.frame_time : 0.0;
+  clip->set_clip_id(record.clip_id);
+  clip->set_name(record.name);
+  clip->set_source_file(record.source_file);
+  for (const std::string& tag : record.tags) clip->add_tags(tag);
+  clip->set_skeleton_id(record.skeleton_id);
+  clip->set_created_unix_ms(record.created_unix_ms);
+  clip->set_frame_count(static_cast<int32_t>(record.frame_count));
+  clip->set_fps(fps);
+  clip->set_duration_s(fps > 0 ? record.frame_count / fps : 0.0);
+  clip->set_joint_count(record.joint_count);
+  clip->set_content_hash(record.content_hash);
+  if (const std::optional<Provenance> provenance = ParseProvenance(record.provenance)) {
+    v1::Provenance* out = clip->mutable_provenance();
+    out->set_operator_(provenance->op);
+    out->set_space(provenance->space);
+    for (const SourceRange& source : provenance->sources) {
+      v1::ClipRange* range = out->add_sources();
+      range->set_clip_id(source.clip_id);
+      range->set_first_frame(source.frames.first);
+      range->set_last_frame(source.frames.last);
+    }
+    out->set_parameters_json(provenance->parameters_json);
+  }
+}
+
+void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
+  ToProto(outcome.clip, response->mutable_clip());
+  for (const std::string& warning : outcome.warnings) response->add_warnings(warning);
+  for (const std::string& space : outcome.spaces) response->add_projected_spaces(space);
+  response->set_result(ToProto(outcome.result));
+  response->set_replaced_clip_id(outcome.replaced_clip_id);
+  for (const storage::ClipRecord& duplicate : outcome.duplicates) {
+    v1::ClipRef* same = response->add_duplicate_of();
+    same->set_clip_id(duplicate.clip_id);
+    same->set_name(duplicate.name);
+  }
+}
+
+void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response) {
+  response->set_bvh(std::move(exported.bvh));
+  response->set_file_name(exported.file_name);
+  response->set_first_frame(exported.frames.first);
+  response->set_last_frame(exported.frames.last);
+}
+
+void ToProto(const storage::ClipPage& page, v1::ListClipsResponse* response) {
+  for (const storage::ClipRecord& record : page.clips) ToProto(record, response->add_clips());
+  response->set_next_page_token(page.next_page_token);
+  response->set_total_size(page.total_size);
+}
+
+void ToProto(const ClipPoses& poses, v1::ClipPoses* response) {
+  response->set_clip_id(poses.clip_id);
+  for (const std::string& name : poses.joint_names) response->add_joint_names(ValidUtf8(name));
+  for (const int parent : poses.parents) response->add_parents(parent);
+  response->set_sample_rate(poses.sample_rate);
+  response->set_frames(static_cast<int32_t>(poses.positions.rows()));
+  response->set_first_frame(poses.frames.first);
+  response->set_last_frame(poses.frames.last);
+  AppendFloat32s(poses.positions.data(), poses.positions.size(), response->mutable_positions());
+}
+
+void ToProto(const storage::ClipLayout& layout, v1::Clip* clip) {
+  ToProto(layout.record, clip);
+  for (const Joint& joint : layout.skeleton->joints()) clip->add_joint_names(ValidUtf8(joint.name));
+}
+
+void ToProto(const std::vector<storage::SkeletonSummary>& skeletons,
+             v1::ListSkeletonsResponse* response) {
+  for (const storage::SkeletonSummary& skeleton : skeletons) {
+    ToProto(skeleton, response->add_skeletons());
+  }
+}
+
+}  // namespace motiondb::server
