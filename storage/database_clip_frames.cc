@@ -130,10 +130,18 @@ absl::Status Database::ReadClipFrames(int64_t clip_id, FrameRange frames, int ba
   });
 }
 
-absl::StatusOr<StoredClip> ReadClipRange(SqliteConnection& db, int64_t clip_id, FrameRange frames) {
+absl::StatusOr<StoredClip> ReadStoredClip(SqliteConnection& db, int64_t clip_id,
+                                          std::optional<FrameRange> frames) {
   MOTIONDB_ASSIGN_OR_RETURN(ClipLayout layout, ReadLayout(db, clip_id));
-  MOTIONDB_ASSIGN_OR_RETURN(FrameReader reader, FrameReader::Open(db, layout, frames));
-  MOTIONDB_ASSIGN_OR_RETURN(Clip clip, reader.Read(frames.first, frames.size()));
+  const int64_t frame_count = layout.record.frame_count;
+  if (!frames && frame_count == 0) {  // a BVH may say "Frames: 0"; there is no range to read
+    MOTIONDB_ASSIGN_OR_RETURN(
+        Clip clip, DecodeClipFrames(layout.skeleton, layout.record.frame_time, "", "", 0));
+    return StoredClip{std::move(layout.record), std::move(clip)};
+  }
+  const FrameRange range = frames.value_or(FrameRange{0, frame_count - 1});
+  MOTIONDB_ASSIGN_OR_RETURN(FrameReader reader, FrameReader::Open(db, layout, range));
+  MOTIONDB_ASSIGN_OR_RETURN(Clip clip, reader.Read(range.first, range.size()));
   return StoredClip{std::move(layout.record), std::move(clip)};
 }
 

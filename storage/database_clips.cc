@@ -334,23 +334,7 @@ absl::StatusOr<std::vector<int64_t>> Database::ClipsOfSkeleton(int64_t skeleton_
 absl::StatusOr<StoredClip> Database::GetClip(int64_t clip_id, std::optional<FrameRange> frames) {
   std::optional<StoredClip> result;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
-    if (frames) {
-      MOTIONDB_ASSIGN_OR_RETURN(result, ReadClipRange(db, clip_id, *frames));
-      return absl::OkStatus();
-    }
-    MOTIONDB_ASSIGN_OR_RETURN(
-        SqliteStatement query,
-        db.Prepare(absl::StrCat("SELECT ", kClipRecordColumns, ", ", kClipFrameColumns,
-                                " FROM clips c WHERE c.clip_id = ?1")));
-    query.BindInt64(1, clip_id);
-    MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.Step());
-    if (!found) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
-    ClipRecord record = ReadClipRecord(query);
-    MOTIONDB_ASSIGN_OR_RETURN(Clip clip, Prefixed(absl::StrCat("stored clip ", clip_id),
-                                                  ReadClip(query, record, record.frame_count)));
-    MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement tags, PrepareTagQuery(db));
-    MOTIONDB_ASSIGN_OR_RETURN(record.tags, LoadTags(tags, clip_id));
-    result.emplace(StoredClip{std::move(record), std::move(clip)});
+    MOTIONDB_ASSIGN_OR_RETURN(result, ReadStoredClip(db, clip_id, frames));
     return absl::OkStatus();
   }));
   return *std::move(result);

@@ -56,15 +56,6 @@ absl::StatusOr<Clip> DecodeClipFrames(std::shared_ptr<const Skeleton> skeleton, 
   return clip;
 }
 
-absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record,
-                              int64_t frames) {
-  MOTIONDB_ASSIGN_OR_RETURN(std::shared_ptr<const Skeleton> skeleton, ReadClipLayout(row, record));
-  // The blobs follow kClipLayoutColumns.
-  constexpr int kBlobs = kClipRecordColumnCount + 2;
-  return DecodeClipFrames(std::move(skeleton), record.frame_time, row.ColumnBlob(kBlobs),
-                          row.ColumnBlob(kBlobs + 1), frames);
-}
-
 SpaceRecord ReadSpaceRecord(const SqliteStatement& row) {
   SpaceRecord record;
   record.space_id = row.ColumnInt64(0);

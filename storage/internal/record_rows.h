@@ -31,26 +31,18 @@ inline constexpr absl::string_view kClipRecordColumns =
 inline constexpr int kClipRecordColumnCount = 10;
 // The columns ReadClipLayout reads, listed after kClipRecordColumns.
 inline constexpr absl::string_view kClipLayoutColumns = "c.position_joint_count, c.layout";
-// The columns ReadClip reads besides, listed after kClipRecordColumns: kClipLayoutColumns, then
-// the frames' blobs.
-inline constexpr absl::string_view kClipFrameColumns =
-    "c.position_joint_count, c.layout, c.rotations, c.positions";
 // The columns ReadSpaceRecord reads, of the spaces table.
 inline constexpr absl::string_view kSpaceRecordColumns =
     "space_id, name, skeleton_id, version, created_unix_ms, build_report_json";
 
 // The record of a row that starts with kClipRecordColumns; its tags are read with LoadTags.
 ClipRecord ReadClipRecord(const SqliteStatement& row);
-// The `frames` (record.frame_count) frames of a row of kClipRecordColumns then
-// kClipFrameColumns, whose record is `record`. DATA_LOSS when the stored
-// bytes no longer decode into the clip the row describes.
-absl::StatusOr<Clip> ReadClip(const SqliteStatement& row, const ClipRecord& record, int64_t frames);
-// The skeleton of a row of kClipRecordColumns then kClipLayoutColumns (or kClipFrameColumns),
-// whose record is `record`; DATA_LOSS as ReadClip.
+// The skeleton of a row of kClipRecordColumns then kClipLayoutColumns, whose record is
+// `record`. DATA_LOSS when the stored layout no longer describes the row.
 absl::StatusOr<std::shared_ptr<const Skeleton>> ReadClipLayout(const SqliteStatement& row,
                                                                const ClipRecord& record);
 // `frames` frames of a clip of `skeleton` from the bytes of its blobs (ParseRotationBlob's
-// quaternions, float32 positions); DATA_LOSS as ReadClip.
+// quaternions, float32 positions). DATA_LOSS when the bytes do not decode into such a clip.
 absl::StatusOr<Clip> DecodeClipFrames(std::shared_ptr<const Skeleton> skeleton, double frame_time,
                                       absl::string_view rotations_blob,
                                       absl::string_view positions_blob, int64_t frames);
