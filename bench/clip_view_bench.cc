@@ -23,6 +23,7 @@
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "bench/call_context.h"
 #include "bench/measure.h"
 #include "core/bvh/bvh_writer.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
@@ -46,9 +47,7 @@ struct Flags {
 };
 
 std::unique_ptr<grpc::ClientContext> Context() {
-  auto context = std::make_unique<grpc::ClientContext>();
-  context->set_deadline(std::chrono::system_clock::now() + std::chrono::minutes(10));
-  return context;
+  return bench::ContextWithin(std::chrono::minutes(10));
 }
 
 // Median and p95 of `ms`, in milliseconds.

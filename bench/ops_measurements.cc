@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "absl/strings/match.h"
+#include "bench/call_context.h"
 #include "bench/measure.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/bvh/bvh_writer.h"
@@ -280,9 +281,7 @@ absl::StatusOr<std::pair<double, double>> Time(int calls,
 }
 
 std::unique_ptr<grpc::ClientContext> Context() {
-  auto context = std::make_unique<grpc::ClientContext>();
-  context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
-  return context;
+  return bench::ContextWithin(std::chrono::seconds(120));
 }
 
 // The clip the speed measurements edit: its id and how many frames make 10 s.

@@ -30,6 +30,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include "absl/strings/str_cat.h"
+#include "bench/call_context.h"
 #include "bench/hostile_clients.h"
 #include "bench/measure.h"
 #include "core/bvh/bvh_writer.h"
@@ -104,9 +105,7 @@ struct Library {
 };
 
 std::unique_ptr<grpc::ClientContext> Context() {
-  auto context = std::make_unique<grpc::ClientContext>();
-  context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-  return context;
+  return bench::ContextWithin(std::chrono::seconds(60));
 }
 
 // One client: its own connection and clips, a mix of calls until `stop_at`.
