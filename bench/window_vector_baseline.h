@@ -37,8 +37,8 @@ struct WindowBaselineOptions {
   // The index and its checks (points FLANN compares a search, at least the windows asked for)
   // were chosen on bandai2-normal's first half of takes and bandai1 leave-style-out
   // (bench/notes/2026-12-07-window-baseline.md): FLANN's recall@100 against the exact nearest
-  // windows 1.000 and 0.991 with a k-means tree and 256 checks; a 4-tree kd forest needed 1024
-  // checks for 1.000 (0.944 with 512) and was 4-7x slower.
+  // windows 1.000 and 0.986-0.991 with a k-means tree and 256 checks; a 4-tree kd forest needed
+  // 1024 checks for 1.000 (0.944 with 512) and was 4-7x slower.
   WindowIndexKind kind = WindowIndexKind::kKMeans;
   int trees = 4;        // kd forest
   int branching = 32;   // k-means tree
