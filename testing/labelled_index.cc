@@ -1,6 +1,8 @@
 #include "testing/labelled_index.h"
 
 #include <algorithm>
+#include <map>
+#include <utility>
 
 #include "absl/strings/str_split.h"
 #include "core/bvh/bvh_reader.h"
@@ -23,12 +25,22 @@ std::string ContentLabel(const std::filesystem::path& path) { return NameField(p
 std::string StyleLabel(const std::filesystem::path& path) { return NameField(path, 2); }
 
 absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
-                                                             std::vector<std::string>* labels) {
+                                                             std::vector<std::string>* labels,
+                                                             Takes takes) {
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (entry.path().extension() == ".bvh") files.push_back(entry.path());
   }
   std::sort(files.begin(), files.end());
+  if (takes != Takes::kAll) {
+    std::map<std::pair<std::string, std::string>, int> group_size, seen;
+    for (const auto& path : files) ++group_size[{ContentLabel(path), StyleLabel(path)}];
+    std::erase_if(files, [&](const std::filesystem::path& path) {
+      const std::pair<std::string, std::string> group = {ContentLabel(path), StyleLabel(path)};
+      const bool first_half = seen[group]++ < (group_size[group] + 1) / 2;
+      return first_half != (takes == Takes::kFirstHalf);
+    });
+  }
   std::vector<TrainingClip> clips;
   for (const std::filesystem::path& path : files) {
     MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult read, ReadBvhFile(path.string()));
@@ -40,12 +52,13 @@ absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesyst
 
 absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,
-                                                const LibraryIndexOptions& index_options) {
+                                                const LibraryIndexOptions& index_options,
+                                                Takes takes) {
   LabelledIndex library;
   std::vector<TrainingClip> clips;
   for (const std::filesystem::path& folder : folders) {
     MOTIONDB_ASSIGN_OR_RETURN(std::vector<TrainingClip> read,
-                              ReadLabelledFolder(folder, &library.labels));
+                              ReadLabelledFolder(folder, &library.labels, takes));
     for (TrainingClip& clip : read) {
       library.styles.push_back(StyleLabel(clip.source));
       library.sources.push_back(folder.filename().string());

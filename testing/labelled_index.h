@@ -28,15 +28,22 @@ std::string ContentLabel(const std::filesystem::path& path);
 // "dataset-2_raise-up-left-hand_normal_003.bvh" -> "normal".
 std::string StyleLabel(const std::filesystem::path& path);
 
-// Every *.bvh of `folder`, in name order, as whole training clips named by their file names;
-// `labels` gets each one's ContentLabel.
-absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
-                                                             std::vector<std::string>* labels);
+// Which takes of a folder are read, for a held-out split: of each content and style's n files
+// in name order, the first ceil(n/2) or the others (a lone take is in the first half).
+enum class Takes { kAll, kFirstHalf, kSecondHalf };
 
-// One space trained on every clip of every folder, and one index of them all, in folder order.
+// Every *.bvh of `folder` (of `takes`), in name order, as whole training clips named by their
+// file names; `labels` gets each one's ContentLabel.
+absl::StatusOr<std::vector<TrainingClip>> ReadLabelledFolder(const std::filesystem::path& folder,
+                                                             std::vector<std::string>* labels,
+                                                             Takes takes = Takes::kAll);
+
+// One space trained on every clip (of `takes`) of every folder, and one index of them all, in
+// folder order.
 absl::StatusOr<LabelledIndex> LoadLabelledIndex(const std::vector<std::filesystem::path>& folders,
                                                 const SpaceOptions& space_options,
-                                                const LibraryIndexOptions& index_options);
+                                                const LibraryIndexOptions& index_options,
+                                                Takes takes = Takes::kAll);
 
 }  // namespace motiondb::testing
 

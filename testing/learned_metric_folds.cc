@@ -59,12 +59,17 @@ class FoldSums {
     all_.queries += fold.queries;
     all_.skipped_queries += fold.skipped_queries;
     all_.precision += fold.precision * fold.queries;
+    all_.wide_precision += fold.wide_precision * fold.queries;
     all_.exact_queries += fold.exact_queries;
     all_.exact_precision += fold.exact_precision * fold.exact_queries;
+    all_.exact_wide_precision += fold.exact_wide_precision * fold.exact_queries;
     all_.recall += fold.recall * fold.exact_queries;
     all_.latency_p50_ms += fold.latency_p50_ms * fold.queries;
+    // The folds' largest: an upper bound of the merged percentiles.
+    all_.latency_p90_ms = std::max(all_.latency_p90_ms, fold.latency_p90_ms);
     all_.latency_p99_ms = std::max(all_.latency_p99_ms, fold.latency_p99_ms);
     all_.exact_latency_p50_ms += fold.exact_latency_p50_ms * fold.exact_queries;
+    all_.exact_latency_p99_ms = std::max(all_.exact_latency_p99_ms, fold.exact_latency_p99_ms);
     all_.precision_by_group[group] += fold.precision * fold.queries;
     group_queries_[group] += fold.queries;
     for (const auto& [label, found] : fold.confusion) {
@@ -78,11 +83,13 @@ class FoldSums {
   absl::StatusOr<RetrievalReport> Means() && {
     if (all_.queries == 0) return absl::InvalidArgumentError("no query has enough relevant clips");
     all_.precision /= all_.queries;
+    all_.wide_precision /= all_.queries;
     all_.latency_p50_ms /= all_.queries;
     for (auto& [stage, ms] : all_.mean_stage_ms) ms /= all_.queries;
     for (auto& [group, sum] : all_.precision_by_group) sum /= group_queries_[group];
     if (all_.exact_queries > 0) {
       all_.exact_precision /= all_.exact_queries;
+      all_.exact_wide_precision /= all_.exact_queries;
       all_.recall /= all_.exact_queries;
       all_.exact_latency_p50_ms /= all_.exact_queries;
     }

@@ -160,6 +160,36 @@ TEST_F(SyntheticValidation, FastRecallAgainstExactAtTen) {
   EXPECT_GE(found, 45) << found << " of " << total;
 }
 
+// The held-out split's halves (testing::Takes): of each content's takes in name order, the first
+// ceil(n/2) and the others, together every take once.
+TEST(BandaiQuality, TakeHalvesPartitionEachContent) {
+  MOTIONDB_REQUIRE_MOCAP(mocap);
+  std::vector<std::string> all_labels, first_labels, second_labels;
+  const auto all = testing::ReadLabelledFolder(mocap / "bandai2-normal", &all_labels);
+  const auto first = testing::ReadLabelledFolder(mocap / "bandai2-normal", &first_labels,
+                                                 testing::Takes::kFirstHalf);
+  const auto second = testing::ReadLabelledFolder(mocap / "bandai2-normal", &second_labels,
+                                                  testing::Takes::kSecondHalf);
+  ASSERT_TRUE(all.ok() && first.ok() && second.ok());
+  ASSERT_EQ(first->size() + second->size(), all->size());
+  std::map<std::string, int> count, first_count;
+  for (const std::string& label : all_labels) ++count[label];
+  for (const std::string& label : first_labels) ++first_count[label];
+  for (const auto& [label, n] : count) EXPECT_EQ(first_count[label], (n + 1) / 2) << label;
+  std::vector<std::string> names;
+  for (const auto* half : {&*first, &*second}) {
+    for (const TrainingClip& clip : *half) names.push_back(clip.source);
+  }
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end());
+  // Within a content, every first-half take sorts before every second-half one.
+  std::map<std::string, std::string> last_first;
+  for (size_t i = 0; i < first->size(); ++i) last_first[first_labels[i]] = (*first)[i].source;
+  for (size_t i = 0; i < second->size(); ++i) {
+    EXPECT_LT(last_first[second_labels[i]], (*second)[i].source);
+  }
+}
+
 // Each clip as a query against all the others: precision@5 of the content class >= 0.98 (0.988
 // measured) and the fast search's recall@10 against exact search >= 0.95 (0.977 measured), with
 // the default (unit) metric.
