@@ -169,6 +169,9 @@ absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Q
     }
     params.characteristic_frames.push_back(row);
   }
+  // Checked before the answer and the warps' memory are sized from them (a bad max_results is
+  // INVALID_ARGUMENT, not a refused answer); the engine checks them again with the same function
+  // at its entry (core/search/search_query.cc), its contract with every caller.
   MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, dims));
   return params;
 }
