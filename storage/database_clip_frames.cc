@@ -139,7 +139,7 @@ absl::StatusOr<StoredClip> ReadStoredClip(SqliteConnection& db, int64_t clip_id,
         Clip clip, DecodeClipFrames(layout.skeleton, layout.record.frame_time, "", "", 0));
     return StoredClip{std::move(layout.record), std::move(clip)};
   }
-  const FrameRange range = frames.value_or(FrameRange{0, frame_count - 1});
+  const FrameRange range = frames.value_or(FrameRange{0, static_cast<int>(frame_count - 1)});
   MOTIONDB_ASSIGN_OR_RETURN(FrameReader reader, FrameReader::Open(db, layout, range));
   MOTIONDB_ASSIGN_OR_RETURN(Clip clip, reader.Read(range.first, range.size()));
   return StoredClip{std::move(layout.record), std::move(clip)};
