@@ -2,11 +2,30 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ranges>
 
 #include "absl/strings/str_cat.h"
 
 namespace motiondb::server {
+namespace {
+
+// The first frame of 0..count - 1 where `before` turns false (it is true, then false). Written
+// out rather than std::ranges::partition_point over std::views::iota: clang 14 (the fuzz build's
+// compiler) cannot compile libstdc++ 12's iota_view.
+template <typename Predicate>
+int64_t PartitionPoint(int64_t count, const Predicate& before) {
+  int64_t low = 0, high = count;
+  while (low < high) {
+    const int64_t middle = low + (high - low) / 2;
+    if (before(middle)) {
+      low = middle + 1;
+    } else {
+      high = middle;
+    }
+  }
+  return low;
+}
+
+}  // namespace
 
 int FrameConversion::ToOriginal(int64_t space_frame) const {
   const double original = std::round(static_cast<double>(space_frame) * fps_ / rate_);
@@ -23,13 +42,10 @@ std::pair<int64_t, int64_t> FrameConversion::ToSpace(FrameRange range) const {
 }
 
 std::pair<int64_t, int64_t> FrameConversion::SpaceFramesWithin(FrameRange range) const {
-  const auto frames = std::views::iota(int64_t{0}, space_frames_);
   const int64_t first =
-      std::ranges::partition_point(frames, [&](int64_t s) { return ToOriginal(s) < range.first; }) -
-      frames.begin();
+      PartitionPoint(space_frames_, [&](int64_t s) { return ToOriginal(s) < range.first; });
   const int64_t after =
-      std::ranges::partition_point(frames, [&](int64_t s) { return ToOriginal(s) <= range.last; }) -
-      frames.begin();
+      PartitionPoint(space_frames_, [&](int64_t s) { return ToOriginal(s) <= range.last; });
   return {first, after - 1};
 }
 
