@@ -221,6 +221,7 @@ struct VariantFlags {
   std::vector<double> window_epsilon;  // the default window seeds' approximate tree search
   std::vector<int> points;             // characteristic points (0: by the query's length)
   std::vector<double> second_anchor;   // SearchParams::second_anchor_scatter values
+  std::vector<int> shape_clips;        // candidates from the query's shape (kShapeWindows)
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
@@ -253,6 +254,12 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     SearchParams params;
     params.characteristic_points = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " characteristic points"), params);
+  }
+  for (int clips : flags.shape_clips) {
+    SearchParams params;
+    params.seed_selection = SeedSelection::kShapeWindows;
+    params.shape_clips = clips;
+    variants.emplace_back(absl::StrCat("shape candidates, ", clips, " clips"), params);
   }
   for (double scatter : flags.second_anchor) {
     SearchParams params;
@@ -317,6 +324,16 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
         "then %.1f MiB = %.2fx\n",
         SecondsSince(start) * 1000, library.tree_bytes() / 1048576.0,
         library.tree_bytes() / 1048576.0 / indexed_mib);
+  }
+  if (!variant_flags.shape_clips.empty()) {
+    // The first shape search builds the shape index; the variants' times are without it.
+    SearchParams params;
+    params.seed_selection = SeedSelection::kShapeWindows;
+    const auto start = std::chrono::steady_clock::now();
+    MOTIONDB_RETURN_IF_ERROR(
+        Search(library, CoordinateView::Of(bench.queries[0].coordinates), params).status());
+    std::printf("first shape search (builds the shape index) %.1f ms; shape index %.1f MiB\n",
+                SecondsSince(start) * 1000, library.shape_bytes() / 1048576.0);
   }
   for (const auto& [label, params] : Variants(variant_flags)) {
     MOTIONDB_ASSIGN_OR_RETURN(const Run run, RunQueries(bench, params, false, queries, 3));
@@ -436,6 +453,11 @@ int main(int argc, char** argv) {
                  "approximate tree search of these epsilons (SearchParams::epsilon)")
       ->type_name("E ...")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--shapes", variants.shape_clips,
+                 "also measure the search from the query's shape with these numbers of clips "
+                 "re-ranked (SearchParams::shape_clips)")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,
                  "also measure the fast search with these numbers of characteristic points (0: "
                  "one per action of the query)")

@@ -64,7 +64,7 @@ struct QualityFlags {
   std::string metric = "unit";
   std::string weights = "mass";
   std::string neutral = "mean";
-  bool keep_heading = false, no_refine = false, windows = false;
+  bool keep_heading = false, no_refine = false, windows = false, shapes = false;
   int places = 0;
   double learned_metric = -1;  // LearnedMetricOptions::shrink; negative: the space's metric
   bool unseen_labels = false;  // --learned-metric fitted without the queries' labels
@@ -135,6 +135,18 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
       ->capture_default_str();
   app.add_flag("--no-refine", flags->no_refine, "the thesis's search as is");
   app.add_flag("--windows", flags->windows, "seeds by window (the poses 0.25 s either side too)");
+  app.add_flag("--shapes", flags->shapes,
+               "candidates from the query's whole shape, re-ranked by the warp over their ranges");
+  for (auto [name, field, what, min] :
+       {std::tuple{"--shape-windows", &params.shape_windows, "--shapes: windows a length", 1},
+        {"--shape-clips", &params.shape_clips, "--shapes: distinct clips re-ranked", 1},
+        {"--shape-lengths", &params.shape_lengths_either_side,
+         "--shapes: window lengths searched either side of the query's", 0}}) {
+    app.add_option(name, *field, what)
+        ->type_name("N")
+        ->capture_default_str()
+        ->check(cli::WholeAtLeast(min));
+  }
   app.add_option("--second-anchor", params.second_anchor_scatter,
                  "a second anchor when the seeds scatter over more clusters than this share of "
                  "them (0: never)")
@@ -355,6 +367,8 @@ absl::Status Run(QualityFlags& flags) {
     params.places = flags.places;
   } else if (flags.windows) {
     params.seed_selection = SeedSelection::kNearestWindows;
+  } else if (flags.shapes) {
+    params.seed_selection = SeedSelection::kShapeWindows;
   }
 
   const bench::Clock::time_point start = bench::Clock::now();
@@ -455,7 +469,9 @@ absl::Status Run(QualityFlags& flags) {
     std::printf("window baseline: not run with --learned-metric\n");
   }
   PrintTable(options, report, flags.split,
-             (library.index->coordinate_bytes() + library.index->tree_bytes()) / kMiB,
+             (library.index->coordinate_bytes() + library.index->tree_bytes() +
+              library.index->shape_bytes()) /
+                 kMiB,
              baseline ? baseline->memory_bytes() / kMiB : 0.0);
   if (flags.time_scaled && baseline) {
     MOTIONDB_RETURN_IF_ERROR(MeasureTimeScaled(flags, library, folders, baseline_options));

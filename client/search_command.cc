@@ -25,7 +25,7 @@ struct SearchFlags {
   std::string bvh;
   FrameRangeFlags range;
   std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, exact_threads;
-  std::optional<int> points;
+  std::optional<int> points, shape_windows, shape_clips, shape_lengths;
   std::vector<int> char_frames;
   std::optional<double> max_point_gap, second_anchor;
   std::string seeds = "frames";
@@ -69,6 +69,15 @@ constexpr Parameter kParameters[] = {
      "characteristic points found, one in each K-th of the query, each anchoring its part "
      "(0: one per action of the query)",
      &SearchFlags::points, &v1::SearchRequest::set_characteristic_points, 0},
+    {"--shape-windows", "shape_windows", "N", "100",
+     "--seeds shapes: windows nearest the query's shape asked at each length",
+     &SearchFlags::shape_windows, &v1::SearchRequest::set_shape_windows},
+    {"--shape-clips", "shape_clips", "N", "100",
+     "--seeds shapes: distinct clips, nearest first, whose windows the warp re-ranks",
+     &SearchFlags::shape_clips, &v1::SearchRequest::set_shape_clips},
+    {"--shape-lengths", "shape_lengths_either_side", "N", "2",
+     "--seeds shapes: window lengths (sqrt(2) apart) searched either side of the query's",
+     &SearchFlags::shape_lengths, &v1::SearchRequest::set_shape_lengths_either_side, 0},
 };
 
 // The flags that set SearchRequest's fields, for the server's errors.
@@ -113,6 +122,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
   request.set_seed_selection(flags.seeds == "places"    ? v1::SEED_SELECTION_DISTINCT_PLACES
                              : flags.seeds == "windows" ? v1::SEED_SELECTION_NEAREST_WINDOWS
+                             : flags.seeds == "shapes"  ? v1::SEED_SELECTION_SHAPE_WINDOWS
                                                         : v1::SEED_SELECTION_NEAREST_FRAMES);
   if (flags.epsilon) request.set_epsilon(static_cast<float>(*flags.epsilon));
   request.set_neutral(flags.neutral == "boundary" ? v1::NEUTRAL_POSE_BOUNDARY_MEAN
@@ -278,9 +288,10 @@ void AddSearch(Commands& commands) {
         {"mean", "boundary", "origin"})
       ->capture_default_str();
   OneOf(search->add_option("--seeds", flags->seeds,
-                           "seeds: the thesis's nearest frames, distinct places, or the frames "
-                           "nearest by their poses a quarter second either side too"),
-        {"frames", "places", "windows"})
+                           "seeds: the thesis's nearest frames, distinct places, the frames "
+                           "nearest by their poses a quarter second either side too, or "
+                           "candidates from the query's whole shape"),
+        {"frames", "places", "windows", "shapes"})
       ->capture_default_str();
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
   search->add_option("--threads", flags->exact_threads, "--exact: threads scanning the library")
@@ -310,6 +321,9 @@ void AddSearch(Commands& commands) {
       "--seeds windows: seeds matched by three poses, a quarter second apart (more distinct\n"
       "takes: higher recall where many takes pass the query's pose; the first such search\n"
       "of a space builds its window index).\n"
+      "--seeds shapes: candidates from the query's whole shape at its length and lengths\n"
+      "either side, re-ranked by the exact warp over their ranges (no characteristic point;\n"
+      "the first such search of a space builds its shape index).\n"
       "--ann-dims and --dtw-dims are at most the space's dimensions. --neutral: the query's\n"
       "mean pose, the mean of its first and last poses, or the space's origin. --no-refine\n"
       "skips re-warping each candidate free of its seed. --exact ignores the seed parameters.\n"

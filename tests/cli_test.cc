@@ -171,7 +171,10 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--bvh FILE",
                              "--from F=0",
                              "--to T=last",
-                             "--seeds frames|places|windows=frames",
+                             "--seeds frames|places|windows|shapes=frames",
+                             "--shape-windows N=100",
+                             "--shape-clips N=100",
+                             "--shape-lengths N=2",
                              "--places N=128",
                              "--neighbours K=0",
                              "--threads N=0 = one per core",
@@ -390,6 +393,7 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
        {std::vector<std::string>{"--seeds", "places", "--places", "16"},
         {"--seeds", "frames", "--neighbours", "200"},
         {"--seeds", "windows", "--neighbours", "100"},
+        {"--seeds", "shapes", "--shape-clips", "20", "--shape-lengths", "1"},
         {"--exact", "--threads", "2"},
         {"--char-frames", "15,35"},
         {"--points", "2", "--max-point-gap", "1"},
@@ -408,6 +412,10 @@ TEST_F(CliServerTest, SearchSeedsAndExactThreads) {
       {"search", "--space", "body", "--clip", clip_id_, "--seeds", "places", "--places", "200000"});
   EXPECT_EQ(places.exit_code, 1);
   EXPECT_THAT(places.err, HasSubstr("--places 200000 is out of range; expected 1..100000"));
+  const testing::CommandResult shapes = Remote({"search", "--space", "body", "--clip", clip_id_,
+                                                "--seeds", "shapes", "--shape-lengths", "9"});
+  EXPECT_EQ(shapes.exit_code, 1);
+  EXPECT_THAT(shapes.err, HasSubstr("--shape-lengths 9 is out of range; expected 0..8"));
   const testing::CommandResult threads =
       Remote({"search", "--space", "body", "--clip", clip_id_, "--exact", "--threads", "5000"});
   EXPECT_EQ(threads.exit_code, 1);

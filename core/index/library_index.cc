@@ -6,6 +6,7 @@
 #include <iterator>
 #include <limits>
 #include <mutex>
+#include <tuple>
 
 #include <flann/algorithms/dist.h>
 #include <flann/algorithms/kdtree_single_index.h>
@@ -102,6 +103,23 @@ struct LibraryIndex::Windows {
   std::unique_ptr<Tree> tree;
 };
 
+// The shape windows of one length: a row a window (its shape turned to the principal axes and
+// truncated), the windows of clip c being rows clip_first[c]..clip_first[c + 1] - 1, and their
+// kd-tree (none when the length has no window).
+struct LibraryIndex::ShapeLevel {
+  RowMatrixXf rows;
+  std::vector<int32_t> first_frame;  // per window, in its clip
+  std::vector<int32_t> frames;       // per window: the length, or a short clip's own
+  std::vector<int64_t> clip_first;   // per clip, and one past the last
+  std::unique_ptr<Tree> tree;
+};
+
+struct LibraryIndex::Shapes {
+  Eigen::MatrixXf basis;  // kShapeSamples x shape_dims values -> shape_index_dims axes
+  int dims = 0;           // the coordinates sampled
+  std::vector<ShapeLevel> levels;
+};
+
 struct LibraryIndex::Block {
   RowMatrixXf coordinates;
   int64_t first_frame = 0;  // global number of row 0
@@ -145,6 +163,25 @@ void WriteWindow(CoordinateView rows, int64_t frame, int offset, int dims, float
   }
 }
 
+// Writes the shape of rows first..first + frames - 1 of `rows`: kShapeSamples poses evenly
+// spaced from its first row to its last, linearly interpolated, over the first `dims`
+// coordinates, scaled by 1 / sqrt(kShapeSamples) so that the distance between two shapes is the
+// root mean square of their samples' pose distances. kShapeSamples x dims values.
+void WriteShape(CoordinateView rows, int64_t first, int64_t frames, int dims, float* out) {
+  const float scale = 1.0f / std::sqrt(static_cast<float>(kShapeSamples));
+  const int64_t last = first + frames - 1;
+  for (int i = 0; i < kShapeSamples; ++i) {
+    const double at =
+        static_cast<double>(first) + static_cast<double>(frames - 1) * i / (kShapeSamples - 1);
+    const int64_t below = std::min(last, static_cast<int64_t>(at));
+    const int64_t above = std::min(last, below + 1);
+    const float w = static_cast<float>(at - static_cast<double>(below));
+    const float* a = rows.row(below);
+    const float* b = rows.row(above);
+    for (int k = 0; k < dims; ++k) *out++ = scale * ((1.0f - w) * a[k] + w * b[k]);
+  }
+}
+
 // Rows taken at once by PrincipalAxes and TurnRows: a copy of millions of rows would double the
 // build's memory for nothing.
 constexpr Eigen::Index kRowChunk = 4096;
@@ -181,7 +218,14 @@ LibraryIndex::LibraryIndex(double rate, const LibraryIndexOptions& options, int 
       options_(options),
       dims_(dims),
       // Capped: only a rate beyond any capture's could reach it.
-      window_frames_(static_cast<int>(std::lround(std::min(options.seed_window_s * rate, 1e9)))) {}
+      window_frames_(static_cast<int>(std::lround(std::min(options.seed_window_s * rate, 1e9)))) {
+  // Lengths sqrt(2) apart in seconds; at a low rate, lengths that round alike are one.
+  for (double seconds = kShapeShortestS; seconds <= kShapeLongestS * 1.001;
+       seconds *= std::sqrt(2.0)) {
+    const int64_t frames = std::max<int64_t>(2, std::llround(std::min(seconds * rate, 1e9)));
+    if (shape_lengths_.empty() || frames > shape_lengths_.back()) shape_lengths_.push_back(frames);
+  }
+}
 
 LibraryIndex::~LibraryIndex() = default;
 
@@ -190,8 +234,10 @@ absl::StatusOr<std::unique_ptr<LibraryIndex>> LibraryIndex::Build(
   if (!std::isfinite(rate) || rate <= 0.0) {
     return absl::InvalidArgumentError(absl::StrCat("library rate must be positive, got ", rate));
   }
-  if (options.ann_dims < 1 || options.leaf_size < 1) {
-    return absl::InvalidArgumentError("ann_dims and leaf_size must be at least 1");
+  if (options.ann_dims < 1 || options.leaf_size < 1 || options.shape_dims < 1 ||
+      options.shape_index_dims < 1) {
+    return absl::InvalidArgumentError(
+        "ann_dims, leaf_size, shape_dims and shape_index_dims must be at least 1");
   }
   if (!(options.seed_window_s >= 0.0 && options.seed_window_s <= kMaxSeedWindowS)) {
     return absl::InvalidArgumentError(absl::StrCat("seed_window_s must be in [0, ", kMaxSeedWindowS,
@@ -322,6 +368,162 @@ const LibraryIndex::Windows& LibraryIndex::WindowsOf(int b) const {
     block.windows_ready.store(true, std::memory_order_release);
   });
   return block.windows;
+}
+
+const LibraryIndex::Shapes& LibraryIndex::ShapesOf() const {
+  std::call_once(shapes_built_, [&] {
+    auto shapes = std::make_unique<Shapes>();
+    shapes->dims = std::min(options_.shape_dims, dims_);
+    const int values = kShapeSamples * shapes->dims;
+    const int kept = std::min(options_.shape_index_dims, values);
+    // Every window of one length, clip by clip: calls `window(first_frame, frames)`.
+    const auto for_each_window = [&](int c, int64_t length, auto&& window) {
+      const int64_t frames = clips_[c].frame_count;
+      if (frames < length) {
+        if (frames * 4 >= length) window(int64_t{0}, frames);
+        return;
+      }
+      const int64_t stride = std::max<int64_t>(1, length / kShapeStrideDivisor);
+      for (int64_t first = 0; first + length <= frames; first += stride) window(first, length);
+      // The clip's end, when the strides pass over it.
+      if ((frames - length) % stride != 0) window(frames - length, length);
+    };
+    // The principal axes of a sample of the windows (of every length): a full pass would cost
+    // values^2 multiplications a window.
+    int64_t windows = 0;
+    for (const int64_t length : shape_lengths_) {
+      for (int c = 0; c < clip_count(); ++c) {
+        for_each_window(c, length, [&](int64_t, int64_t) { ++windows; });
+      }
+    }
+    constexpr int64_t kBasisSample = 50'000;
+    const int64_t every = std::max<int64_t>(1, windows / kBasisSample);
+    RowMatrixXf sample((windows + every - 1) / every, values);
+    int64_t seen = 0, taken = 0;
+    for (const int64_t length : shape_lengths_) {
+      for (int c = 0; c < clip_count(); ++c) {
+        const CoordinateView clip = clip_coordinates(c);
+        for_each_window(c, length, [&](int64_t first, int64_t frames) {
+          if (seen++ % every == 0 && taken < sample.rows()) {
+            WriteShape(clip, first, frames, shapes->dims, sample.row(taken++).data());
+          }
+        });
+      }
+    }
+    shapes->basis = PrincipalAxes(sample.topRows(taken)).leftCols(kept);
+    Eigen::RowVectorXf shape(values);
+    for (const int64_t length : shape_lengths_) {
+      ShapeLevel& level = shapes->levels.emplace_back();
+      int64_t count = 0;
+      for (int c = 0; c < clip_count(); ++c) {
+        for_each_window(c, length, [&](int64_t, int64_t) { ++count; });
+      }
+      level.rows.resize(count, kept);
+      level.first_frame.reserve(count);
+      level.frames.reserve(count);
+      level.clip_first.reserve(clip_count() + 1);
+      int64_t row = 0;
+      for (int c = 0; c < clip_count(); ++c) {
+        level.clip_first.push_back(row);
+        const CoordinateView clip = clip_coordinates(c);
+        for_each_window(c, length, [&](int64_t first, int64_t frames) {
+          WriteShape(clip, first, frames, shapes->dims, shape.data());
+          level.rows.row(row++) = shape * shapes->basis;
+          level.first_frame.push_back(static_cast<int32_t>(first));
+          level.frames.push_back(static_cast<int32_t>(frames));
+        });
+      }
+      level.clip_first.push_back(row);
+      if (count > 0) {
+        level.tree = std::make_unique<Tree>(level.rows.data(), count, kept, kept,
+                                            options_.leaf_size, /*first=*/0, /*every=*/1);
+      }
+    }
+    shapes_ = std::move(shapes);
+    shapes_ready_.store(true, std::memory_order_release);
+  });
+  return *shapes_;
+}
+
+int LibraryIndex::ShapeLengthNearest(int64_t frames) const {
+  int best = 0;
+  double best_ratio = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < shape_lengths_.size(); ++i) {
+    const double ratio = std::abs(std::log(static_cast<double>(shape_lengths_[i]) /
+                                           static_cast<double>(std::max<int64_t>(1, frames))));
+    if (ratio < best_ratio) {
+      best_ratio = ratio;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+std::vector<ShapeWindow> LibraryIndex::NearestShapes(CoordinateView query, int length, int k,
+                                                     float epsilon,
+                                                     const std::vector<bool>& allowed_clips) const {
+  const Shapes& shapes = ShapesOf();
+  const ShapeLevel& level = shapes.levels[length];
+  const int64_t count = level.rows.rows();
+  if (count == 0 || k <= 0) return {};
+  Eigen::RowVectorXf shape(kShapeSamples * shapes.dims);
+  WriteShape(query, 0, query.rows, shapes.dims, shape.data());
+  const Eigen::RowVectorXf point = shape * shapes.basis;
+  const int dims = static_cast<int>(point.size());
+  const auto window_of = [&](int clip, int64_t row, float distance) {
+    return ShapeWindow{clip, level.first_frame[row], level.frames[row], distance};
+  };
+  const auto clip_of_row = [&](int64_t row) {
+    return static_cast<int>(
+        std::upper_bound(level.clip_first.begin(), level.clip_first.end(), row) -
+        level.clip_first.begin() - 1);
+  };
+  int64_t allowed = count;
+  if (!allowed_clips.empty()) {
+    allowed = 0;
+    for (int c = 0; c < clip_count(); ++c) {
+      if (allowed_clips[c]) allowed += level.clip_first[c + 1] - level.clip_first[c];
+    }
+  }
+  std::vector<ShapeWindow> found;
+  if (allowed * 2 >= count) {
+    // As FilteredNearest: enough extra windows to cover the filtered-out ones, doubling a few
+    // times, then a scan.
+    int64_t wanted =
+        k + (k * (count - allowed)) / std::max<int64_t>(1, allowed) + (allowed == count ? 0 : 16);
+    for (int attempt = 0; attempt < 4; ++attempt) {
+      wanted = std::min(wanted, count);
+      found.clear();
+      for (const Neighbour& n :
+           level.tree->Nearest(point.data(), dims, static_cast<int>(wanted), epsilon)) {
+        const int clip = clip_of_row(n.frame);
+        if (allowed_clips.empty() || allowed_clips[clip]) {
+          found.push_back(window_of(clip, n.frame, n.distance));
+        }
+      }
+      if (static_cast<int64_t>(found.size()) >= k || wanted == count) {
+        found.resize(std::min<size_t>(found.size(), k));
+        return found;
+      }
+      wanted *= 2;
+    }
+  }
+  found.clear();
+  for (int c = 0; c < clip_count(); ++c) {
+    if (!allowed_clips.empty() && !allowed_clips[c]) continue;
+    for (int64_t row = level.clip_first[c]; row < level.clip_first[c + 1]; ++row) {
+      found.push_back(window_of(c, row, Distance(point.data(), level.rows.row(row).data(), dims)));
+    }
+  }
+  const size_t keep = std::min<size_t>(k, found.size());
+  std::partial_sort(found.begin(), found.begin() + keep, found.end(),
+                    [](const ShapeWindow& a, const ShapeWindow& b) {
+                      return a.distance < b.distance ||
+                             (a.distance == b.distance &&
+                              std::tie(a.clip, a.first_frame) < std::tie(b.clip, b.first_frame));
+                    });
+  found.resize(keep);
+  return found;
 }
 
 CoordinateView LibraryIndex::clip_coordinates(int index) const {
@@ -496,6 +698,19 @@ int64_t LibraryIndex::coordinate_bytes() const {
   int64_t bytes = 0;
   for (const auto& block : blocks_) {
     bytes += block->coordinates.size() * static_cast<int64_t>(sizeof(float));
+  }
+  return bytes;
+}
+
+int64_t LibraryIndex::shape_bytes() const {
+  if (!shapes_ready_.load(std::memory_order_acquire)) return 0;
+  int64_t bytes = shapes_->basis.size() * static_cast<int64_t>(sizeof(float));
+  for (const ShapeLevel& level : shapes_->levels) {
+    bytes += level.rows.size() * static_cast<int64_t>(sizeof(float)) +
+             static_cast<int64_t>(level.first_frame.size() + level.frames.size()) *
+                 static_cast<int64_t>(sizeof(int32_t)) +
+             static_cast<int64_t>(level.clip_first.size() * sizeof(int64_t)) +
+             (level.tree ? level.tree->bytes() : 0);
   }
   return bytes;
 }

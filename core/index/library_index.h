@@ -12,8 +12,10 @@
 #ifndef MOTIONDB_CORE_INDEX_LIBRARY_INDEX_H_
 #define MOTIONDB_CORE_INDEX_LIBRARY_INDEX_H_
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,16 @@ inline constexpr double kDefaultSeedWindowS = 0.25;
 // Longer windows than this span whole actions rather than a pose's motion.
 inline constexpr double kMaxSeedWindowS = 2.0;
 
+// The shape windows (LibraryIndex::NearestShapes): library windows at lengths about sqrt(2)
+// apart, from kShapeShortestS to kShapeLongestS, each resampled to kShapeSamples poses of the
+// first `shape_dims` coordinates; the query's shape is the query resampled alike.
+inline constexpr int kShapeSamples = 16;
+inline constexpr double kShapeShortestS = 0.5;
+inline constexpr double kShapeLongestS = 5.7;  // 0.5 s x sqrt(2)^7, 170 frames at 30 Hz
+// Windows start an eighth of their length apart (issue 39's prototype: a stride of L / 8 instead
+// of 2 frames halved the index for the same precision).
+inline constexpr int kShapeStrideDivisor = 8;
+
 struct LibraryIndexOptions {
   // Dimensions of the kd-tree; searches with another ann_dims fall back to a linear scan.
   int ann_dims = kDefaultAnnDims;
@@ -64,6 +76,19 @@ struct LibraryIndexOptions {
   // frame. A window tells a take's own motion through a pose from other takes passing the same
   // pose: see kDefaultSeedWindowS. 0: no windows (NearestWindows gives the nearest frames).
   double seed_window_s = kDefaultSeedWindowS;
+  // Shape windows: the coordinates sampled (at most the library's), and the dimensions kept of
+  // a window's kShapeSamples x shape_dims values, its principal axes (a window of smooth motion
+  // is nearly determined by its first few): shape_index_dims floats a window.
+  int shape_dims = 10;
+  int shape_index_dims = 16;
+};
+
+// A library window found by its shape: frames first_frame.. of the clip of index `clip`.
+struct ShapeWindow {
+  int clip = 0;
+  int64_t first_frame = 0;
+  int64_t frames = 0;
+  float distance = 0;  // between the shapes: about the RMS pose distance of their samples
 };
 
 struct Neighbour {
@@ -147,13 +172,30 @@ class LibraryIndex {
                                         float epsilon,
                                         const std::vector<bool>& allowed_clips) const;
 
-  // Bytes held: the coordinate blocks; the kd-trees and the seed windows they index.
+  // The shape windows' lengths in frames, increasing (about sqrt(2) apart; kShapeShortestS to
+  // kShapeLongestS at rate()).
+  const std::vector<int64_t>& shape_lengths() const { return shape_lengths_; }
+  // The index of the shape length nearest `frames` (by ratio).
+  int ShapeLengthNearest(int64_t frames) const;
+  // The k windows of length shape_lengths()[length] nearest `query`'s shape (the query resampled
+  // to kShapeSamples poses), nearest first, of the allowed clips (empty: all). A clip shorter
+  // than a length but at least a quarter of it is one window of that length, whole (resampled
+  // alike). The windows and their kd-trees are built by the first call (thread-safe): about
+  // 1.8 windows a frame at 30 Hz, shape_index_dims floats each (shape_bytes()).
+  std::vector<ShapeWindow> NearestShapes(CoordinateView query, int length, int k, float epsilon,
+                                         const std::vector<bool>& allowed_clips) const;
+
+  // Bytes held: the coordinate blocks; the kd-trees and the seed windows they index; the shape
+  // windows and their kd-trees (0 until a search asks for them).
   int64_t coordinate_bytes() const;
   int64_t tree_bytes() const;
+  int64_t shape_bytes() const;
 
  private:
   class Tree;
   struct Windows;
+  struct ShapeLevel;
+  struct Shapes;
   struct Block;
   LibraryIndex(double rate, const LibraryIndexOptions& options, int dims);
   // A block of `clips` (validated) after `first_frame` global frames, with its kd-tree; appends
@@ -164,6 +206,8 @@ class LibraryIndex {
   int64_t AllowedFrames(const std::vector<bool>& allowed_clips) const;
   // Block b's seed windows, built on first use (thread-safe).
   const Windows& WindowsOf(int b) const;
+  // The shape windows of every block, built on first use (thread-safe).
+  const Shapes& ShapesOf() const;
   // The k nearest over one kd-tree of every block (tree_of(b): block b's, null if none),
   // merged; the first block's must exist.
   std::vector<Neighbour> TreeNearest(absl::FunctionRef<const Tree*(int block)> tree_of,
@@ -180,6 +224,7 @@ class LibraryIndex {
   LibraryIndexOptions options_;
   int dims_;
   int window_frames_;
+  std::vector<int64_t> shape_lengths_;
   int64_t total_frames_ = 0;
   // The first block holds the clips of the last full build; a second one, if any, those added
   // since. Clips are numbered across blocks in order.
@@ -188,6 +233,10 @@ class LibraryIndex {
   std::vector<int> clip_block_;  // per clip: its block
   // Clip id -> index: searches filtered by clip ids look up every id.
   absl::flat_hash_map<int64_t, int> index_of_id_;
+  // The shape windows of this snapshot, built by the first search that asks (ShapesOf).
+  mutable std::once_flag shapes_built_;
+  mutable std::atomic<bool> shapes_ready_{false};
+  mutable std::unique_ptr<Shapes> shapes_;
 };
 
 }  // namespace motiondb

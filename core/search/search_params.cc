@@ -21,6 +21,8 @@ const char* SeedSelectionName(SeedSelection selection) {
       return "distinct_places";
     case SeedSelection::kNearestWindows:
       return "nearest_windows";
+    case SeedSelection::kShapeWindows:
+      return "shape_windows";
     case SeedSelection::kNearestFrames:
       break;
   }
@@ -46,6 +48,15 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   }
   if (params.places < 1 || params.places > 100'000) {
     return OutOfRange("places", params.places, "1..100000");
+  }
+  if (params.shape_windows < 1 || params.shape_windows > 100'000) {
+    return OutOfRange("shape_windows", params.shape_windows, "1..100000");
+  }
+  if (params.shape_clips < 1 || params.shape_clips > 100'000) {
+    return OutOfRange("shape_clips", params.shape_clips, "1..100000");
+  }
+  if (params.shape_lengths_either_side < 0 || params.shape_lengths_either_side > 8) {
+    return OutOfRange("shape_lengths_either_side", params.shape_lengths_either_side, "0..8");
   }
   if (params.exact_threads < 0 || params.exact_threads > 1024) {
     return OutOfRange("exact_threads", params.exact_threads, "0..1024 (0: one per core)");

@@ -37,6 +37,16 @@ enum class SeedSelection {
   // side, LibraryIndex::NearestWindows) are nearest to the query's around the characteristic
   // frame, clustered in time as the nearest frames are.
   kNearestWindows,
+  // Candidates from the query's whole shape (issue 39, item 3): the library windows
+  // (LibraryIndex::NearestShapes, lengths about sqrt(2) apart from 0.5 to 5.7 s, each resampled
+  // to 16 poses of the first 10 coordinates) nearest the query resampled alike, at the length
+  // nearest the query's and `shape_lengths_either_side` lengths either side (a take up to twice
+  // as fast or slow is still a candidate), the `shape_windows` nearest at each length; the
+  // windows of the first `shape_clips` distinct clips, each widened by half the query's length
+  // on both sides, are re-ranked by the exact search's subsequence warp (its bounds and early
+  // abandoning) over those ranges alone. The characteristic points and the other seed
+  // parameters do not apply; a one-frame query is a pose search as ever.
+  kShapeWindows,
 };
 
 // A clip's range, in frames at the library's rate, that no result may overlap: a result over
@@ -66,6 +76,13 @@ struct SearchParams {
   // windows: 500), taken again, twice as many, while they fall in fewer than two places a
   // result (core/search/motion_search.cc).
   int neighbours = 0;
+  // kShapeWindows: the nearest windows asked at each length searched.
+  int shape_windows = 100;
+  // kShapeWindows: the distinct clips, nearest first, whose windows are re-ranked by the warp.
+  int shape_clips = 100;
+  // kShapeWindows: the window lengths searched either side of the one nearest the query's
+  // (sqrt(2) apart: 2 reaches half and twice the query's length, the default slope limit's).
+  int shape_lengths_either_side = 2;
   // Approximation bound of the seed search (0 = exact).
   float epsilon = 0.0f;
   // Dimensions of the pose distance inside the time warp.
@@ -126,7 +143,7 @@ struct SearchParams {
   std::function<bool()> should_stop;
 };
 
-// "nearest_frames", "distinct_places" or "nearest_windows".
+// "nearest_frames", "distinct_places", "nearest_windows" or "shape_windows".
 const char* SeedSelectionName(SeedSelection selection);
 
 // INVALID_ARGUMENT naming the first out-of-range parameter; `dims` is the library's dimensions.

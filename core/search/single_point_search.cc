@@ -273,6 +273,7 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
         return library.NearestWindows(query, query_frame, params.ann_dims, count, params.epsilon,
                                       allowed);
       case SeedSelection::kNearestFrames:
+      case SeedSelection::kShapeWindows:  // Search() runs the shape search instead
         break;
     }
     return library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon, allowed);

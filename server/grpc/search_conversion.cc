@@ -31,6 +31,8 @@ absl::StatusOr<SeedSelection> FromProto(v1::SeedSelection selection) {
       return SeedSelection::kDistinctPlaces;
     case v1::SEED_SELECTION_NEAREST_WINDOWS:
       return SeedSelection::kNearestWindows;
+    case v1::SEED_SELECTION_SHAPE_WINDOWS:
+      return SeedSelection::kShapeWindows;
     default:
       return UnknownValue("seed_selection", selection);
   }
@@ -42,6 +44,11 @@ absl::StatusOr<SearchParams> ParamsFromProto(const v1::SearchRequest& request) {
   MOTIONDB_ASSIGN_OR_RETURN(params.seed_selection, FromProto(request.seed_selection()));
   if (request.has_places()) params.places = request.places();
   if (request.has_neighbours()) params.neighbours = request.neighbours();
+  if (request.has_shape_windows()) params.shape_windows = request.shape_windows();
+  if (request.has_shape_clips()) params.shape_clips = request.shape_clips();
+  if (request.has_shape_lengths_either_side()) {
+    params.shape_lengths_either_side = request.shape_lengths_either_side();
+  }
   if (request.has_exact_threads()) params.exact_threads = request.exact_threads();
   if (request.has_epsilon()) params.epsilon = request.epsilon();
   if (request.has_slope_limit()) params.slope_limit = request.slope_limit();
