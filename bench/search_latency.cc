@@ -6,7 +6,7 @@
 //
 // usage: search_latency [--scenario 70s120|1h30|10h30|10h120|100h30|sweeps|all] [--queries N]
 //          [--exact-queries N] [--places N ...] [--neighbours N ...] [--points K ...]
-//          [--second-anchor S ...]
+//          [--second-anchor S ...] [--threads N ...]
 // real10h30: real capture from ../shared/mocap grown to 10 h by perturbed copies, real queries.
 #include <sys/resource.h>
 #include <unistd.h>
@@ -222,6 +222,7 @@ struct VariantFlags {
   std::vector<int> points;             // characteristic points (0: by the query's length)
   std::vector<double> second_anchor;   // SearchParams::second_anchor_scatter values
   std::vector<int> shape_clips;        // candidates from the query's shape (kShapeWindows)
+  std::vector<int> threads;            // the default search on these many threads
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
@@ -232,6 +233,12 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
   unrefined.refine = false;
   std::vector<std::pair<std::string, SearchParams>> variants = {{"fast", {}},
                                                                 {"fast, no refinement", unrefined}};
+  for (int count : flags.threads) {
+    SearchParams params;
+    params.threads = count;
+    variants.emplace_back(absl::StrCat("fast, ", count, count == 1 ? " thread" : " threads"),
+                          params);
+  }
   for (int count : flags.neighbours) {
     SearchParams params;
     params.neighbours = count;
@@ -456,6 +463,11 @@ int main(int argc, char** argv) {
   app.add_option("--shapes", variants.shape_clips,
                  "also measure the search from the query's shape with these numbers of clips "
                  "re-ranked (SearchParams::shape_clips)")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--threads", variants.threads,
+                 "also measure the default search with its warps and refinement on these "
+                 "numbers of threads (SearchParams::threads)")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,

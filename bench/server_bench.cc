@@ -4,8 +4,9 @@
 //     ../shared/mocap/bandai2-normal): frames/s for the first half, before any space exists,
 //     and for the second half, into a skeleton with a space (each clip projected in the same
 //     transaction and the resident index rebuilt aside and swapped);
-//  2. searches per second and client-side p50/p99 latency with 1, 4 and 16 concurrent clients,
-//     each on its own connection, every stored clip in turn as the query, default parameters;
+//  2. searches per second and client-side p50/p99 latency with 1, 2, 4 and 16 concurrent
+//     clients, each on its own connection, every stored clip in turn as the query, default
+//     parameters, and again with each search on one thread (SearchRequest.threads = 1);
 //  3. the baseline: the same searches in process (server::SearchRunner on the same database and
 //     indices loaded as the server loads them, no gRPC) with 1 and 2 threads, measured in turns
 //     interleaved with the served ones;
@@ -117,15 +118,16 @@ absl::StatusOr<std::vector<double>> TimeSearches(const std::string& address,
 }
 
 // Searches from `clients` clients, each on its own connection to `address`, every clip of `ids`
-// in turn as the query.
+// in turn as the query, each search on `search_threads` threads (0: the server's choice).
 absl::StatusOr<Throughput> MeasureServed(const std::string& address, int clients, double seconds,
-                                         const std::vector<int64_t>& ids) {
+                                         const std::vector<int64_t>& ids, int search_threads = 0) {
   std::vector<std::unique_ptr<v1::SearchService::Stub>> stubs;
   for (int c = 0; c < clients; ++c) {
     stubs.push_back(v1::SearchService::NewStub(OwnConnection(address)));
   }
   return Measure(clients, seconds, [&](int worker, int64_t k) {
-    const v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
+    v1::SearchRequest request = QueryOf(ids[(worker * 7919 + k) % ids.size()]);
+    if (search_threads > 0) request.set_threads(search_threads);
     v1::SearchResponse response;
     grpc::ClientContext context;
     return FromGrpc(stubs[worker]->Search(&context, request, &response), "Search");
@@ -237,21 +239,29 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
     std::string label;
     int threads = 1;
     bool served = false;
+    int search_threads = 0;  // served: each search's threads (0: the server's choice)
     Throughput total;
     std::vector<double> server_ms;  // as the server logged them
   };
   std::vector<Way> ways;
-  for (int clients : {1, 4, 16}) {
-    ways.push_back({absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients"),
-                    clients,
-                    true,
-                    {},
-                    {}});
+  // Each search on every core while it runs alone, one beside others (the server's choice), and
+  // on one thread always, as before SearchParams::threads.
+  for (int clients : {1, 2, 4, 16}) {
+    for (int search_threads : {0, 1}) {
+      ways.push_back({absl::StrCat("gRPC, ", clients, clients == 1 ? " client" : " clients",
+                                   search_threads == 1 ? ", one thread a search" : ""),
+                      clients,
+                      true,
+                      search_threads,
+                      {},
+                      {}});
+    }
   }
   for (int threads : {1, 2}) {
     ways.push_back({absl::StrCat("in process, ", threads, threads == 1 ? " thread" : " threads"),
                     threads,
                     false,
+                    0,
                     {},
                     {}});
   }
@@ -267,9 +277,9 @@ absl::Status ServedSearches(const std::filesystem::path& folder, double seconds,
     for (Way& way : ways) {
       if (way.served != true) continue;
       const size_t log_before = turn_server.Log().size();
-      MOTIONDB_ASSIGN_OR_RETURN(
-          const Throughput part,
-          MeasureServed(turn_server.address(), way.threads, seconds / turns, ids));
+      MOTIONDB_ASSIGN_OR_RETURN(const Throughput part,
+                                MeasureServed(turn_server.address(), way.threads, seconds / turns,
+                                              ids, way.search_threads));
       Add(part, turns, way.total);
       const std::vector<double> logged = LoggedSearchMs(turn_server.Log(), log_before);
       way.server_ms.insert(way.server_ms.end(), logged.begin(), logged.end());

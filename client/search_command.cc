@@ -24,7 +24,7 @@ struct SearchFlags {
   std::optional<int64_t> clip;
   std::string bvh;
   FrameRangeFlags range;
-  std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, exact_threads;
+  std::optional<int> places, neighbours, ann_dims, dtw_dims, slope, max, char_frame, threads;
   std::optional<int> points, shape_windows, shape_clips, shape_lengths;
   std::vector<int> char_frames;
   std::optional<double> max_point_gap, second_anchor;
@@ -91,6 +91,7 @@ FlagNames SearchFlagNames(const SearchFlags& flags) {
                      {"epsilon", "--epsilon"},
                      {"neutral", "--neutral"},
                      {"exact_threads", "--threads"},
+                     {"threads", "--threads"},
                      {"characteristic_frames", "--char-frames"},
                      {"max_point_gap_s", "--max-point-gap"},
                      {"second_anchor_scatter", "--second-anchor"}};
@@ -119,7 +120,8 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   for (const int frame : flags.char_frames) request.add_characteristic_frames(frame);
   if (flags.max_point_gap) request.set_max_point_gap_s(*flags.max_point_gap);
   if (flags.second_anchor) request.set_second_anchor_scatter(*flags.second_anchor);
-  if (flags.exact_threads) request.set_exact_threads(*flags.exact_threads);
+  if (flags.threads && flags.exact) request.set_exact_threads(*flags.threads);
+  if (flags.threads && !flags.exact) request.set_threads(*flags.threads);
   request.set_seed_selection(flags.seeds == "places"    ? v1::SEED_SELECTION_DISTINCT_PLACES
                              : flags.seeds == "windows" ? v1::SEED_SELECTION_NEAREST_WINDOWS
                              : flags.seeds == "shapes"  ? v1::SEED_SELECTION_SHAPE_WINDOWS
@@ -294,9 +296,13 @@ void AddSearch(Commands& commands) {
         {"frames", "places", "windows", "shapes"})
       ->capture_default_str();
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
-  search->add_option("--threads", flags->exact_threads, "--exact: threads scanning the library")
+  search
+      ->add_option("--threads", flags->threads,
+                   "threads of one search: its warps and refinement (0: every core while the "
+                   "server runs no other search, else one), or with --exact the clips it "
+                   "scans (0: one per core)")
       ->type_name("N")
-      ->default_str("0 = one per core")
+      ->default_str("0 = auto")
       ->check(WholeAtLeast(0));
   search->add_flag("--no-refine", flags->no_refine,
                    "the thesis's search as is (faster, lower recall)");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "core/index/coarse_rate.h"
 #include "core/motion/resample.h"
@@ -144,8 +145,9 @@ absl::StatusOr<int> QueryRow(const Query& query, int frame, absl::string_view fi
 }
 
 absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Query& query,
-                                           int dims) {
+                                           int dims, int searches_running) {
   SearchParams params = WithSearchDims(request, dims);
+  params.threads = request.threads.value_or(searches_running == 1 ? 0 : 1);
   params.characteristic_frame = -1;
   if (request.characteristic_frame) {
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -271,6 +273,8 @@ SearchParams WithSearchDims(const SearchRequest& request, int dims) {
 absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                                                 const std::function<bool()>& should_stop) const {
   const auto start = std::chrono::steady_clock::now();
+  const int searches_running = ++running_;
+  const absl::Cleanup done = [this] { --running_; };
   // The snapshot is held to the end: the query's rows and the results point into it.
   MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const SpaceSnapshot> snapshot,
                             FindSpace(registry_, request.space));
@@ -288,7 +292,8 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
   } else {
     return absl::InvalidArgumentError("query: give a stored clip (clip) or a BVH file (bvh)");
   }
-  MOTIONDB_ASSIGN_OR_RETURN(SearchParams params, ResolveParams(request, query, dims));
+  MOTIONDB_ASSIGN_OR_RETURN(SearchParams params,
+                            ResolveParams(request, query, dims, searches_running));
   params.excluded = own;
   {
     SearchParams searched = params;

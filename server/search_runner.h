@@ -5,6 +5,7 @@
 #ifndef MOTIONDB_SERVER_SEARCH_RUNNER_H_
 #define MOTIONDB_SERVER_SEARCH_RUNNER_H_
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -45,6 +46,10 @@ struct SearchRequest {
   // Several characteristic points, as characteristic_frame, increasing (SearchParams'
   // characteristic_frames); empty: none given.
   std::vector<int> characteristic_frames;
+  // Threads of a fast search (SearchParams::threads); unset: every core while the runner runs
+  // no other search, else one, so that a quiet server answers one client sooner and a busy one
+  // gives each search a core as before.
+  std::optional<int> threads;
   // The exhaustive search instead of the seeded one.
   bool exact = false;
   // A stored-clip query: drop hits in its clip overlapping its range (unset: true), filling
@@ -119,6 +124,7 @@ class SearchRunner {
   storage::Database& database_;
   UploadLimits limits_;
   int max_query_frames_;
+  mutable std::atomic<int> running_{0};  // searches in Run now
 };
 
 }  // namespace motiondb::server

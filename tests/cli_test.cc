@@ -177,7 +177,7 @@ TEST_F(CliTest, HelpSearchAndSearchHelpListEveryFlagWithItsDefault) {
                              "--shape-lengths N=2",
                              "--places N=128",
                              "--neighbours K=0",
-                             "--threads N=0 = one per core",
+                             "--threads N=0 = auto",
                              "--ann-dims N=5",
                              "--dtw-dims N=5",
                              "--slope S=2",

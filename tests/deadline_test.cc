@@ -2,11 +2,13 @@
 // its n-th poll on ends each long operation with CANCELLED at that poll, without finishing the
 // work (it makes no further poll, and polls far fewer times than the whole operation), and
 // stores nothing; the query length limit refuses before anything is searched. Deterministic:
-// the stop functions count their polls, nothing is timed.
+// the stop functions count their polls, nothing is timed. A search held inside its poll also
+// shows the runner's choice of threads beside it.
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -281,6 +283,55 @@ TEST_F(DeadlineTest, SearchRunnerStopsWhileParsingAnUploadedQuery) {
   StopAfter stop(1);
   EXPECT_TRUE(absl::IsCancelled(server::ReadUpload(*bvh_, "bvh", {}, stop.function()).status()));
   EXPECT_EQ(stop.polls(), 2);
+}
+
+// SearchRequest::threads unset: every core for a search alone, one beside another (here one held
+// inside its first stop poll), so that a busy server gives each search a core as before.
+TEST_F(DeadlineTest, SearchRunnerGivesEveryCoreOnlyToASearchAlone) {
+  const server::SearchRunner runner(*registry_, *database_, {});
+  server::SearchRequest request;
+  request.space = "body";
+  request.query = server::ClipSelection{clip_ids_->front(), 100, 160};
+  const absl::StatusOr<server::SearchOutcome> alone = runner.Run(request, [] { return false; });
+  ASSERT_TRUE(alone.ok()) << alone.status();
+  EXPECT_EQ(alone->stats.threads, ThreadsFor(0));
+
+  std::promise<void> entered, release;
+  std::shared_future<void> released = release.get_future().share();
+  std::atomic<bool> held_once = false;
+  absl::StatusOr<server::SearchOutcome> held;
+  std::thread holder([&] {
+    held = runner.Run(request, [&] {
+      if (!held_once.exchange(true)) {
+        entered.set_value();
+        released.wait();
+      }
+      return false;
+    });
+  });
+  entered.get_future().wait();
+  const absl::StatusOr<server::SearchOutcome> beside = runner.Run(request, [] { return false; });
+  server::SearchRequest asked = request;
+  asked.threads = 3;
+  const absl::StatusOr<server::SearchOutcome> three = runner.Run(asked, [] { return false; });
+  release.set_value();
+  holder.join();
+  ASSERT_TRUE(beside.ok()) << beside.status();
+  EXPECT_EQ(beside->stats.threads, 1);
+  ASSERT_TRUE(three.ok()) << three.status();
+  EXPECT_EQ(three->stats.threads, 3);
+  ASSERT_TRUE(held.ok()) << held.status();
+  EXPECT_EQ(held->stats.threads, ThreadsFor(0));
+  // However many threads, the same hits.
+  const server::SearchOutcome& held_outcome = *held;
+  for (const server::SearchOutcome* outcome : {&*beside, &*three, &held_outcome}) {
+    ASSERT_EQ(outcome->hits.size(), alone->hits.size());
+    for (size_t i = 0; i < alone->hits.size(); ++i) {
+      EXPECT_EQ(outcome->hits[i].clip_id, alone->hits[i].clip_id) << i;
+      EXPECT_EQ(outcome->hits[i].start_frame, alone->hits[i].start_frame) << i;
+      EXPECT_EQ(outcome->hits[i].score, alone->hits[i].score) << i;
+    }
+  }
 }
 
 TEST_F(DeadlineTest, RefusesAQueryOverTheLimitBeforeSearching) {

@@ -81,6 +81,86 @@ TEST(ParallelFor, ReturnsTheLowestFailureAndStopsHandingOut) {
   }
 }
 
+TEST(ParallelForInOrder, CommitsEachIndexInOrderAfterItsComputeOneAtATime) {
+  constexpr int64_t kCount = 20000;
+  for (const int threads : {1, 2, 4}) {
+    std::vector<std::atomic<bool>> computed(kCount);
+    std::vector<int64_t> committed;  // only commits touch it: they never run at once
+    std::atomic<int> committing = 0;
+    std::atomic<int> overlaps = 0, early = 0;
+    // What a compute reads of the commits so far: always at most its own index.
+    std::atomic<int64_t> published = 0;
+    std::atomic<int> ahead = 0;
+    ASSERT_TRUE(ParallelForInOrder(
+                    kCount, threads,
+                    [&](int64_t i, int) {
+                      if (published.load() > i) ++ahead;
+                      computed[i] = true;
+                      return absl::OkStatus();
+                    },
+                    [&](int64_t i, int) {
+                      if (++committing > 1) ++overlaps;
+                      if (!computed[i]) ++early;
+                      committed.push_back(i);
+                      published = i + 1;
+                      --committing;
+                      return absl::OkStatus();
+                    })
+                    .ok());
+    ASSERT_EQ(committed.size(), static_cast<size_t>(kCount)) << threads;
+    for (int64_t i = 0; i < kCount; ++i) ASSERT_EQ(committed[i], i) << threads;
+    EXPECT_EQ(overlaps, 0) << threads;
+    EXPECT_EQ(early, 0) << threads;
+    EXPECT_EQ(ahead, 0) << threads;
+  }
+}
+
+TEST(ParallelForInOrder, OneThreadAlternatesComputeAndCommit) {
+  std::vector<std::string> calls;
+  ASSERT_TRUE(ParallelForInOrder(
+                  3, 1,
+                  [&](int64_t i, int thread) {
+                    EXPECT_EQ(thread, 0);
+                    calls.push_back(absl::StrCat("compute ", i));
+                    return absl::OkStatus();
+                  },
+                  [&](int64_t i, int) {
+                    calls.push_back(absl::StrCat("commit ", i));
+                    return absl::OkStatus();
+                  })
+                  .ok());
+  EXPECT_EQ(calls, (std::vector<std::string>{"compute 0", "commit 0", "compute 1", "commit 1",
+                                             "compute 2", "commit 2"}));
+}
+
+TEST(ParallelForInOrder, AFailureEndsItAndIsReturned) {
+  for (const int threads : {1, 2, 4}) {
+    std::atomic<int64_t> last_commit = -1;
+    const absl::Status commit_failed = ParallelForInOrder(
+        1000, threads, [](int64_t, int) { return absl::OkStatus(); },
+        [&](int64_t i, int) {
+          if (i == 500) return absl::CancelledError("stop at 500");
+          last_commit = i;
+          return absl::OkStatus();
+        });
+    EXPECT_EQ(commit_failed, absl::CancelledError("stop at 500")) << threads;
+    EXPECT_EQ(last_commit, 499) << threads;
+
+    std::atomic<int64_t> commits_after = 0;
+    const absl::Status compute_failed = ParallelForInOrder(
+        1000, threads,
+        [](int64_t i, int) {
+          return i == 300 ? absl::DeadlineExceededError("compute 300") : absl::OkStatus();
+        },
+        [&](int64_t i, int) {
+          if (i >= 300) ++commits_after;
+          return absl::OkStatus();
+        });
+    EXPECT_EQ(compute_failed, absl::DeadlineExceededError("compute 300")) << threads;
+    EXPECT_EQ(commits_after, 0) << threads;
+  }
+}
+
 TEST(ThreadsFor, ZeroIsOnePerCore) {
   EXPECT_EQ(ThreadsFor(3), 3);
   EXPECT_EQ(ThreadsFor(0), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));

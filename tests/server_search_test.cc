@@ -11,6 +11,7 @@
 #include "testing/synthetic_corpus.h"
 #include "tests/server_fixture.h"
 #include "tests/test_data.h"
+#include "util/parallel_for.h"
 
 namespace motiondb {
 namespace {
@@ -100,6 +101,26 @@ TEST_F(ServerTest, CreateSpaceSearchAndCurve) {
   EXPECT_GT(found.counts().seeds(), 0);
   EXPECT_GT(found.counts().warps(), 0);
   EXPECT_GT(found.timings().total_ms(), 0);
+  // Alone on the server the search took every core; the threads asked are taken, with the same
+  // results; a bad count is refused by name.
+  EXPECT_EQ(found.counts().threads(), ThreadsFor(0));
+  for (const int threads : {1, 3}) {
+    v1::SearchRequest asked = query;
+    asked.set_threads(threads);
+    v1::SearchResponse same;
+    ASSERT_TRUE(client.Search(asked, &same).ok());
+    EXPECT_EQ(same.counts().threads(), threads);
+    ASSERT_EQ(same.results_size(), found.results_size());
+    for (int i = 0; i < found.results_size(); ++i) {
+      EXPECT_EQ(same.results(i).SerializeAsString(), found.results(i).SerializeAsString()) << i;
+    }
+  }
+  v1::SearchRequest too_many = query;
+  too_many.set_threads(5000);
+  v1::SearchResponse refused_threads;
+  status = client.Search(too_many, &refused_threads);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("threads"));
   for (int i = 1; i < found.results_size(); ++i) {
     EXPECT_LE(found.results(i - 1).score(), found.results(i).score());
   }

@@ -7,6 +7,8 @@
 #include <thread>
 #include <vector>
 
+#include "util/status_macros.h"
+
 namespace motiondb {
 namespace {
 
@@ -58,6 +60,43 @@ absl::Status ParallelFor(int64_t count, int threads,
     run(0);
   }
   return failure;
+}
+
+absl::Status ParallelForInOrder(
+    int64_t count, int threads,
+    const std::function<absl::Status(int64_t index, int thread)>& compute,
+    const std::function<absl::Status(int64_t index, int thread)>& commit) {
+  std::vector<std::atomic<bool>> computed(static_cast<size_t>(std::max<int64_t>(count, 0)));
+  std::mutex committing;
+  std::atomic<int64_t> next_commit{0};  // written under `committing`
+  absl::Status commit_failure;          // under `committing`
+  // Commits every computed index from next_commit on; false once a commit failed.
+  const auto commit_ready = [&](int thread) {
+    for (int64_t i = next_commit; i < count && computed[i]; i = ++next_commit) {
+      commit_failure = commit(i, thread);
+      if (!commit_failure.ok()) return false;
+    }
+    return true;
+  };
+  absl::Status status = ParallelFor(count, threads, [&](int64_t index, int thread) -> absl::Status {
+    MOTIONDB_RETURN_IF_ERROR(compute(index, thread));
+    computed[index] = true;
+    // A thread that finds another committing goes on computing: the committer takes this index
+    // too if it gets there, else the next thread to finish or the caller's last sweep does.
+    while (committing.try_lock()) {
+      const bool ok = commit_ready(thread);
+      committing.unlock();
+      if (!ok) return absl::AbortedError("an earlier commit failed");
+      const int64_t next = next_commit;
+      if (next >= count || !computed[next]) break;
+    }
+    return absl::OkStatus();
+  });
+  const std::lock_guard<std::mutex> lock(committing);
+  if (!commit_failure.ok()) return commit_failure;
+  MOTIONDB_RETURN_IF_ERROR(status);
+  commit_ready(0);
+  return commit_failure;
 }
 
 int PieceCount(int64_t count, int64_t min_piece, int threads) {

@@ -61,6 +61,9 @@ absl::Status ValidateSearchParams(const SearchParams& params, int dims) {
   if (params.exact_threads < 0 || params.exact_threads > 1024) {
     return OutOfRange("exact_threads", params.exact_threads, "0..1024 (0: one per core)");
   }
+  if (params.threads < 0 || params.threads > 1024) {
+    return OutOfRange("threads", params.threads, "0..1024 (0: one per core)");
+  }
   if (!std::isfinite(params.epsilon) || params.epsilon < 0) {
     return OutOfRange("epsilon", params.epsilon, "a finite value >= 0");
   }

@@ -35,7 +35,10 @@ struct SearchStats {
   int second_anchor = -1;
   int64_t seeds = 0;
   int64_t clusters = 0;  // cluster representatives, each the anchor of one warp
-  int64_t warps = 0;     // warps completed (inside their clip, not abandoned)
+  // Warps completed (inside their clip, not abandoned); on several threads, some warped against
+  // an older threshold than one thread's count too.
+  int64_t warps = 0;
+  int threads = 1;  // the threads of the warps and refinement (SearchParams::threads)
   // Exact mode: DTW cells evaluated and column blocks skipped by the lower bound; on several
   // threads they depend on which clips finish first.
   int64_t cells = 0;

@@ -1,6 +1,7 @@
 #include "core/search/internal/single_point_search.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -11,6 +12,7 @@
 #include "core/search/internal/search_query.h"
 #include "core/search/warp/time_warp.h"
 #include "core/search/warp_refinement.h"
+#include "util/parallel_for.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -188,28 +190,40 @@ class ClipBestScores {
   std::vector<double> scores_;
 };
 
+// What each thread of a search keeps for itself (SearchParams::threads).
+struct SearchThread {
+  StopPoll stop;
+  WarpWorkspace warps;
+  BandWorkspace bands;
+};
+
 // The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
-// settled at the full rate. `stop` is told the band warps' cells.
+// settled at the full rate. On several threads, the same candidates as on one: refinement
+// moves each candidate alone, and each settle is judged against the bound of the settles
+// before it in order (ParallelForInOrder).
 absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
                                                  int anchor, int coarse_anchor, int factor,
                                                  const WarpConstraints& constraints,
                                                  const SearchParams& params,
                                                  std::vector<SearchResult> candidates,
-                                                 StopPoll& stop) {
-  BandWorkspace workspace;
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    SearchResult& candidate = candidates[i];
-    if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
-    const int64_t phase = candidate.first_frame % factor;
-    ToCoarseFrames(factor, phase, candidate);
-    RefineCandidate(CoarseView(query, factor),
-                    PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
-                    coarse_anchor, library.rate() / factor, constraints, workspace, candidate,
-                    &stop);
-    if (stop.stopped()) return SearchStopped();
-    ToClipFrames(factor, phase, candidate);
-  }
+                                                 std::vector<SearchThread>& threads) {
+  const int thread_count = static_cast<int>(threads.size());
+  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
+      static_cast<int64_t>(candidates.size()), thread_count, [&](int64_t i, int t) -> absl::Status {
+        SearchResult& candidate = candidates[i];
+        StopPoll& stop = threads[t].stop;
+        if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
+        const int64_t phase = candidate.first_frame % factor;
+        ToCoarseFrames(factor, phase, candidate);
+        RefineCandidate(CoarseView(query, factor),
+                        PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
+                        coarse_anchor, library.rate() / factor, constraints, threads[t].bands,
+                        candidate, &stop);
+        if (stop.stopped()) return SearchStopped();
+        ToClipFrames(factor, phase, candidate);
+        return absl::OkStatus();
+      }));
   if (factor > 1) {
     const size_t fine_pool =
         std::max<size_t>(params.max_results,
@@ -221,21 +235,50 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
     // places, the next best candidates are settled too.
     std::vector<SearchResult> settled;
     ClipBestScores ranked_above(params.max_results);
-    for (size_t i = 0; i < candidates.size(); ++i) {
+    struct Settle {
+      SearchResult candidate;  // settled, or as it was
+      bool settled = false;
+      double abandon_score = 0;  // the bound it was settled against
+    };
+    std::vector<Settle> settles(candidates.size());
+    const auto settle = [&](size_t i, double abandon_score, SearchThread& thread) {
+      Settle& s = settles[i];
+      if (thread.stop.Done(query.rows)) return SearchStopped();
+      s.candidate = candidates[i];
+      s.abandon_score = abandon_score;
+      s.settled =
+          RefineFromCoarse(query, library.clip_coordinates(s.candidate.clip_index), anchor, factor,
+                           constraints, abandon_score, thread.bands, s.candidate, &thread.stop);
+      return thread.stop.stopped() ? SearchStopped() : absl::OkStatus();
+    };
+    const auto keep = [&](size_t i) {
+      if (!settles[i].settled) return;
+      ranked_above.Add(settles[i].candidate.clip_index, settles[i].candidate.score);
+      settled.push_back(std::move(settles[i].candidate));
+    };
+    // The bound only falls as settles are kept, so a settle given up against an older bound is
+    // given up against today's too; one kept against an older bound is settled again.
+    std::atomic<double> bound{ranked_above.bound()};
+    const size_t always_settled = std::min(fine_pool, candidates.size());
+    MOTIONDB_RETURN_IF_ERROR(ParallelForInOrder(
+        static_cast<int64_t>(always_settled), thread_count,
+        [&](int64_t i, int t) { return settle(i, bound.load(), threads[t]); },
+        [&](int64_t i, int t) -> absl::Status {
+          if (settles[i].settled && settles[i].abandon_score > ranked_above.bound()) {
+            MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), threads[t]));
+          }
+          keep(i);
+          bound = ranked_above.bound();
+          return absl::OkStatus();
+        }));
+    for (size_t i = always_settled; i < candidates.size(); ++i) {
       // A finite bound means max_results clips hold a settled result, each of them ranked.
-      if (i >= fine_pool &&
-          (std::isfinite(ranked_above.bound()) ||
-           RankedCount(settled, params.max_overlap, params.max_results) == params.max_results)) {
+      if (std::isfinite(ranked_above.bound()) ||
+          RankedCount(settled, params.max_overlap, params.max_results) == params.max_results) {
         break;
       }
-      SearchResult& candidate = candidates[i];
-      if (stop.Done(query.rows)) return SearchStopped();
-      if (RefineFromCoarse(query, library.clip_coordinates(candidate.clip_index), anchor, factor,
-                           constraints, ranked_above.bound(), workspace, candidate, &stop)) {
-        ranked_above.Add(candidate.clip_index, candidate.score);
-        settled.push_back(std::move(candidate));
-      }
-      if (stop.stopped()) return SearchStopped();
+      MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), threads[0]));
+      keep(i);
     }
     candidates = std::move(settled);
   }
@@ -359,7 +402,9 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   const CoordinateView warp_query = CoarseView(query, factor);
   const int warp_anchor = CoarseRow(anchor, factor, warp_query.rows);
 
-  StopPoll stop = SearchStop(params);
+  std::vector<SearchThread> threads(ThreadsFor(params.threads), {SearchStop(params), {}, {}});
+  stats.threads = static_cast<int>(threads.size());
+  StopPoll& stop = threads[0].stop;
   if (stop.Done(query.rows)) return SearchStopped();
   std::vector<Seed> order = ClusteredSeeds(library, query, anchor, warp_query.rows, factor,
                                            filter.allowed, params, stats, stop);
@@ -370,44 +415,67 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   std::sort(order.begin(), order.end(),
             [](const Seed& a, const Seed& b) { return a.distance < b.distance; });
   const WarpConstraints constraints{params.slope_limit, params.dtw_dims};
-  WarpWorkspace workspace;
   const int pool =
       params.refine ? static_cast<int>(std::lround(
                           params.max_results * RefinePoolPerThousandSeeds(params.seed_selection) *
                           std::max(1.0, static_cast<double>(stats.seeds) / 1000.0)))
                     : params.max_results;
   StreamingTopResults top(pool, params.max_overlap, warp_query.rows);
-  for (size_t i = 0; i < order.size(); ++i) {
+  const bool keep_path = params.return_path || params.refine;
+  struct SeedWarp {
+    std::optional<Warp> warp;
+    float abandon_at = 0;  // the threshold it was warped against
+  };
+  std::vector<SeedWarp> warps(order.size());
+  const auto warp_seed = [&](size_t i, float abandon_at, SearchThread& thread) {
     // A warp's cells are counted as it fills them; its setup costs about a row's.
-    if (stop.Done(warp_query.rows)) return SearchStopped();
+    if (thread.stop.Done(warp_query.rows)) return SearchStopped();
     const Seed& seed = order[i];
     const int64_t phase = seed.frame % factor;
     // A second anchor's warp needs its path to say where it passes the characteristic frame.
-    const bool second_anchor = seed.anchor != anchor;
-    const bool keep_path = params.return_path || params.refine;
-    std::optional<Warp> warp =
+    warps[i] = {
         AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
                      CoarseRow(seed.anchor, factor, warp_query.rows), seed.frame / factor,
-                     constraints, keep_path || second_anchor, workspace, top.threshold(), &stop);
-    if (stop.stopped()) return SearchStopped();
-    if (!warp) continue;
-    ++stats.warps;
-    SearchResult candidate = MakeResult(seed.clip, *std::move(warp), seed.frame / factor);
-    ToClipFrames(factor, phase, candidate);
-    if (second_anchor) {
-      candidate.seed_frame = candidate.path[warp_anchor];
-      if (!keep_path) candidate.path = {};
-    }
-    // Left out before it takes a place in the pool that an admitted one would have had.
-    if (filter.Admits(candidate)) top.Offer(std::move(candidate));
-  }
+                     constraints, keep_path || seed.anchor != anchor, thread.warps, abandon_at,
+                     &thread.stop),
+        abandon_at};
+    return thread.stop.stopped() ? SearchStopped() : absl::OkStatus();
+  };
+  // On several threads each seed is warped against the threshold its thread last saw, and
+  // offered in order: a warp given up against a lower threshold than its offer sees (the
+  // threshold rises when a candidate suppresses two kept ones) is warped again, so that the
+  // pool holds what one thread would have kept.
+  std::atomic<float> threshold{top.threshold()};
+  MOTIONDB_RETURN_IF_ERROR(ParallelForInOrder(
+      static_cast<int64_t>(order.size()), static_cast<int>(threads.size()),
+      [&](int64_t i, int t) { return warp_seed(i, threshold.load(), threads[t]); },
+      [&](int64_t i, int t) -> absl::Status {
+        if (!warps[i].warp && warps[i].abandon_at < top.threshold()) {
+          MOTIONDB_RETURN_IF_ERROR(warp_seed(i, top.threshold(), threads[t]));
+        }
+        if (!warps[i].warp) return absl::OkStatus();
+        ++stats.warps;
+        const Seed& seed = order[i];
+        SearchResult candidate =
+            MakeResult(seed.clip, *std::move(warps[i].warp), seed.frame / factor);
+        ToClipFrames(factor, seed.frame % factor, candidate);
+        if (seed.anchor != anchor) {
+          candidate.seed_frame = candidate.path[warp_anchor];
+          if (!keep_path) candidate.path = {};
+        }
+        // Left out before it takes a place in the pool that an admitted one would have had.
+        if (filter.Admits(candidate)) top.Offer(std::move(candidate));
+        threshold = top.threshold();
+        return absl::OkStatus();
+      }));
   stats.warps_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
-    MOTIONDB_ASSIGN_OR_RETURN(candidates, Refine(library, query, anchor, warp_anchor, factor,
-                                                 constraints, params, std::move(candidates), stop));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params,
+                           std::move(candidates), threads));
   }
   stats.refine_ms = MillisecondsSince(stage);
 

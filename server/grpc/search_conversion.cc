@@ -97,6 +97,8 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
   }
   out.characteristic_frames.assign(request.characteristic_frames().begin(),
                                    request.characteristic_frames().end());
+  // 0 asks for the automatic choice, as unset does.
+  if (request.has_threads() && request.threads() != 0) out.threads = request.threads();
   out.exact = request.exact();
   out.exclude_query = Optional(request.has_exclude_query(), request.exclude_query());
   out.explain = request.explain();
@@ -150,6 +152,7 @@ void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
   counts->set_warps(stats.warps);
   counts->set_cells(stats.cells);
   counts->set_pruned_blocks(stats.pruned_blocks);
+  counts->set_threads(stats.threads);
 }
 
 }  // namespace motiondb::server
