@@ -23,20 +23,6 @@ int ThreadsFor(int requested);
 absl::Status ParallelFor(int64_t count, int threads,
                          const std::function<absl::Status(int64_t index, int thread)>& body);
 
-// ParallelFor with an ordered second step, for speculative work: compute(index, thread) for
-// every index, as ParallelFor calls body, and commit(index, thread) for every index in
-// increasing order, each after its own compute and the previous index's commit, never two at
-// once, on whichever thread finds it ready (a commit can run beside later indices' computes).
-// With one thread: compute(0), commit(0), compute(1), commit(1), ... A compute reads what the
-// commits so far have published (a bound, a threshold); a commit sees everything before it
-// committed, and redoes its compute when what that read has changed since. After a failure no
-// further index is computed or committed; returns the commit's failure, else the compute's of
-// the lowest index, or OK.
-absl::Status ParallelForInOrder(
-    int64_t count, int threads,
-    const std::function<absl::Status(int64_t index, int thread)>& compute,
-    const std::function<absl::Status(int64_t index, int thread)>& commit);
-
 // Work cut into a few large contiguous pieces, one a thread, for loops that cannot fail.
 // How many pieces to cut `count` items into for `threads` (0: one a core): one a thread, but
 // none smaller than `min_piece` items (a thread costs tens of microseconds to start), except

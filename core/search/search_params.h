@@ -132,7 +132,7 @@ struct SearchParams {
   // Fast search, one characteristic point: threads sharing the query's warps and refinement
   // (its seeds are found on one); 0: one per core. The results are the same however many: each
   // warp and settle is judged, in order, against what the ones before it left
-  // (util/parallel_for.h ParallelForInOrder). One by default, as the thesis's algorithm: a
+  // (util/thread_team.h). One by default, as the thesis's algorithm: a
   // server gives a search every core only while it runs no other (server/search_runner.h).
   int threads = 1;
   // Return each result's warp path (one library frame per query frame).

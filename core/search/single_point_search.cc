@@ -14,6 +14,7 @@
 #include "core/search/warp_refinement.h"
 #include "util/parallel_for.h"
 #include "util/status_macros.h"
+#include "util/thread_team.h"
 
 namespace motiondb {
 namespace {
@@ -201,16 +202,13 @@ struct SearchThread {
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
 // settled at the full rate. On several threads, the same candidates as on one: refinement
 // moves each candidate alone, and each settle is judged against the bound of the settles
-// before it in order (ParallelForInOrder).
-absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
-                                                 int anchor, int coarse_anchor, int factor,
-                                                 const WarpConstraints& constraints,
-                                                 const SearchParams& params,
-                                                 std::vector<SearchResult> candidates,
-                                                 std::vector<SearchThread>& threads) {
-  const int thread_count = static_cast<int>(threads.size());
-  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
-      static_cast<int64_t>(candidates.size()), thread_count, [&](int64_t i, int t) -> absl::Status {
+// before it in order (ThreadTeam::ParallelForInOrder).
+absl::StatusOr<std::vector<SearchResult>> Refine(
+    const LibraryIndex& library, CoordinateView query, int anchor, int coarse_anchor, int factor,
+    const WarpConstraints& constraints, const SearchParams& params,
+    std::vector<SearchResult> candidates, ThreadTeam& team, std::vector<SearchThread>& threads) {
+  MOTIONDB_RETURN_IF_ERROR(team.ParallelFor(
+      static_cast<int64_t>(candidates.size()), [&](int64_t i, int t) -> absl::Status {
         SearchResult& candidate = candidates[i];
         StopPoll& stop = threads[t].stop;
         if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
@@ -260,8 +258,8 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
     // given up against today's too; one kept against an older bound is settled again.
     std::atomic<double> bound{ranked_above.bound()};
     const size_t always_settled = std::min(fine_pool, candidates.size());
-    MOTIONDB_RETURN_IF_ERROR(ParallelForInOrder(
-        static_cast<int64_t>(always_settled), thread_count,
+    MOTIONDB_RETURN_IF_ERROR(team.ParallelForInOrder(
+        static_cast<int64_t>(always_settled),
         [&](int64_t i, int t) { return settle(i, bound.load(), threads[t]); },
         [&](int64_t i, int t) -> absl::Status {
           if (settles[i].settled && settles[i].abandon_score > ranked_above.bound()) {
@@ -402,7 +400,9 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   const CoordinateView warp_query = CoarseView(query, factor);
   const int warp_anchor = CoarseRow(anchor, factor, warp_query.rows);
 
-  std::vector<SearchThread> threads(ThreadsFor(params.threads), {SearchStop(params), {}, {}});
+  // Started now, so that the helpers are running by the time the seeds are found.
+  ThreadTeam team(ThreadsFor(params.threads));
+  std::vector<SearchThread> threads(team.size(), {SearchStop(params), {}, {}});
   stats.threads = static_cast<int>(threads.size());
   StopPoll& stop = threads[0].stop;
   if (stop.Done(query.rows)) return SearchStopped();
@@ -446,8 +446,8 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   // threshold rises when a candidate suppresses two kept ones) is warped again, so that the
   // pool holds what one thread would have kept.
   std::atomic<float> threshold{top.threshold()};
-  MOTIONDB_RETURN_IF_ERROR(ParallelForInOrder(
-      static_cast<int64_t>(order.size()), static_cast<int>(threads.size()),
+  MOTIONDB_RETURN_IF_ERROR(team.ParallelForInOrder(
+      static_cast<int64_t>(order.size()),
       [&](int64_t i, int t) { return warp_seed(i, threshold.load(), threads[t]); },
       [&](int64_t i, int t) -> absl::Status {
         if (!warps[i].warp && warps[i].abandon_at < top.threshold()) {
@@ -475,7 +475,7 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   if (params.refine) {
     MOTIONDB_ASSIGN_OR_RETURN(
         candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params,
-                           std::move(candidates), threads));
+                           std::move(candidates), team, threads));
   }
   stats.refine_ms = MillisecondsSince(stage);
 
