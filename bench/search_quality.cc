@@ -123,6 +123,8 @@ void AddFlags(CLI::App& app, QualityFlags* flags) {
         {"--slope", &params.slope_limit, "the warp's slope limit", 1},
         {"--points", &params.characteristic_points,
          "characteristic points per query (0: one per action of the query)", 0},
+        {"--threads", &params.threads,
+         "threads of the fast search's warps and refinement (0: one per core)", 0},
         {"--exact-every", &flags->retrieval.exact_every,
          "run the exact search on every N-th query (0: never)", 0}}) {
     app.add_option(name, *field, what)
