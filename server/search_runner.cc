@@ -13,6 +13,7 @@
 #include "core/search/warp/time_warp.h"
 #include "core/space/search_coordinates.h"
 #include "server/space_lookup.h"
+#include "util/parallel_for.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -147,7 +148,8 @@ absl::StatusOr<int> QueryRow(const Query& query, int frame, absl::string_view fi
 absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Query& query,
                                            int dims, int searches_running) {
   SearchParams params = WithSearchDims(request, dims);
-  params.threads = request.threads.value_or(searches_running == 1 ? 0 : 1);
+  const bool automatic = !request.threads || *request.threads == 0;
+  params.threads = automatic ? (searches_running == 1 ? ThreadsFor(0) : 1) : *request.threads;
   params.characteristic_frame = -1;
   if (request.characteristic_frame) {
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -175,6 +177,8 @@ absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Q
   // INVALID_ARGUMENT, not a refused answer); the engine checks them again with the same function
   // at its entry (core/search/search_query.cc), its contract with every caller.
   MOTIONDB_RETURN_IF_ERROR(ValidateSearchParams(params, dims));
+  // Threads past the cores would only spin beside each other.
+  params.threads = std::min(params.threads, ThreadsFor(0));
   return params;
 }
 

@@ -46,9 +46,9 @@ struct SearchRequest {
   // Several characteristic points, as characteristic_frame, increasing (SearchParams'
   // characteristic_frames); empty: none given.
   std::vector<int> characteristic_frames;
-  // Threads of a fast search (SearchParams::threads); unset: every core while the runner runs
-  // no other search, else one, so that a quiet server answers one client sooner and a busy one
-  // gives each search a core as before.
+  // Threads of a fast search (SearchParams::threads), at most the cores; unset or 0: every core
+  // when the search starts while the runner runs no other, else one, so that a quiet server
+  // answers one client sooner and a busy one gives each search a core as before.
   std::optional<int> threads;
   // The exhaustive search instead of the seeded one.
   bool exact = false;

@@ -145,5 +145,25 @@ TEST(ThreadTeamInOrder, AFailureEndsItAndIsReturned) {
   }
 }
 
+// A commit that failed once would succeed if tried again (another member's stop has not said
+// stop yet): it is not tried again, and its failure is the answer.
+TEST(ThreadTeamInOrder, AFailedCommitIsNotTriedAgain) {
+  for (const int threads : {1, 2, 4}) {
+    ThreadTeam team(threads);
+    std::atomic<int> tries = 0;
+    std::atomic<int64_t> committed_past = 0;
+    const absl::Status status = team.ParallelForInOrder(
+        2000, [](int64_t, int) { return absl::OkStatus(); },
+        [&](int64_t i, int) {
+          if (i == 500 && tries++ == 0) return absl::CancelledError("stopped at 500");
+          if (i >= 500) ++committed_past;
+          return absl::OkStatus();
+        });
+    EXPECT_EQ(status, absl::CancelledError("stopped at 500")) << threads;
+    EXPECT_EQ(tries, 1) << threads;
+    EXPECT_EQ(committed_past, 0) << threads;
+  }
+}
+
 }  // namespace
 }  // namespace motiondb

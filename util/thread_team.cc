@@ -1,6 +1,9 @@
 #include "util/thread_team.h"
 
+#include <algorithm>
 #include <mutex>
+
+#include "absl/cleanup/cleanup.h"
 
 #include "util/internal/helper_threads.h"
 #include "util/internal/index_handout.h"
@@ -13,7 +16,10 @@ ThreadTeam::ThreadTeam(int threads) {
       threads, [this](int member) { Help(member); }, helpers_);
 }
 
-ThreadTeam::~ThreadTeam() { closing_ = true; }  // the helpers are joined as helpers_ goes
+ThreadTeam::~ThreadTeam() {
+  closing_ = true;
+  helpers_.clear();  // joined here, while what they read is alive
+}
 
 void ThreadTeam::Help(int member) {
   uint64_t seen = 0;
@@ -46,11 +52,15 @@ void ThreadTeam::RunStage(const std::function<void(int member)>& stage) {
   stage_ = &stage;
   stage_state_.store(0, std::memory_order_release);  // open, no helper in it yet
   stages_.fetch_add(1, std::memory_order_release);
+  // Closed and left by every helper before the stage's state goes, even when the caller's part
+  // throws.
+  const absl::Cleanup close = [this] {
+    stage_state_.fetch_or(kStageClosed, std::memory_order_acq_rel);
+    while ((stage_state_.load(std::memory_order_acquire) & ~kStageClosed) != 0) {
+      std::this_thread::yield();
+    }
+  };
   stage(0);
-  stage_state_.fetch_or(kStageClosed, std::memory_order_acq_rel);
-  while ((stage_state_.load(std::memory_order_acquire) & ~kStageClosed) != 0) {
-    std::this_thread::yield();
-  }
 }
 
 absl::Status ThreadTeam::ParallelFor(
@@ -66,14 +76,16 @@ absl::Status ThreadTeam::ParallelForInOrder(
   std::vector<std::atomic<bool>> computed(static_cast<size_t>(std::max<int64_t>(count, 0)));
   std::mutex committing;
   std::atomic<int64_t> next_commit{0};  // written under `committing`
-  absl::Status commit_failure;          // under `committing`
-  // Commits every computed index from next_commit on; false once a commit failed.
+  absl::Status commit_failure;          // under `committing`; once set, nothing more commits
+  // Commits every computed index from next_commit on; the failure, if a commit failed (now or
+  // before: a failed commit is not tried again by another member, whose stop may not have said
+  // stop yet).
   const auto commit_ready = [&](int member) {
-    for (int64_t i = next_commit; i < count && computed[i]; i = ++next_commit) {
+    for (int64_t i = next_commit; commit_failure.ok() && i < count && computed[i];
+         i = ++next_commit) {
       commit_failure = commit(i, member);
-      if (!commit_failure.ok()) return false;
     }
-    return true;
+    return commit_failure;
   };
   const absl::Status status = ParallelFor(count, [&](int64_t index, int member) -> absl::Status {
     MOTIONDB_RETURN_IF_ERROR(compute(index, member));
@@ -81,9 +93,9 @@ absl::Status ThreadTeam::ParallelForInOrder(
     // A member that finds another committing goes on computing: the committer takes this index
     // too if it gets there, else the next member to finish or the caller's last sweep does.
     while (committing.try_lock()) {
-      const bool ok = commit_ready(member);
+      const absl::Status committed = commit_ready(member);
       committing.unlock();
-      if (!ok) return absl::AbortedError("an earlier commit failed");
+      MOTIONDB_RETURN_IF_ERROR(committed);
       const int64_t next = next_commit;
       if (next >= count || !computed[next]) break;
     }
@@ -92,8 +104,7 @@ absl::Status ThreadTeam::ParallelForInOrder(
   const std::lock_guard<std::mutex> lock(committing);
   if (!commit_failure.ok()) return commit_failure;
   MOTIONDB_RETURN_IF_ERROR(status);
-  commit_ready(0);
-  return commit_failure;
+  return commit_ready(0);
 }
 
 }  // namespace motiondb

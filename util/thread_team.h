@@ -7,7 +7,9 @@
 // first serial work and spin (yielding the core to anything else that wants it) between stages
 // until the team is destroyed.
 //
-// Not thread-safe: one caller drives a team; its stages run on the team's threads.
+// Not thread-safe: one caller drives a team; its stages run on the team's threads. A stage that
+// throws on the caller is closed and left by the helpers first; one that throws on a helper ends
+// the process, as ParallelFor's would.
 #ifndef MOTIONDB_UTIL_THREAD_TEAM_H_
 #define MOTIONDB_UTIL_THREAD_TEAM_H_
 
@@ -40,11 +42,13 @@ class ThreadTeam {
   // For speculative work: compute(index, member) for every index as ParallelFor calls body, and
   // commit(index, member) for every index in increasing order, each after its own compute and
   // the previous index's commit, never two at once, on whichever member finds it ready (a
-  // commit can run beside later indices' computes). With one thread: compute(0), commit(0),
-  // compute(1), commit(1), ... A compute reads what the commits so far have published (a bound,
-  // a threshold); a commit sees everything before it committed, and redoes its compute when
-  // what that read has changed since. After a failure no further index is computed or
-  // committed; returns the commit's failure, else the compute's of the lowest index, or OK.
+  // commit can run beside later indices' computes), inside that member's own call, so that a
+  // member's state is never used by two threads. With one thread: compute(0), commit(0),
+  // compute(1), commit(1), ... The caller's compute reads what the commits so far have
+  // published (a bound, a threshold); its commit sees everything before it committed, and is
+  // where the caller redoes a compute whose reading has changed since. After a failure no
+  // further index is computed or committed, nor a failed commit tried again; returns the
+  // commit's failure, else the compute's of the lowest index, or OK.
   absl::Status ParallelForInOrder(
       int64_t count, const std::function<absl::Status(int64_t index, int member)>& compute,
       const std::function<absl::Status(int64_t index, int member)>& commit);

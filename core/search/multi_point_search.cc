@@ -284,6 +284,7 @@ void AddStageStats(const SearchStats& part, SearchStats& total) {
   total.seeds += part.seeds;
   total.clusters += part.clusters;
   total.warps += part.warps;
+  total.threads = part.threads;
   total.characteristic_ms += part.characteristic_ms;
   total.seeds_ms += part.seeds_ms;
   total.clusters_ms += part.clusters_ms;

@@ -129,9 +129,9 @@ struct SearchParams {
   bool refine = true;
   // Exact search: threads scanning the library's clips (0: one per core).
   int exact_threads = 0;
-  // Fast search, one characteristic point: threads sharing the query's warps and refinement
-  // (its seeds are found on one); 0: one per core. The results are the same however many: each
-  // warp and settle is judged, in order, against what the ones before it left
+  // Fast search: threads sharing the query's warps and refinement (each part's, with several
+  // characteristic points; the seeds are found on one); 0: one per core. The results are the same
+  // however many: each warp and settle is judged, in order, against what the ones before it left
   // (util/thread_team.h). One by default, as the thesis's algorithm: a
   // server gives a search every core only while it runs no other (server/search_runner.h).
   int threads = 1;

@@ -191,8 +191,8 @@ class ClipBestScores {
   std::vector<double> scores_;
 };
 
-// What each thread of a search keeps for itself (SearchParams::threads).
-struct SearchThread {
+// What each member of a search's thread team keeps for itself (SearchParams::threads).
+struct MemberState {
   StopPoll stop;
   WarpWorkspace warps;
   BandWorkspace bands;
@@ -206,17 +206,17 @@ struct SearchThread {
 absl::StatusOr<std::vector<SearchResult>> Refine(
     const LibraryIndex& library, CoordinateView query, int anchor, int coarse_anchor, int factor,
     const WarpConstraints& constraints, const SearchParams& params,
-    std::vector<SearchResult> candidates, ThreadTeam& team, std::vector<SearchThread>& threads) {
+    std::vector<SearchResult> candidates, ThreadTeam& team, std::vector<MemberState>& members) {
   MOTIONDB_RETURN_IF_ERROR(team.ParallelFor(
       static_cast<int64_t>(candidates.size()), [&](int64_t i, int t) -> absl::Status {
         SearchResult& candidate = candidates[i];
-        StopPoll& stop = threads[t].stop;
+        StopPoll& stop = members[t].stop;
         if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
         const int64_t phase = candidate.first_frame % factor;
         ToCoarseFrames(factor, phase, candidate);
         RefineCandidate(CoarseView(query, factor),
                         PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
-                        coarse_anchor, library.rate() / factor, constraints, threads[t].bands,
+                        coarse_anchor, library.rate() / factor, constraints, members[t].bands,
                         candidate, &stop);
         if (stop.stopped()) return SearchStopped();
         ToClipFrames(factor, phase, candidate);
@@ -233,26 +233,26 @@ absl::StatusOr<std::vector<SearchResult>> Refine(
     // places, the next best candidates are settled too.
     std::vector<SearchResult> settled;
     ClipBestScores ranked_above(params.max_results);
-    struct Settle {
+    struct SettleAttempt {
       SearchResult candidate;  // settled, or as it was
       bool settled = false;
       double abandon_score = 0;  // the bound it was settled against
     };
-    std::vector<Settle> settles(candidates.size());
-    const auto settle = [&](size_t i, double abandon_score, SearchThread& thread) {
-      Settle& s = settles[i];
-      if (thread.stop.Done(query.rows)) return SearchStopped();
+    std::vector<SettleAttempt> attempts(candidates.size());
+    const auto settle = [&](size_t i, double abandon_score, MemberState& member) {
+      SettleAttempt& s = attempts[i];
+      if (member.stop.Done(query.rows)) return SearchStopped();
       s.candidate = candidates[i];
       s.abandon_score = abandon_score;
       s.settled =
           RefineFromCoarse(query, library.clip_coordinates(s.candidate.clip_index), anchor, factor,
-                           constraints, abandon_score, thread.bands, s.candidate, &thread.stop);
-      return thread.stop.stopped() ? SearchStopped() : absl::OkStatus();
+                           constraints, abandon_score, member.bands, s.candidate, &member.stop);
+      return member.stop.stopped() ? SearchStopped() : absl::OkStatus();
     };
     const auto keep = [&](size_t i) {
-      if (!settles[i].settled) return;
-      ranked_above.Add(settles[i].candidate.clip_index, settles[i].candidate.score);
-      settled.push_back(std::move(settles[i].candidate));
+      if (!attempts[i].settled) return;
+      ranked_above.Add(attempts[i].candidate.clip_index, attempts[i].candidate.score);
+      settled.push_back(std::move(attempts[i].candidate));
     };
     // The bound only falls as settles are kept, so a settle given up against an older bound is
     // given up against today's too; one kept against an older bound is settled again.
@@ -260,10 +260,10 @@ absl::StatusOr<std::vector<SearchResult>> Refine(
     const size_t always_settled = std::min(fine_pool, candidates.size());
     MOTIONDB_RETURN_IF_ERROR(team.ParallelForInOrder(
         static_cast<int64_t>(always_settled),
-        [&](int64_t i, int t) { return settle(i, bound.load(), threads[t]); },
+        [&](int64_t i, int t) { return settle(i, bound.load(), members[t]); },
         [&](int64_t i, int t) -> absl::Status {
-          if (settles[i].settled && settles[i].abandon_score > ranked_above.bound()) {
-            MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), threads[t]));
+          if (attempts[i].settled && attempts[i].abandon_score > ranked_above.bound()) {
+            MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), members[t]));
           }
           keep(i);
           bound = ranked_above.bound();
@@ -275,7 +275,7 @@ absl::StatusOr<std::vector<SearchResult>> Refine(
           RankedCount(settled, params.max_overlap, params.max_results) == params.max_results) {
         break;
       }
-      MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), threads[0]));
+      MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), members[0]));
       keep(i);
     }
     candidates = std::move(settled);
@@ -402,9 +402,9 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
 
   // Started now, so that the helpers are running by the time the seeds are found.
   ThreadTeam team(ThreadsFor(params.threads));
-  std::vector<SearchThread> threads(team.size(), {SearchStop(params), {}, {}});
-  stats.threads = static_cast<int>(threads.size());
-  StopPoll& stop = threads[0].stop;
+  std::vector<MemberState> members(team.size(), {SearchStop(params), {}, {}});
+  stats.threads = static_cast<int>(members.size());
+  StopPoll& stop = members[0].stop;
   if (stop.Done(query.rows)) return SearchStopped();
   std::vector<Seed> order = ClusteredSeeds(library, query, anchor, warp_query.rows, factor,
                                            filter.allowed, params, stats, stop);
@@ -427,19 +427,19 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
     float abandon_at = 0;  // the threshold it was warped against
   };
   std::vector<SeedWarp> warps(order.size());
-  const auto warp_seed = [&](size_t i, float abandon_at, SearchThread& thread) {
+  const auto warp_seed = [&](size_t i, float abandon_at, MemberState& member) {
     // A warp's cells are counted as it fills them; its setup costs about a row's.
-    if (thread.stop.Done(warp_query.rows)) return SearchStopped();
+    if (member.stop.Done(warp_query.rows)) return SearchStopped();
     const Seed& seed = order[i];
     const int64_t phase = seed.frame % factor;
     // A second anchor's warp needs its path to say where it passes the characteristic frame.
     warps[i] = {
         AnchoredWarp(warp_query, PhasedView(library.clip_coordinates(seed.clip), factor, phase),
                      CoarseRow(seed.anchor, factor, warp_query.rows), seed.frame / factor,
-                     constraints, keep_path || seed.anchor != anchor, thread.warps, abandon_at,
-                     &thread.stop),
+                     constraints, keep_path || seed.anchor != anchor, member.warps, abandon_at,
+                     &member.stop),
         abandon_at};
-    return thread.stop.stopped() ? SearchStopped() : absl::OkStatus();
+    return member.stop.stopped() ? SearchStopped() : absl::OkStatus();
   };
   // On several threads each seed is warped against the threshold its thread last saw, and
   // offered in order: a warp given up against a lower threshold than its offer sees (the
@@ -448,10 +448,17 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   std::atomic<float> threshold{top.threshold()};
   MOTIONDB_RETURN_IF_ERROR(team.ParallelForInOrder(
       static_cast<int64_t>(order.size()),
-      [&](int64_t i, int t) { return warp_seed(i, threshold.load(), threads[t]); },
+      [&](int64_t i, int t) { return warp_seed(i, threshold.load(), members[t]); },
       [&](int64_t i, int t) -> absl::Status {
-        if (!warps[i].warp && warps[i].abandon_at < top.threshold()) {
-          MOTIONDB_RETURN_IF_ERROR(warp_seed(i, top.threshold(), threads[t]));
+        // Also warped again: a warp completed against a higher threshold than the offer sees
+        // whose cost is about at it (the pool's double scores and the warp's float threshold
+        // can disagree at a tie).
+        const float now = top.threshold();
+        const std::optional<Warp>& warp = warps[i].warp;
+        if (warp ? warps[i].abandon_at > now &&
+                       warp->score * static_cast<double>(warp_query.rows) >= now * (1 - 1e-5)
+                 : warps[i].abandon_at < now) {
+          MOTIONDB_RETURN_IF_ERROR(warp_seed(i, now, members[t]));
         }
         if (!warps[i].warp) return absl::OkStatus();
         ++stats.warps;
@@ -475,7 +482,7 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   if (params.refine) {
     MOTIONDB_ASSIGN_OR_RETURN(
         candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params,
-                           std::move(candidates), team, threads));
+                           std::move(candidates), team, members));
   }
   stats.refine_ms = MillisecondsSince(stage);
 

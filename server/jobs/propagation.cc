@@ -162,6 +162,7 @@ absl::StatusOr<double> SpaceScoreScale(const SpaceSnapshot& snapshot, const Sear
                                  std::min(timing.frame_count - 1, first + length - 1)};
     search.params.max_results = kScaleRank;
     search.exclude_query = true;
+    search.threads = 1;  // the windows are shared out over the job's own threads
   }
   // NaN: the window left out.
   std::vector<double> last_scores(windows.size(), std::nan(""));
@@ -260,6 +261,9 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
         search.query = ClipSelection{label.clip_id, static_cast<int>(label.first_frame),
                                      static_cast<int>(label.last_frame)};
         search.exclude_query = true;
+        // One thread a search: the job shares its queries out over its own threads
+        // (--job-threads), whose cores a search's spinning helpers would only take.
+        search.threads = 1;
         const absl::StatusOr<SearchOutcome> found = runner.Run(search, should_stop);
         if (found.ok()) {
           AddCandidates(label, *found, snapshot->record.space_id, job_id, &found_by_label[i]);
