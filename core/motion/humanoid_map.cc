@@ -165,14 +165,15 @@ class Mapper {
   // the torso).
   void FindHips() {
     if (Get(Slot::kHips) >= 0) return;
+    int named = -1;
     for (int j = 0; j < count_; ++j) {
       if (readings_[j].part == BodyPart::kHips && !owner_[j] &&
-          (Get(Slot::kHips) < 0 || depth_[j] < depth_[Get(Slot::kHips)])) {
-        map_.joints[static_cast<int>(Slot::kHips)] = j;
+          (named < 0 || depth_[j] < depth_[named])) {
+        named = j;
       }
     }
-    if (Get(Slot::kHips) >= 0) {
-      owner_[Get(Slot::kHips)] = true;
+    if (named >= 0) {
+      Set(Slot::kHips, named);
       return;
     }
     for (int j = 0; j < count_; ++j) {
@@ -185,12 +186,12 @@ class Mapper {
     }
   }
 
-  // The limb's slots filled from `chosen` (a joint or -1 for each): a slot between two chosen
+  // A limb's slots filled from `chain` (a joint or -1 for each): a slot between two chosen
   // takes the ancestors of the later one, a slot after the last chosen the chain's next joint,
-  // the slot before the first chosen its parent when that is a limb joint of this side. The
+  // the slot before the first chosen its parent when that may be a limb's joint. The
   // hierarchy thus fills what names leave open, and a chain whose names skip a slot that no
   // joint can fill scores lower. Returns the filled chain.
-  std::array<int, 4> FillChain(const Limb& limb, std::array<int, 4> chain) const {
+  std::array<int, 4> FillChain(std::array<int, 4> chain) const {
     const auto usable = [&](int joint) { return joint >= 0 && !owner_[joint]; };
     int last = -1;
     for (int i = 0; i < 4; ++i) {
@@ -199,7 +200,7 @@ class Mapper {
       for (int k = i - 1; k > last && ancestor >= 0; --k) {
         if (last >= 0 && !IsStrictAncestor(chain[last], ancestor)) break;
         if (ancestor == Get(Slot::kHips) || !usable(ancestor)) break;
-        if (last < 0 && !IsLimbJoint(ancestor, limb.side)) break;
+        if (last < 0 && !IsLimbJoint(ancestor)) break;
         chain[k] = ancestor;
         ancestor = Parent(ancestor);
       }
@@ -213,12 +214,13 @@ class Mapper {
     return chain;
   }
 
-  // A joint that belongs to one side's limb: below the hips, above no joint named for the
-  // other side, and not on the way to the head.
-  bool IsLimbJoint(int joint, BodySide side) const {
+  // A joint that may belong to a limb: below the hips, not on the way to the head, and not
+  // above joints named for both sides (the chest). A side's name does not bar it: an override
+  // may give a limb the other side's chain (a rig whose names have the sides swapped).
+  bool IsLimbJoint(int joint) const {
     if (!IsStrictAncestor(Get(Slot::kHips), joint)) return false;
     if (head_ >= 0 && IsAncestor(joint, head_)) return false;
-    return !named_below_[joint][side == BodySide::kLeft ? 1 : 0];
+    return !(named_below_[joint][0] && named_below_[joint][1]);
   }
 
   ChainScore Score(const Limb& limb, const std::array<int, 4>& named,
@@ -256,7 +258,7 @@ class Mapper {
     std::array<int, 4> named{};
     const auto visit = [&](auto&& self, int slot, int previous) -> void {
       if (slot == 4) {
-        const std::array<int, 4> filled = FillChain(limb, named);
+        const std::array<int, 4> filled = FillChain(named);
         const ChainScore score = Score(limb, named, filled);
         if (score > best_score) {
           best_score = score;
