@@ -339,9 +339,9 @@ class Database {
   // The skeleton and its stored slot overrides. NOT_FOUND for an unknown skeleton.
   absl::StatusOr<SkeletonRecord> GetSkeleton(int64_t skeleton_id);
   // Sets and clears a skeleton's slot overrides in one transaction and returns the skeleton as
-  // updated. NOT_FOUND for an unknown skeleton; INVALID_ARGUMENT naming `set[i]` for a joint
-  // the skeleton lacks, a slot set twice or both set and cleared, or a joint that another
-  // override (stored, or set here) gives to another slot. Nothing changes on error.
+  // updated. NOT_FOUND for an unknown skeleton; INVALID_ARGUMENT naming `set[i].joint` for a
+  // joint the skeleton lacks or that another override (stored, or set here) gives to another
+  // slot, `set[i].slot` for a slot set twice or both set and cleared. Nothing changes on error.
   absl::StatusOr<SkeletonRecord> UpdateSlotOverrides(int64_t skeleton_id,
                                                      const SlotOverrideChange& change,
                                                      const WriteOptions& write = {});

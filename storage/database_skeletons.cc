@@ -102,19 +102,19 @@ absl::StatusOr<std::map<HumanoidSlot, std::string>> ChangedOverrides(
   std::map<HumanoidSlot, size_t> set_at;
   for (size_t i = 0; i < change.set.size(); ++i) {
     const SlotOverride& set = change.set[i];
-    const std::string what = absl::StrCat("set[", i, "]");
+    const std::string what = absl::StrCat("set[", i, "].");
     const absl::string_view slot = HumanoidSlotName(set.slot);
     if (stored.skeleton->FindJoint(set.joint) < 0) {
       return absl::InvalidArgumentError(
-          absl::StrCat(what, ": skeleton ", stored.summary.skeleton_id, " has no joint named '",
-                       set.joint.substr(0, 128), "'"));
+          absl::StrCat(what, "joint: skeleton ", stored.summary.skeleton_id,
+                       " has no joint named '", set.joint.substr(0, 128), "'"));
     }
     if (!set_at.emplace(set.slot, i).second) {
-      return absl::InvalidArgumentError(absl::StrCat(what, ": slot ", slot, " is set twice"));
+      return absl::InvalidArgumentError(absl::StrCat(what, "slot: ", slot, " is set twice"));
     }
     if (std::find(change.clear.begin(), change.clear.end(), set.slot) != change.clear.end()) {
       return absl::InvalidArgumentError(
-          absl::StrCat(what, ": slot ", slot, " is both set and cleared"));
+          absl::StrCat(what, "slot: ", slot, " is both set and cleared"));
     }
     overrides[set.slot] = set.joint;
   }
@@ -122,7 +122,7 @@ absl::StatusOr<std::map<HumanoidSlot, std::string>> ChangedOverrides(
     for (const auto& [other, joint] : overrides) {
       if (other != slot && joint == change.set[i].joint) {
         return absl::InvalidArgumentError(
-            absl::StrCat("set[", i, "]: joint '", joint, "' is already the override of slot ",
+            absl::StrCat("set[", i, "].joint: '", joint, "' is already the override of slot ",
                          HumanoidSlotName(other), "; clear that slot or set it to another joint"));
       }
     }

@@ -70,13 +70,13 @@ TEST_F(StorageTest, BadSlotOverridesChangeNothing) {
   // The first set is good: the batch is refused whole.
   refused({.set = {{Slot::kLeftFoot, "Foot_L"}, {Slot::kLeftHand, "hand_l"}}},
           absl::StatusCode::kInvalidArgument,
-          absl::StrCat("set[1]: skeleton ", skeleton_id, " has no joint named 'hand_l'"));
+          absl::StrCat("set[1].joint: skeleton ", skeleton_id, " has no joint named 'hand_l'"));
   refused({.set = {{Slot::kLeftHand, "Hand_L"}, {Slot::kLeftHand, "Hand_R"}}},
-          absl::StatusCode::kInvalidArgument, "set[1]: slot LeftHand is set twice");
+          absl::StatusCode::kInvalidArgument, "set[1].slot: LeftHand is set twice");
   refused({.set = {{Slot::kLeftHand, "Hand_L"}}, .clear = {Slot::kLeftHand}},
-          absl::StatusCode::kInvalidArgument, "set[0]: slot LeftHand is both set and cleared");
+          absl::StatusCode::kInvalidArgument, "set[0].slot: LeftHand is both set and cleared");
   refused({.set = {{Slot::kNeck, "Neck"}}}, absl::StatusCode::kInvalidArgument,
-          "set[0]: joint 'Neck' is already the override of slot Head; clear that slot or set it "
+          "set[0].joint: 'Neck' is already the override of slot Head; clear that slot or set it "
           "to another joint");
   const absl::StatusOr<SkeletonRecord> stopped = Db().UpdateSlotOverrides(
       skeleton_id, {.set = {{Slot::kLeftHand, "Hand_L"}}}, {.should_stop = [] { return true; }});
