@@ -86,5 +86,18 @@ TEST_F(StorageTest, BadSlotOverridesChangeNothing) {
             absl::StatusCode::kNotFound);
 }
 
+TEST_F(StorageTest, ASchemaSixFileGainsTheOverridesTable) {
+  const int64_t clip = Insert(Named("h"), Motion(testing::HumanoidSkeleton(true), 2));
+  const int64_t skeleton_id = Db().GetClipRecord(clip)->skeleton_id;
+  Close();
+  // The file as version 6 left it.
+  ASSERT_TRUE(Raw()->Execute("DROP TABLE skeleton_slot_overrides; PRAGMA user_version = 6").ok());
+  const absl::StatusOr<SkeletonRecord> record = Db().GetSkeleton(skeleton_id);
+  ASSERT_TRUE(record.ok()) << record.status();
+  EXPECT_TRUE(record->slot_overrides.empty());
+  EXPECT_EQ(*Raw()->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
+  EXPECT_TRUE(Db().UpdateSlotOverrides(skeleton_id, {.set = {{Slot::kHead, "Neck"}}}).ok());
+}
+
 }  // namespace
 }  // namespace motiondb::storage
