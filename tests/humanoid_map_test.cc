@@ -404,6 +404,55 @@ TEST(HumanoidMap, EveryFileOfTheCorpusMapsCompletely) {
   }
 }
 
+// The skeleton with every name replaced by jointN: what the hierarchy and rest pose alone give.
+absl::StatusOr<Skeleton> Renamed(const Skeleton& skeleton) {
+  std::vector<Joint> joints = skeleton.joints();
+  for (size_t j = 0; j < joints.size(); ++j) joints[j].name = absl::StrCat("joint", j + 1);
+  return Skeleton::Create(std::move(joints));
+}
+
+TEST(HumanoidMap, RealSkeletonsWithoutNamesMapFromTheirShapeOrSayWhatIsMissing) {
+  MOTIONDB_REQUIRE_MOCAP(mocap);
+  // CMU's two conversions and the Z-up retarget are T-poses facing along their toes: the
+  // shape alone finds every required slot where the names put them.
+  for (const char* file :
+       {"cmu/01_01_3dsmax.bvh", "cmu/01_01_motionbuilder.bvh", "other-skeletons/cmu1006_ROM.bvh"}) {
+    SCOPED_TRACE(file);
+    const absl::StatusOr<BvhReadResult> read = ReadBvhFile((mocap / file).string());
+    ASSERT_TRUE(read.ok()) << read.status();
+    const absl::StatusOr<Skeleton> renamed = Renamed(read->clip.skeleton());
+    ASSERT_TRUE(renamed.ok()) << renamed.status();
+    const absl::StatusOr<HumanoidMap> named = MapHumanoid(read->clip.skeleton());
+    const absl::StatusOr<HumanoidMap> unnamed = MapHumanoid(*renamed);
+    ASSERT_TRUE(named.ok() && unnamed.ok());
+    EXPECT_TRUE(unnamed->complete()) << MissingText(*unnamed);
+    for (const Slot slot : AllHumanoidSlots()) {
+      if (!IsRequiredSlot(slot)) continue;
+      EXPECT_EQ(unnamed->joint(slot), named->joint(slot)) << HumanoidSlotName(slot);
+    }
+  }
+  // Bandai's rest pose lays every bone along its parent's x axis: no left or right to read from
+  // it, so without names its limbs are missing, and said to be.
+  const absl::StatusOr<BvhReadResult> bandai =
+      ReadBvhFile((mocap / "bandai1/dataset-1_bow_active_001.bvh").string());
+  ASSERT_TRUE(bandai.ok()) << bandai.status();
+  const absl::StatusOr<Skeleton> renamed = Renamed(bandai->clip.skeleton());
+  ASSERT_TRUE(renamed.ok()) << renamed.status();
+  const absl::StatusOr<HumanoidMap> map = MapHumanoid(*renamed);
+  ASSERT_TRUE(map.ok()) << map.status();
+  for (const Slot slot : AllHumanoidSlots()) {
+    if (map->joint(slot) >= 0)
+      std::cerr << HumanoidSlotName(slot) << " "
+                << bandai->clip.skeleton().joint(map->joint(slot)).name << "\n";
+  }
+  EXPECT_EQ(MissingText(*map),
+            "LeftUpperArm,LeftLowerArm,LeftHand,RightUpperArm,RightLowerArm,RightHand,"
+            "LeftUpperLeg,LeftLowerLeg,LeftFoot,RightUpperLeg,RightLowerLeg,RightFoot");
+  const std::map<std::string, std::string> torso = {
+      {"Hips", "joint2"}, {"Spine", "joint3"}, {"Neck", "joint5"}, {"Head", "joint6"}};
+  EXPECT_EQ(SlotNames(*renamed, *map), torso);
+}
+
 TEST(HumanoidMap, AssimpBoxingRigMaps) {
   const std::optional<std::filesystem::path> assimp = testing::AssimpBvhDir();
   if (!assimp) GTEST_SKIP() << "assimp-testmodels is not installed; skipped";

@@ -1,6 +1,7 @@
 #include "core/motion/humanoid_map.h"
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -309,16 +310,19 @@ class Mapper {
     return -1;
   }
 
-  // A limb from its root down its chain, by bone lengths: the upper and lower bones are the
-  // longest two in a row, starting at the root or the joint after it (which makes the root a
-  // shoulder, or a hip helper such as CMU's LHipJoint for a leg).
+  // A limb from its root down its chain. The upper bone starts at the joint after the root
+  // (the root then a shoulder, or a hip helper such as CMU's LHipJoint for a leg) when the root
+  // sits where its parent does (CMU's LeftCollar and LHipJoint: a bone's length says nothing
+  // there, CMU's collar bone being longer than its forearm), or when the two bones after the
+  // root are the longer pair; else at the root.
   std::array<int, 4> ShapeChain(int root, bool arm) const {
     std::vector<int> chain;
     for (int j = root; j >= 0 && chain.size() < 6; j = ChainChild(j)) chain.push_back(j);
     const auto bone = [&](size_t i) {
       return i + 1 < chain.size() ? skeleton_.joint(chain[i + 1]).offset.norm() : 0.0;
     };
-    const size_t upper = bone(1) + bone(2) > bone(0) + bone(1) ? 1 : 0;
+    const bool at_parent = skeleton_.joint(root).offset.norm() < 1e-3 * (bone(0) + bone(1));
+    const size_t upper = at_parent || bone(1) + bone(2) > bone(0) + bone(1) ? 1 : 0;
     const auto at = [&](size_t i) { return i < chain.size() ? chain[i] : -1; };
     if (arm) return {upper == 1 ? at(0) : -1, at(upper), at(upper + 1), at(upper + 2)};
     return {at(upper), at(upper + 1), at(upper + 2), at(upper + 3)};
@@ -327,6 +331,7 @@ class Mapper {
   // The two roots among `roots` farthest apart across the body, left first, by the rest
   // positions of their subtrees.
   std::pair<int, int> SplitSides(const std::vector<int>& roots) const {
+    if (!left_) return {-1, -1};
     int left = -1, right = -1;
     double most = 0, least = 0;
     for (const int root : roots) {
@@ -338,32 +343,39 @@ class Mapper {
     return {left, right};
   }
 
-  // How far left of the hips a rest position lies.
+  // How far left of the hips a rest position lies; only with a left direction.
   double Across(const Eigen::Vector3d& position) const {
-    return (position - rest_[Get(Slot::kHips)]).dot(left_);
+    return (position - rest_[Get(Slot::kHips)]).dot(*left_);
   }
 
-  // The body's left direction (see MapHumanoid): up from the hips to the head (or the arms'
-  // branch), forward from each foot to its toe (or end site).
-  void FindLeft(const std::vector<std::array<int, 4>>& legs, int top) {
+  // The body's up and left directions (see MapHumanoid): up from the hips to the head (or the
+  // arms' branch), forward from each foot to its toe (or end site). No left when the feet give
+  // no forward direction across the up one and +X lies along it too: Bandai's rest pose lays
+  // every bone along its parent's x axis, the toes cancelling out, and its sides cannot be read.
+  void FindUpAndLeft(const std::vector<std::array<int, 4>>& legs, int top) {
     const Eigen::Vector3d up =
         top >= 0 ? Eigen::Vector3d(rest_[top] - rest_[Get(Slot::kHips)]) : Eigen::Vector3d::UnitY();
+    up_ = up.norm() > 0 ? up.normalized() : Eigen::Vector3d::UnitY();
     Eigen::Vector3d forward = Eigen::Vector3d::Zero();
+    double feet = 0;
     for (const std::array<int, 4>& leg : legs) {
       if (leg[2] < 0) continue;
       const Joint& foot = skeleton_.joint(leg[2]);
-      if (leg[3] >= 0) {
-        forward += skeleton_.joint(leg[3]).offset;
-      } else if (foot.end_site) {
-        forward += *foot.end_site;
-      }
+      const std::optional<Eigen::Vector3d> toe =
+          leg[3] >= 0 ? std::optional<Eigen::Vector3d>(skeleton_.joint(leg[3]).offset)
+                      : foot.end_site;
+      if (!toe) continue;
+      forward += *toe;
+      feet += toe->norm();
     }
-    const Eigen::Vector3d unit_up = up.norm() > 0 ? up.normalized() : Eigen::Vector3d::UnitY();
-    forward -= forward.dot(unit_up) * unit_up;
-    if (forward.norm() > 1e-9) {
-      left_ = unit_up.cross(forward).normalized();
+    forward -= forward.dot(up_) * up_;
+    const Eigen::Vector3d x_across = Eigen::Vector3d::UnitX() - up_.x() * up_;
+    if (feet > 0 && forward.norm() > 0.1 * feet) {
+      left_ = up_.cross(forward).normalized();
+    } else if (x_across.norm() > 0.5) {
+      left_ = x_across.normalized();
     } else {
-      left_ = Eigen::Vector3d::UnitX() - unit_up.x() * unit_up;
+      left_.reset();
     }
   }
 
@@ -378,7 +390,7 @@ class Mapper {
     std::vector<std::array<int, 4>> legs;
     for (const int root : leg_roots) legs.push_back(ShapeChain(root, /*arm=*/false));
     const int branch = ArmBranch();
-    FindLeft(legs, head_ >= 0 ? head_ : branch);
+    FindUpAndLeft(legs, head_ >= 0 ? head_ : branch);
     const auto [left_leg, right_leg] = SplitSides(leg_roots);
     std::vector<int> arm_roots;
     if (branch >= 0) {
@@ -415,11 +427,14 @@ class Mapper {
     if (Get(Slot::kHead) < 0) {
       int head = head_;
       if (head < 0) {
-        // The end of the chain the arms' branch continues in, past the shoulders.
+        // The end of the chain the arms' branch continues in: its child whose subtree lies
+        // most nearly straight up from it.
         const int branch = ArmBranch();
+        double most_up = -2;
         for (const int child : branch >= 0 ? skeleton_.Children(branch) : std::vector<int>()) {
-          if (owner_[child] || (head >= 0 && height_[child] <= height_[head])) continue;
-          head = child;
+          const Eigen::Vector3d away = rest_sum_[child] / size_[child] - rest_[branch];
+          const double up = away.norm() > 0 ? away.normalized().dot(up_) : -1;
+          if (!owner_[child] && up > most_up) head = child, most_up = up;
         }
         while (head >= 0 && ChainChild(head) >= 0) head = ChainChild(head);
       }
@@ -525,9 +540,10 @@ class Mapper {
   std::vector<Eigen::Vector3d> rest_;      // rest positions: the offsets summed from the root
   std::vector<Eigen::Vector3d> rest_sum_;  // of the subtree's rest positions
   std::vector<std::array<bool, 2>> named_below_;  // a joint named left, right in the subtree
-  Eigen::Vector3d left_ = Eigen::Vector3d::UnitX();
-  int head_ = -1;            // the head, once a name or an override found it
-  std::vector<bool> owner_;  // whether the joint plays a slot
+  Eigen::Vector3d up_ = Eigen::Vector3d::UnitY();
+  std::optional<Eigen::Vector3d> left_;  // none when the rest pose shows no left
+  int head_ = -1;                        // the head, once a name or an override found it
+  std::vector<bool> owner_;              // whether the joint plays a slot
   HumanoidMap map_;
 };
 

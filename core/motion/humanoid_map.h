@@ -97,7 +97,8 @@ struct HumanoidMap {
 // FBX and glTF are. Names are tried first because rest poses are not reliable: Bandai's BVH
 // rest pose lays every bone along its parent's x axis, so its left leg's offset is no more
 // "left" than its right's. Without feet to give the forward direction, +X is taken as left,
-// BVH's habit (Y up, facing +Z, as CMU and Mixamo export).
+// BVH's habit (Y up, facing +Z, as CMU and Mixamo export); when +X lies along the up direction
+// too (Bandai's rest pose, without its names), no side is guessed: the limbs are left missing.
 absl::StatusOr<HumanoidMap> MapHumanoid(const Skeleton& skeleton,
                                         const std::vector<SlotOverride>& overrides = {});
 
