@@ -1,5 +1,6 @@
-// motiondb clips [--tag T ...] | skeletons | clip show ID | clip update ID [--name N] [--tag
-// +T|-T]... | clip delete ID | export ID [--from F --to T] -o OUT
+// motiondb clips [--tag T ...] | skeletons [show ID | map ID --slot S=J... --clear S...] | clip
+// show ID | clip update ID [--name N] [--tag +T|-T]... | clip delete ID | export ID [--from F
+// --to T] -o OUT
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -156,6 +157,106 @@ absl::Status ListSkeletons(bool json, const ServerConnection& connection) {
   return absl::OkStatus();
 }
 
+nlohmann::json SkeletonJson(const v1::SkeletonDetail& detail) {
+  const v1::Skeleton& skeleton = detail.skeleton();
+  nlohmann::json joints = nlohmann::json::array();
+  for (const v1::SkeletonJoint& joint : detail.joints()) {
+    joints.push_back({{"name", joint.name()}, {"parent", joint.parent()}});
+  }
+  const v1::HumanoidMap& map = detail.humanoid_map();
+  nlohmann::json slots = nlohmann::json::array();
+  for (const v1::HumanoidSlot& slot : map.slots()) {
+    slots.push_back({{"slot", slot.slot()},
+                     {"joint", slot.joint_name()},
+                     {"overridden", slot.overridden()},
+                     {"required", slot.required()}});
+  }
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const v1::JointPair& pair : map.mirror_pairs()) {
+    pairs.push_back({{"left", pair.left_name()}, {"right", pair.right_name()}});
+  }
+  return {{"skeleton_id", skeleton.skeleton_id()},
+          {"name", skeleton.name()},
+          {"joint_count", skeleton.joint_count()},
+          {"clip_count", skeleton.clip_count()},
+          {"joints", joints},
+          {"humanoid_map",
+           {{"complete", map.complete()},
+            {"slots", slots},
+            {"missing_slots",
+             std::vector<std::string>(map.missing_slots().begin(), map.missing_slots().end())},
+            {"mirror_pairs", pairs}}}};
+}
+
+// What `skeletons show` and `skeletons map` print: every slot with its joint (or "-"), the
+// overrides marked, what is missing, and the mirror pairs.
+void PrintSkeleton(const v1::SkeletonDetail& detail, bool json) {
+  if (json) {
+    std::cout << SkeletonJson(detail).dump() << "\n";
+    return;
+  }
+  const v1::Skeleton& skeleton = detail.skeleton();
+  const v1::HumanoidMap& map = detail.humanoid_map();
+  absl::PrintF("skeleton %d: %s, %d joints, %d clip%s\n", skeleton.skeleton_id(), skeleton.name(),
+               skeleton.joint_count(), skeleton.clip_count(),
+               skeleton.clip_count() == 1 ? "" : "s");
+  absl::PrintF("humanoid map: %s\n", map.complete()
+                                         ? "complete"
+                                         : absl::StrCat("incomplete, missing ",
+                                                        absl::StrJoin(map.missing_slots(), ", ")));
+  for (const v1::HumanoidSlot& slot : map.slots()) {
+    absl::PrintF("  %-14s %s%s\n", slot.slot(), slot.joint_name(),
+                 slot.overridden() ? "  (override)" : "");
+  }
+  std::vector<std::string> pairs;
+  for (const v1::JointPair& pair : map.mirror_pairs()) {
+    pairs.push_back(absl::StrCat(pair.left_name(), "/", pair.right_name()));
+  }
+  absl::PrintF("mirror pairs (%d): %s\n", map.mirror_pairs_size(),
+               pairs.empty() ? "none" : absl::StrJoin(pairs, ", "));
+}
+
+absl::Status ShowSkeleton(int64_t id, bool json, const ServerConnection& connection) {
+  v1::GetSkeletonRequest request;
+  request.set_skeleton_id(id);
+  MOTIONDB_ASSIGN_OR_RETURN(const v1::SkeletonDetail detail,
+                            CallUnary(connection, &v1::ClipService::Stub::GetSkeleton, request));
+  PrintSkeleton(detail, json);
+  return absl::OkStatus();
+}
+
+struct MapFlags {
+  int64_t id = 0;
+  std::vector<std::string> slots;  // each "SLOT=JOINT"
+  std::vector<std::string> clear;
+};
+
+absl::Status MapSkeleton(const MapFlags& flags, bool json, const ServerConnection& connection) {
+  v1::MapSkeletonRequest request;
+  request.set_skeleton_id(flags.id);
+  FlagNames names;
+  for (const std::string& slot : flags.slots) {
+    const size_t equals = slot.find('=');
+    names.emplace_back(absl::StrCat("set[", request.set_size(), "].slot"),
+                       absl::StrCat("--slot ", slot));
+    names.emplace_back(absl::StrCat("set[", request.set_size(), "].joint"),
+                       absl::StrCat("--slot ", slot));
+    v1::SlotOverride* set = request.add_set();
+    set->set_slot(slot.substr(0, equals));
+    set->set_joint(slot.substr(equals + 1));
+  }
+  for (const std::string& slot : flags.clear) {
+    names.emplace_back(absl::StrCat("clear[", request.clear_size(), "]"),
+                       absl::StrCat("--clear ", slot));
+    request.add_clear(slot);
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const v1::SkeletonDetail detail,
+      CallUnary(connection, &v1::ClipService::Stub::MapSkeleton, request, names));
+  PrintSkeleton(detail, json);
+  return absl::OkStatus();
+}
+
 absl::Status ShowClip(int64_t id, bool json, const ServerConnection& connection) {
   v1::GetClipRequest request;
   request.set_clip_id(id);
@@ -265,6 +366,13 @@ void AddClipId(CLI::App* command, int64_t* id) {
       ->check(WholeAtLeast(1));
 }
 
+// A stored skeleton's id, the positional argument of `skeletons show` and `skeletons map`.
+void AddSkeletonId(CLI::App* command, int64_t* id) {
+  command->add_option("ID", *id, "the skeleton's id (see 'motiondb skeletons')")
+      ->required()
+      ->check(WholeAtLeast(1));
+}
+
 }  // namespace
 
 void AddClipCommands(Commands& commands) {
@@ -290,11 +398,48 @@ void AddClipCommands(Commands& commands) {
       "With --limit or --page-token, one page is listed and the next page's token, when there\n"
       "is one, printed: on stderr, or as next_page_token with --json.");
 
-  commands.AddServer(commands.root(), "skeletons",
-                     "list the skeletons: joint hierarchies that clips and spaces share",
-                     [&global](const ServerConnection& connection) {
-                       return ListSkeletons(global.json, connection);
-                     });
+  CLI::App* skeletons = commands.AddServer(
+      commands.root(), "skeletons",
+      "list the skeletons: joint hierarchies that clips and spaces share; show or map one",
+      [&global](const ServerConnection& connection) {
+        return ListSkeletons(global.json, connection);
+      });
+  skeletons->require_subcommand(0, 1);
+  auto skeleton_id = std::make_shared<int64_t>(0);
+  AddSkeletonId(commands.AddServer(skeletons, "show",
+                                   "a skeleton's joints, humanoid map and left/right pairs",
+                                   [skeleton_id, &global](const ServerConnection& connection) {
+                                     return ShowSkeleton(*skeleton_id, global.json, connection);
+                                   }),
+                skeleton_id.get());
+  auto map = std::make_shared<MapFlags>();
+  CLI::App* mapper = commands.AddServer(
+      skeletons, "map", "give slots of a skeleton's humanoid map their joints by hand",
+      [map, &global](const ServerConnection& connection) {
+        return MapSkeleton(*map, global.json, connection);
+      });
+  AddSkeletonId(mapper, &map->id);
+  mapper
+      ->add_option("--slot", map->slots,
+                   "SLOT=JOINT: the slot (LeftHand, Hips, ...) is played by the joint of that "
+                   "name; repeat for more")
+      ->type_name("SLOT=JOINT")
+      ->allow_extra_args(false)
+      ->check(CLI::Validator(
+          [](const std::string& slot) -> std::string {
+            if (slot.find('=') != std::string::npos) return "";
+            return "'" + slot + "' is not SLOT=JOINT";
+          },
+          ""));
+  mapper
+      ->add_option("--clear", map->clear,
+                   "hand the slot back to the automatic map; repeat for more")
+      ->type_name("SLOT")
+      ->allow_extra_args(false);
+  mapper->footer(
+      "Slots: Hips, Spine, Chest, Neck, Head, and Left... and Right... Shoulder, UpperArm,\n"
+      "LowerArm, Hand, UpperLeg, LowerLeg, Foot, Toes. The overrides are stored; the automatic\n"
+      "map fills the other slots around them.");
 
   CLI::App* clip =
       commands.AddGroup(commands.root(), "clip", "one stored clip: show, update, delete");

@@ -179,33 +179,6 @@ absl::StatusOr<std::unique_ptr<Database>> Database::Open(const std::string& path
       new Database(std::make_unique<Impl>(path, options.busy_timeout_ms, std::move(writer))));
 }
 
-absl::StatusOr<std::vector<SkeletonSummary>> Database::ListSkeletons() {
-  std::vector<SkeletonSummary> skeletons;
-  MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {
-    // Both subqueries walk the clips_by_skeleton index: no scan of the clips.
-    MOTIONDB_ASSIGN_OR_RETURN(
-        SqliteStatement query,
-        db.Prepare("SELECT s.skeleton_id, s.joint_count, s.joint_names, "
-                   "(SELECT count(*) FROM clips c WHERE c.skeleton_id = s.skeleton_id), "
-                   "(SELECT c.name FROM clips c WHERE c.skeleton_id = s.skeleton_id "
-                   "ORDER BY c.clip_id LIMIT 1) "
-                   "FROM skeletons s ORDER BY s.skeleton_id"));
-    while (true) {
-      MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
-      if (!row) return absl::OkStatus();
-      SkeletonSummary& skeleton = skeletons.emplace_back();
-      skeleton.skeleton_id = query.ColumnInt64(0);
-      skeleton.joint_count = static_cast<int>(query.ColumnInt64(1));
-      // joint_names holds one name a line, the root's first.
-      const std::string names = query.ColumnText(2);
-      skeleton.root_joint = names.substr(0, names.find('\n'));
-      skeleton.clip_count = query.ColumnInt64(3);
-      skeleton.first_clip_name = query.ColumnText(4);  // NULL reads as ""
-    }
-  }));
-  return skeletons;
-}
-
 absl::StatusOr<Counts> Database::GetCounts() {
   Counts counts;
   MOTIONDB_RETURN_IF_ERROR(impl_->Read([&](SqliteConnection& db) -> absl::Status {

@@ -1,6 +1,7 @@
 // motiondb's embedded storage: one SQLite file (WAL, foreign keys, schema migrations by
-// PRAGMA user_version) holding skeletons, clips (frames as float32 blobs), Motion Curve spaces
-// (serialised), each clip's cached projection per space, and labels.
+// PRAGMA user_version) holding skeletons (and their humanoid slot overrides), clips (frames as
+// float32 blobs), Motion Curve spaces (serialised), each clip's cached projection per space, and
+// labels.
 //
 // Every multi-row write is one transaction: a crash at any point loses no acknowledged write
 // and leaves no half-written clip or space. Every write takes WriteOptions, whose should_stop
@@ -30,6 +31,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
+#include "core/motion/humanoid_map.h"
 #include "core/motion/matrix.h"
 #include "core/space/motion_space.h"
 #include "storage/job_record.h"
@@ -162,6 +164,22 @@ struct SkeletonSummary {
   std::string root_joint;  // the first joint's name (a BVH file's ROOT)
   int64_t clip_count = 0;
   std::string first_clip_name;  // of its lowest clip id; empty when it has none
+};
+
+// A skeleton, its joints and the slots of its humanoid map (core/motion/humanoid_map.h) given
+// their joints by hand.
+struct SkeletonRecord {
+  SkeletonSummary summary;
+  // The joints with the offsets and channels of the skeleton's first clip (offsets differ
+  // between actors of one skeleton); names and parents alone, offsets zero, when it has no clip.
+  std::shared_ptr<const Skeleton> skeleton;
+  std::vector<SlotOverride> slot_overrides;  // in slot order
+};
+
+// What UpdateSlotOverrides changes; slots neither set nor cleared keep their override.
+struct SlotOverrideChange {
+  std::vector<SlotOverride> set{};
+  std::vector<HumanoidSlot> clear{};
 };
 
 struct Counts {
@@ -318,6 +336,15 @@ class Database {
 
   // Every skeleton, in id order, with its clip count and first clip, in one query.
   absl::StatusOr<std::vector<SkeletonSummary>> ListSkeletons();
+  // The skeleton and its stored slot overrides. NOT_FOUND for an unknown skeleton.
+  absl::StatusOr<SkeletonRecord> GetSkeleton(int64_t skeleton_id);
+  // Sets and clears a skeleton's slot overrides in one transaction and returns the skeleton as
+  // updated. NOT_FOUND for an unknown skeleton; INVALID_ARGUMENT naming `set[i].joint` for a
+  // joint the skeleton lacks or that another override (stored, or set here) gives to another
+  // slot, `set[i].slot` for a slot set twice or both set and cleared. Nothing changes on error.
+  absl::StatusOr<SkeletonRecord> UpdateSlotOverrides(int64_t skeleton_id,
+                                                     const SlotOverrideChange& change,
+                                                     const WriteOptions& write = {});
 
   absl::StatusOr<Counts> GetCounts();
 

@@ -227,6 +227,17 @@ DROP INDEX labels_by_clip;
 CREATE INDEX labels_by_clip ON labels (clip_id, first_frame, last_frame, descriptor, value);
 )sql";
 
+// The humanoid map (issue 40): a slot of a skeleton's map (core/motion/humanoid_map.h, by
+// HumanoidSlotName) given its joint by hand, by the joint's name, over the automatic map.
+constexpr const char* kMigration7 = R"sql(
+CREATE TABLE skeleton_slot_overrides (
+  skeleton_id INTEGER NOT NULL REFERENCES skeletons (skeleton_id) ON DELETE CASCADE,
+  slot TEXT NOT NULL CHECK (length(slot) > 0),
+  joint_name TEXT NOT NULL CHECK (length(joint_name) > 0),
+  PRIMARY KEY (skeleton_id, slot)
+) WITHOUT ROWID;
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -277,6 +288,7 @@ constexpr std::array kMigrations = {
     Migration{kMigration4},
     Migration{kMigration5, CopyRotationsLast, kMigration5Finish},
     Migration{kMigration6},
+    Migration{kMigration7},
 };
 // clang-format on
 

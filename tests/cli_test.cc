@@ -595,6 +595,59 @@ TEST_F(CliServerTest, ClipsShowTheSkeletonAndPageFilterAndSort) {
   EXPECT_THAT(r.err, HasSubstr("INVALID_ARGUMENT"));
 }
 
+TEST_F(CliServerTest, SkeletonsShowAndMapTheHumanoidMap) {
+  testing::CommandResult r = Remote({"skeletons", "show", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("skeleton 1: Hips (walk54), 19 joints, 1 clip\n"
+                               "humanoid map: complete\n  Hips           Hips\n"));
+  EXPECT_THAT(r.out, HasSubstr("  LeftHand       Hand_L\n"));
+  EXPECT_THAT(r.out, HasSubstr("mirror pairs (7): Shoulder_L/Shoulder_R, UpperArm_L/UpperArm_R"));
+
+  r = Remote({"skeletons", "map", "1", "--slot", "LeftHand=Hand_R", "--slot", "RightHand=Hand_L"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("  LeftHand       Hand_R  (override)\n"));
+  EXPECT_THAT(r.out, HasSubstr("  LeftLowerArm   LowerArm_R\n"));
+
+  // Bad overrides are told in the command line's words and change nothing.
+  r = Remote({"skeletons", "map", "1", "--slot", "LeftHand=hand_l"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--slot LeftHand=hand_l: skeleton 1 has no joint named 'hand_l'"));
+  r = Remote({"skeletons", "map", "1", "--clear", "Tail"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("--clear Tail: 'Tail' is not a slot (Hips, Spine,"));
+  r = Remote({"skeletons", "map", "1", "--slot", "LeftHand"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("'LeftHand' is not SLOT=JOINT"));
+  r = Remote({"skeletons", "show", "1", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json shown = nlohmann::json::parse(r.out);
+  EXPECT_EQ(shown["joint_count"], 19);
+  EXPECT_EQ(shown["joints"][1], (nlohmann::json{{"name", "Spine"}, {"parent", 0}}));
+  const nlohmann::json& map = shown["humanoid_map"];
+  EXPECT_EQ(map["complete"], true);
+  EXPECT_TRUE(map["missing_slots"].empty());
+  // The arms' sides follow the swapped hands, and so do their pairs.
+  EXPECT_EQ(map["mirror_pairs"][0],
+            (nlohmann::json{{"left", "Shoulder_R"}, {"right", "Shoulder_L"}}));
+  EXPECT_THAT(
+      map["slots"].dump(),
+      HasSubstr(R"({"joint":"Hand_R","overridden":true,"required":true,"slot":"LeftHand"})"));
+
+  r = Remote({"skeletons", "map", "1", "--clear", "LeftHand", "--clear", "RightHand"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, Not(HasSubstr("(override)")));
+
+  // A skeleton that is no humanoid: shown, with what it misses.
+  ASSERT_EQ(Remote({"ingest", walk_}).exit_code, 0);
+  r = Remote({"skeletons", "show", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out,
+              HasSubstr("humanoid map: incomplete, missing Hips, Spine, Head, LeftUpperArm"));
+  r = Remote({"skeletons", "show", "9"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("skeleton 9 not found"));
+}
+
 TEST_F(CliServerTest, SkeletonsListAndSpaceCreateWithSeveralSaysWhichToGive) {
   testing::CommandResult r = Remote({"skeletons"});
   ASSERT_EQ(r.exit_code, 0) << r.err;

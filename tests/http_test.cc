@@ -313,6 +313,9 @@ TEST_F(HttpTest, ReadRoutesAnswerAsGrpc) {
   EXPECT_TRUE(
       SameMessage(Get200(http, "/v1/skeletons"),
                   GrpcAnswer(*clips, &ClipStub::ListSkeletons, v1::ListSkeletonsRequest())));
+  EXPECT_TRUE(SameMessage(Get200(http, "/v1/skeletons/" + skeleton),
+                          GrpcAnswer(*clips, &ClipStub::GetSkeleton,
+                                     Parse<v1::GetSkeletonRequest>("skeleton_id: " + skeleton))));
   EXPECT_TRUE(SameMessage(
       Get200(http, "/v1/spaces"),
       GrpcAnswer(*spaces, &v1::SpaceService::Stub::ListSpaces, v1::ListSpacesRequest())));
@@ -480,6 +483,26 @@ TEST_F(HttpTest, WritesGoThroughTheSameServices) {
       SameMessage(Get200(http, "/v1/jobs"),
                   GrpcAnswer(*jobs, &v1::JobService::Stub::ListJobs, v1::ListJobsRequest())));
 
+  // A skeleton's head given by hand, as GetSkeleton then shows it; a bad override is refused
+  // and changes nothing.
+  const std::string skeleton = absl::StrCat(stored.skeleton_id());
+  const std::string map_path = "/v1/skeletons/" + skeleton + ":map";
+  const auto mapped = FromJson<v1::SkeletonDetail>(
+      Post200(http, map_path, R"({"set":[{"slot":"Head","joint":"Neck"}],"clear":["Neck"]})"));
+  const auto shown = [&] {
+    return GrpcAnswer(*clips, &v1::ClipService::Stub::GetSkeleton,
+                      Parse<v1::GetSkeletonRequest>("skeleton_id: " + skeleton));
+  };
+  EXPECT_TRUE(SameMessage(mapped, shown()));
+  EXPECT_THAT(mapped.humanoid_map().DebugString(),
+              HasSubstr("slot: \"Head\"\n  joint: 3\n  joint_name: \"Neck\"\n  overridden: true"));
+  const httplib::Result refused = http.Post(
+      map_path.c_str(), R"({"set":[{"slot":"LeftHand","joint":"hand_l"}]})", "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_THAT(ErrorOf(refused).message, HasSubstr("set[0].joint: skeleton " + skeleton));
+  EXPECT_TRUE(SameMessage(mapped, shown()));
+
   // A delete, after which gRPC finds no clip.
   const httplib::Result deleted =
       http.Delete(absl::StrCat("/v1/clips/", ingested.clip().clip_id()).c_str());
@@ -514,6 +537,7 @@ TEST_F(HttpTest, ErrorsAreMappedAsGrpcGatewayMapsThemWithCodeAndMessage) {
   };
   // NOT_FOUND, with the message gRPC gives.
   expect_error(http.Get("/v1/clips/999"), 404, 5, "clip 999 not found");
+  expect_error(http.Get("/v1/skeletons/999"), 404, 5, "skeleton 999 not found");
   expect_error(http.Get("/v1/spaces/nowhere"), 404, 5, "nowhere");
   // INVALID_ARGUMENT: a parameter of the wrong type, an unknown one, a value the service
   // refuses, malformed JSON, an unknown JSON field, a path value that is no number.

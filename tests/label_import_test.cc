@@ -179,13 +179,14 @@ TEST(LabelStorage, MigrationSixIndexesWhatIdentifiesALabel) {
     ASSERT_TRUE((*db)->AddLabels({label}).ok());
   }
   {
-    // The file as version 5 left it.
+    // The file as version 5 left it: migration 6's index as it was, migration 7's table gone.
     auto raw =
         storage::SqliteConnection::Open(path, storage::SqliteConnection::Mode::kReadWrite, 1000);
     ASSERT_TRUE(raw.ok()) << raw.status();
     ASSERT_TRUE((*raw)
                     ->Execute("DROP INDEX labels_by_clip; CREATE INDEX labels_by_clip ON labels "
-                              "(clip_id, first_frame); PRAGMA user_version = 5")
+                              "(clip_id, first_frame); DROP TABLE skeleton_slot_overrides; "
+                              "PRAGMA user_version = 5")
                     .ok());
   }
   absl::StatusOr<std::unique_ptr<storage::Database>> db = storage::Database::Open(path);

@@ -2,6 +2,10 @@
 // ingest, listing, poses and export, streamed uploads; clip names that fit a studio's folders.
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <google/protobuf/text_format.h>
@@ -12,6 +16,7 @@
 #include "core/motion/forward_kinematics.h"
 #include "testing/server_process.h"
 #include "tests/server_fixture.h"
+#include "tests/synthetic_motion.h"
 #include "tests/test_data.h"
 #include "util/byte_coding.h"
 
@@ -521,6 +526,90 @@ TEST_F(ServerTest, ClipNamesConflictsHashesAndUpdates) {
   export_request.mutable_clip()->set_last_frame(19);
   ASSERT_TRUE(client.clips().ExportClip(client.Context().get(), export_request, &exported).ok());
   EXPECT_EQ(exported.file_name(), "session1_take_001_10-19.bvh");
+}
+
+TEST_F(ServerTest, SkeletonsShowTheirHumanoidMapAndTakeOverrides) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  v1::IngestClipResponse humanoid, chain;
+  ASSERT_TRUE(client
+                  .Ingest("humanoid.bvh",
+                          BvhText(testing::SyntheticClip(testing::HumanoidSkeleton(false),
+                                                         {.frames = 30, .fps = 30, .seed = 1})),
+                          &humanoid)
+                  .ok());
+  ASSERT_TRUE(client.Ingest("chain.bvh", BvhText(ChainClip()), &chain).ok());
+  const auto get = [&](int64_t skeleton_id, v1::SkeletonDetail* detail) {
+    v1::GetSkeletonRequest request;
+    request.set_skeleton_id(skeleton_id);
+    return client.clips().GetSkeleton(client.Context().get(), request, detail);
+  };
+  const auto slots = [](const v1::SkeletonDetail& detail) {
+    std::map<std::string, std::string> named;
+    for (const v1::HumanoidSlot& slot : detail.humanoid_map().slots()) {
+      named[slot.slot()] = slot.joint_name() + (slot.overridden() ? " (override)" : "");
+    }
+    return named;
+  };
+
+  v1::SkeletonDetail shown;
+  ASSERT_TRUE(get(humanoid.clip().skeleton_id(), &shown).ok());
+  EXPECT_EQ(shown.joints_size(), 19);
+  EXPECT_EQ(shown.joints(2).name(), "Chest");
+  EXPECT_EQ(shown.joints(2).parent(), 1);
+  EXPECT_TRUE(shown.humanoid_map().complete());
+  EXPECT_EQ(shown.humanoid_map().slots_size(), 19);  // every joint: no toes, the rest a slot
+  EXPECT_EQ(slots(shown)["LeftLowerArm"], "LowerArm_L");
+  EXPECT_EQ(shown.humanoid_map().mirror_pairs_size(), 7);
+  EXPECT_EQ(shown.humanoid_map().mirror_pairs(0).left_name(), "Shoulder_L");
+  EXPECT_EQ(shown.humanoid_map().mirror_pairs(0).right_name(), "Shoulder_R");
+
+  // A skeleton that is no humanoid says what it misses; that is no error.
+  v1::SkeletonDetail unmapped;
+  ASSERT_TRUE(get(chain.clip().skeleton_id(), &unmapped).ok());
+  EXPECT_FALSE(unmapped.humanoid_map().complete());
+  EXPECT_EQ(unmapped.humanoid_map().missing_slots_size(), 15);
+  EXPECT_EQ(unmapped.humanoid_map().missing_slots(0), "Hips");
+
+  const auto map = [&](const std::string& text, v1::SkeletonDetail* detail) {
+    v1::MapSkeletonRequest request;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &request));
+    request.set_skeleton_id(humanoid.clip().skeleton_id());
+    return client.clips().MapSkeleton(client.Context().get(), request, detail);
+  };
+  v1::SkeletonDetail mapped;
+  ASSERT_TRUE(map("set { slot: 'LeftHand' joint: 'Hand_R' } set { slot: 'righthand' joint: "
+                  "'Hand_L' }",
+                  &mapped)
+                  .ok());
+  EXPECT_EQ(slots(mapped)["LeftHand"], "Hand_R (override)");
+  EXPECT_EQ(slots(mapped)["RightHand"], "Hand_L (override)");
+  EXPECT_EQ(slots(mapped)["LeftLowerArm"], "LowerArm_R");  // the chain follows its hand
+
+  // Bad overrides are refused naming the field, and change nothing.
+  for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
+           {"set { slot: 'LeftHand' joint: 'hand_l' }",
+            absl::StrCat("set[0].joint: skeleton ", humanoid.clip().skeleton_id(),
+                         " has no joint named 'hand_l'")},
+           {"set { slot: 'Tail' joint: 'Hips' }", "set[0].slot: 'Tail' is not a slot (Hips, "},
+           {"clear: 'Head' clear: 'Wing'", "clear[1]: 'Wing' is not a slot"},
+           {"set { slot: 'Head' joint: 'Hand_L' }",
+            "set[0].joint: 'Hand_L' is already the override of slot RightHand"}}) {
+    v1::SkeletonDetail refused;
+    const grpc::Status status = map(text, &refused);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << text;
+    EXPECT_THAT(status.error_message(), HasSubstr(message));
+    v1::SkeletonDetail after;
+    ASSERT_TRUE(get(humanoid.clip().skeleton_id(), &after).ok());
+    EXPECT_EQ(after.SerializeAsString(), mapped.SerializeAsString()) << text;
+  }
+
+  v1::SkeletonDetail cleared;
+  ASSERT_TRUE(map("clear: 'LeftHand' clear: 'RightHand'", &cleared).ok());
+  EXPECT_EQ(cleared.SerializeAsString(), shown.SerializeAsString());
+  v1::SkeletonDetail missing;
+  EXPECT_EQ(get(999, &missing).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <string>
 #include <utility>
 
+#include "absl/strings/str_join.h"
 #include "server/edit/provenance.h"
 #include "server/grpc/internal/field_conversion.h"
 #include "util/byte_coding.h"
@@ -48,6 +49,17 @@ absl::StatusOr<IngestRequest> IngestRequestOf(const Message& message) {
   request.tags.assign(message.tags().begin(), message.tags().end());
   MOTIONDB_ASSIGN_OR_RETURN(request.on_conflict, FromProto(message.on_conflict()));
   return request;
+}
+
+// INVALID_ARGUMENT "FIELD: 'Tail' is not a slot (Hips, Spine, ...)".
+absl::StatusOr<HumanoidSlot> SlotFromProto(const std::string& field, const std::string& name) {
+  const std::optional<HumanoidSlot> slot = ParseHumanoidSlot(name);
+  if (slot) return *slot;
+  std::vector<std::string> names;
+  for (const HumanoidSlot known : AllHumanoidSlots()) names.emplace_back(HumanoidSlotName(known));
+  return absl::InvalidArgumentError(absl::StrCat(field, ": '", ValidUtf8(name.substr(0, 128)),
+                                                 "' is not a slot (", absl::StrJoin(names, ", "),
+                                                 ")"));
 }
 
 void ToProto(const storage::SkeletonSummary& summary, v1::Skeleton* skeleton) {
@@ -161,6 +173,55 @@ void ToProto(const ClipPoses& poses, v1::ClipPoses* response) {
 void ToProto(const storage::ClipLayout& layout, v1::Clip* clip) {
   ToProto(layout.record, clip);
   for (const Joint& joint : layout.skeleton->joints()) clip->add_joint_names(ValidUtf8(joint.name));
+}
+
+absl::StatusOr<storage::SlotOverrideChange> FromProto(const v1::MapSkeletonRequest& request) {
+  storage::SlotOverrideChange change;
+  for (int i = 0; i < request.set_size(); ++i) {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const HumanoidSlot slot,
+        SlotFromProto(absl::StrCat("set[", i, "].slot"), request.set(i).slot()));
+    change.set.push_back({slot, request.set(i).joint()});
+  }
+  for (int i = 0; i < request.clear_size(); ++i) {
+    MOTIONDB_ASSIGN_OR_RETURN(const HumanoidSlot slot,
+                              SlotFromProto(absl::StrCat("clear[", i, "]"), request.clear(i)));
+    change.clear.push_back(slot);
+  }
+  return change;
+}
+
+void ToProto(const SkeletonMapView& view, v1::SkeletonDetail* detail) {
+  ToProto(view.record.summary, detail->mutable_skeleton());
+  const Skeleton& skeleton = *view.record.skeleton;
+  const auto name = [&](int joint) { return ValidUtf8(skeleton.joint(joint).name); };
+  for (int j = 0; j < skeleton.joint_count(); ++j) {
+    v1::SkeletonJoint* joint = detail->add_joints();
+    joint->set_name(name(j));
+    joint->set_parent(skeleton.joint(j).parent);
+  }
+  v1::HumanoidMap* map = detail->mutable_humanoid_map();
+  for (const HumanoidSlot slot : AllHumanoidSlots()) {
+    const int joint = view.map.joint(slot);
+    if (joint < 0) continue;
+    v1::HumanoidSlot* shown = map->add_slots();
+    shown->set_slot(std::string(HumanoidSlotName(slot)));
+    shown->set_joint(joint);
+    shown->set_joint_name(name(joint));
+    shown->set_overridden(view.overridden[static_cast<int>(slot)]);
+    shown->set_required(IsRequiredSlot(slot));
+  }
+  for (const HumanoidSlot slot : view.map.missing) {
+    map->add_missing_slots(std::string(HumanoidSlotName(slot)));
+  }
+  map->set_complete(view.map.complete());
+  for (const auto& [left, right] : view.map.mirror_pairs) {
+    v1::JointPair* pair = map->add_mirror_pairs();
+    pair->set_left(left);
+    pair->set_right(right);
+    pair->set_left_name(name(left));
+    pair->set_right_name(name(right));
+  }
 }
 
 void ToProto(const std::vector<storage::SkeletonSummary>& skeletons,

@@ -15,6 +15,7 @@
 #include "server/clip_ingest.h"
 #include "server/clip_poses.h"
 #include "server/listing.h"
+#include "server/skeleton_map.h"
 #include "storage/database.h"
 
 namespace motiondb::server {
@@ -26,6 +27,8 @@ absl::StatusOr<IngestRequest> FromProto(const v1::IngestClipStreamRequest& first
 storage::ClipUpdate FromProto(const v1::UpdateClipRequest& request);
 ClipListRequest FromProto(const v1::ListClipsRequest& request);
 PosesRequest FromProto(const v1::GetClipPosesRequest& request);
+// INVALID_ARGUMENT naming `set[i].slot` or `clear[i]` for a name that is not a slot's.
+absl::StatusOr<storage::SlotOverrideChange> FromProto(const v1::MapSkeletonRequest& request);
 
 void ToProto(const storage::ClipRecord& record, v1::Clip* clip);
 // The record and the skeleton's joint names.
@@ -35,6 +38,7 @@ void ToProto(const storage::ClipPage& page, v1::ListClipsResponse* response);
 void ToProto(const ClipPoses& poses, v1::ClipPoses* response);
 void ToProto(const std::vector<storage::SkeletonSummary>& skeletons,
              v1::ListSkeletonsResponse* response);
+void ToProto(const SkeletonMapView& view, v1::SkeletonDetail* detail);
 void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
 // The BVH text is moved into the message (1-2 MB for 10 s at 120 fps: a copy cost 0.8 ms).
 void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response);

@@ -13,6 +13,7 @@
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
 #include "server/listing.h"
+#include "server/skeleton_map.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -104,6 +105,30 @@ grpc::Status ClipServiceImpl::ListSkeletons(grpc::ServerContext* context,
     MOTIONDB_ASSIGN_OR_RETURN(const std::vector<storage::SkeletonSummary> skeletons,
                               database_.ListSkeletons());
     ToProto(skeletons, response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::Status ClipServiceImpl::GetSkeleton(grpc::ServerContext* context,
+                                          const v1::GetSkeletonRequest* request,
+                                          v1::SkeletonDetail* response) {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const SkeletonMapView view,
+                              ShowSkeleton(database_, request->skeleton_id(), answers_));
+    ToProto(view, response);
+    return absl::OkStatus();
+  });
+}
+
+grpc::Status ClipServiceImpl::MapSkeleton(grpc::ServerContext* context,
+                                          const v1::MapSkeletonRequest* request,
+                                          v1::SkeletonDetail* response) {
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::SlotOverrideChange change, FromProto(*request));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const SkeletonMapView view,
+        server::MapSkeleton(database_, request->skeleton_id(), change, answers_, should_stop));
+    ToProto(view, response);
     return absl::OkStatus();
   });
 }

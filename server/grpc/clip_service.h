@@ -1,4 +1,5 @@
-// motiondb.v1.ClipService: ingest, list, get, update, delete and export clips, and their poses.
+// motiondb.v1.ClipService: ingest, list, get, update, delete and export clips, and their poses;
+// list, show and map skeletons.
 #ifndef MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_CLIP_SERVICE_H_
 
@@ -58,6 +59,10 @@ class ClipServiceImpl final : public v1::ClipService::Service {
                             v1::ClipPoses* response) override;
   grpc::Status ListSkeletons(grpc::ServerContext* context, const v1::ListSkeletonsRequest* request,
                              v1::ListSkeletonsResponse* response) override;
+  grpc::Status GetSkeleton(grpc::ServerContext* context, const v1::GetSkeletonRequest* request,
+                           v1::SkeletonDetail* response) override;
+  grpc::Status MapSkeleton(grpc::ServerContext* context, const v1::MapSkeletonRequest* request,
+                           v1::SkeletonDetail* response) override;
 
  private:
   // An IngestClipStream's file as it arrived, with its share of the upload budget.

@@ -19,6 +19,8 @@ const absl::flat_hash_map<absl::string_view, TokenScope>& Table() {
       {"/motiondb.v1.ClipService/ExportClipStream", S::kRead},
       {"/motiondb.v1.ClipService/GetClipPoses", S::kRead},
       {"/motiondb.v1.ClipService/ListSkeletons", S::kRead},
+      {"/motiondb.v1.ClipService/GetSkeleton", S::kRead},
+      {"/motiondb.v1.ClipService/MapSkeleton", S::kWrite},
       {"/motiondb.v1.EditService/Reconstruct", S::kWrite},
       {"/motiondb.v1.EditService/Interpolate", S::kWrite},
       {"/motiondb.v1.EditService/Blend", S::kWrite},

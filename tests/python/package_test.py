@@ -119,6 +119,30 @@ class PackageTest(unittest.TestCase):
         by_file = client.search("arms", bvh=arm_raise_bvh(85, 0.9).encode(), max_results=3)
         self.assertEqual(len(by_file), 3)
 
+    def test_1b_skeletons_and_their_humanoid_maps(self):
+        client = self.client
+        skeleton = client.clip("raise_0").skeleton_id  # Hips, Shoulder, Elbow
+        self.assertIn(skeleton, [s.skeleton_id for s in client.skeletons()])
+        shown = client.skeleton(skeleton)
+        self.assertEqual([j.name for j in shown.joints], ["Hips", "Shoulder", "Elbow"])
+        self.assertFalse(shown.humanoid_map.complete)  # said, not an error
+        self.assertIn("LeftUpperArm", shown.humanoid_map.missing_slots)
+        mapped = client.map_skeleton(skeleton, {"LeftUpperArm": "Shoulder", "leftlowerarm": "Elbow"})
+        self.assertEqual({s.slot: (s.joint_name, s.overridden) for s in mapped.humanoid_map.slots},
+                         {"Hips": ("Hips", False), "LeftUpperArm": ("Shoulder", True),
+                          "LeftLowerArm": ("Elbow", True)})
+        with self.assertRaises(motiondb.Error) as raised:
+            client.map_skeleton(skeleton, {"LeftHand": "no_such_joint"})
+        self.assertEqual(raised.exception.code, "INVALID_ARGUMENT")
+        self.assertIn("no_such_joint", raised.exception.message)
+        self.assertEqual(client.skeleton(skeleton).humanoid_map, mapped.humanoid_map)
+        cleared = client.map_skeleton(skeleton, clear=["LeftUpperArm", "LeftLowerArm"])
+        self.assertEqual(cleared.humanoid_map, shown.humanoid_map)
+        if pathlib.Path("/usr/share/assimp/models/BVH/01_01.bvh").exists():
+            cmu = client.skeleton(client.clip("01_01").skeleton_id).humanoid_map
+            self.assertTrue(cmu.complete)
+            self.assertIn(("LeftUpperLeg", "LeftUpLeg"), [(s.slot, s.joint_name) for s in cmu.slots])
+
     def test_2_errors(self):
         with self.assertRaises(motiondb.Error) as raised:
             self.client.search("no-such-space", clip=1)

@@ -7,6 +7,7 @@
     for result in client.search("body", clip=clip.clip_id, max_results=5):
         print(result.clip_name, result.start_s, result.end_s, result.score)
     client.add_labels([(clip.clip_id, 10, 40, "step", 1.0)])
+    print(client.skeleton(clip.skeleton_id).humanoid_map.missing_slots)  # [] when mapped
     job = client.start_propagation("body", ["step"], max_results=5)
     for update in client.watch(job.job_id):
         print(update.done, "/", update.total)
@@ -21,9 +22,11 @@ motiondb.v1.*_pb2.
 # folder and the build's build/python (generated stubs only) both on PYTHONPATH make one package.
 __path__ = __import__("pkgutil").extend_path(__path__, __name__)
 
-from motiondb.client import (Clip, Client, Error, Job, Label, SearchResult, Space, connect,
-                             decode_curve, job_finished, job_state_name)
+from motiondb.client import (Clip, Client, Error, Job, Label, SearchResult, Skeleton,
+                             SkeletonDetail, Space, connect, decode_curve, job_finished,
+                             job_state_name)
 
-__all__ = ["Clip", "Client", "Error", "Job", "Label", "SearchResult", "Space", "connect",
-           "decode_curve", "job_finished", "job_state_name"]
+__all__ = ["Clip", "Client", "Error", "Job", "Label", "SearchResult", "Skeleton",
+           "SkeletonDetail", "Space", "connect", "decode_curve", "job_finished",
+           "job_state_name"]
 __version__ = "0.1.0"

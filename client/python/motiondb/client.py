@@ -27,6 +27,8 @@ Space = space_service_pb2.Space
 SearchResult = search_service_pb2.SearchResult
 Label = label_service_pb2.Label
 Job = job_service_pb2.Job
+Skeleton = clip_service_pb2.Skeleton
+SkeletonDetail = clip_service_pb2.SkeletonDetail
 
 ClipRef = Union[int, str]  # a clip's id, or its name
 PathOrBytes = Union[str, os.PathLike, bytes]
@@ -217,6 +219,32 @@ class Client:
         finally:
             partial.unlink(missing_ok=True)
         return header
+
+    # -- skeletons -----------------------------------------------------------------------------
+    @_rpc
+    def skeletons(self) -> List[Skeleton]:
+        """Every skeleton (the joint hierarchy clips and spaces share), in id order."""
+        return list(self._call(self._clips.ListSkeletons,
+                               clip_service_pb2.ListSkeletonsRequest()).skeletons)
+
+    @_rpc
+    def skeleton(self, skeleton_id: int) -> SkeletonDetail:
+        """A skeleton's joints and its humanoid map: .humanoid_map.slots (each .slot, .joint_name,
+        .overridden), .missing_slots (empty when .complete) and .mirror_pairs."""
+        return self._call(self._clips.GetSkeleton,
+                          clip_service_pb2.GetSkeletonRequest(skeleton_id=skeleton_id))
+
+    @_rpc
+    def map_skeleton(self, skeleton_id: int, slots: Optional[Dict[str, str]] = None,
+                     clear: Iterable[str] = ()) -> SkeletonDetail:
+        """Gives slots of a skeleton's humanoid map their joints by hand ({"LeftHand": "hand_l"}),
+        or hands slots back to the automatic map (clear), stored; returns the skeleton as
+        skeleton() does. A bad slot or joint raises Error (INVALID_ARGUMENT) and changes
+        nothing."""
+        request = clip_service_pb2.MapSkeletonRequest(skeleton_id=skeleton_id, clear=list(clear))
+        for slot, joint in (slots or {}).items():
+            request.set.add(slot=slot, joint=joint)
+        return self._call(self._clips.MapSkeleton, request)
 
     def clip_id(self, clip: ClipRef) -> int:
         """A clip's id: an int is one already; a str is looked up as the clip's exact name

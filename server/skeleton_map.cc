@@ -1,0 +1,61 @@
+#include "server/skeleton_map.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "util/status_macros.h"
+
+namespace motiondb::server {
+namespace {
+
+// Each joint's name appears at most three times (joints, a slot, a pair), each with its numbers.
+int64_t SkeletonAnswerBytes(const Skeleton& skeleton) {
+  int64_t bytes = kAnswerFixedBytes;
+  for (const Joint& joint : skeleton.joints()) {
+    bytes += 3 * (TextFieldBytes(static_cast<int64_t>(joint.name.size())) + 2 * kNumberFieldBytes +
+                  kFieldFramingBytes);
+  }
+  return bytes;
+}
+
+absl::Status CheckAnswer(const storage::SkeletonRecord& record, const AnswerLimit& answers) {
+  return answers.Check(SkeletonAnswerBytes(*record.skeleton),
+                       absl::StrCat("skeleton ", record.summary.skeleton_id, "'s joints and map"),
+                       "raise --max-answer-mb");
+}
+
+absl::StatusOr<SkeletonMapView> View(storage::SkeletonRecord record) {
+  SkeletonMapView view;
+  MOTIONDB_ASSIGN_OR_RETURN(view.map, MapHumanoid(*record.skeleton, record.slot_overrides));
+  for (const SlotOverride& pinned : record.slot_overrides) {
+    view.overridden[static_cast<int>(pinned.slot)] = true;
+  }
+  view.record = std::move(record);
+  return view;
+}
+
+}  // namespace
+
+absl::StatusOr<SkeletonMapView> ShowSkeleton(storage::Database& database, int64_t skeleton_id,
+                                             const AnswerLimit& answers) {
+  MOTIONDB_ASSIGN_OR_RETURN(storage::SkeletonRecord record, database.GetSkeleton(skeleton_id));
+  MOTIONDB_RETURN_IF_ERROR(CheckAnswer(record, answers));
+  return View(std::move(record));
+}
+
+absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t skeleton_id,
+                                            const storage::SlotOverrideChange& change,
+                                            const AnswerLimit& answers,
+                                            const std::function<bool()>& should_stop) {
+  // Checked before the write: a change whose answer could not be sent is not made. A
+  // skeleton's joints never change, so the check holds for the answer after the write.
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::SkeletonRecord before,
+                            database.GetSkeleton(skeleton_id));
+  MOTIONDB_RETURN_IF_ERROR(CheckAnswer(before, answers));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      storage::SkeletonRecord record,
+      database.UpdateSlotOverrides(skeleton_id, change, {.should_stop = should_stop}));
+  return View(std::move(record));
+}
+
+}  // namespace motiondb::server

@@ -1,0 +1,37 @@
+// A skeleton's humanoid map as the API shows it (ClipService.GetSkeleton, MapSkeleton): the
+// stored overrides applied first, the automatic map (core/motion/humanoid_map.h) around them.
+#ifndef MOTIONDB_SERVER_SKELETON_MAP_H_
+#define MOTIONDB_SERVER_SKELETON_MAP_H_
+
+#include <array>
+#include <cstdint>
+#include <functional>
+
+#include "absl/status/statusor.h"
+#include "core/motion/humanoid_map.h"
+#include "server/answer_limit.h"
+#include "storage/database.h"
+
+namespace motiondb::server {
+
+struct SkeletonMapView {
+  storage::SkeletonRecord record;
+  HumanoidMap map;
+  std::array<bool, kHumanoidSlotCount> overridden{};  // by slot: its joint is an override's
+};
+
+// NOT_FOUND for an unknown skeleton; RESOURCE_EXHAUSTED when its joints' names could take more
+// than `answers` (three times each: joints, slots, pairs).
+absl::StatusOr<SkeletonMapView> ShowSkeleton(storage::Database& database, int64_t skeleton_id,
+                                             const AnswerLimit& answers);
+
+// Stores `change` (storage::Database::UpdateSlotOverrides, whose errors it returns) and shows
+// the skeleton as updated.
+absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t skeleton_id,
+                                            const storage::SlotOverrideChange& change,
+                                            const AnswerLimit& answers,
+                                            const std::function<bool()>& should_stop);
+
+}  // namespace motiondb::server
+
+#endif  // MOTIONDB_SERVER_SKELETON_MAP_H_
