@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <vector>
 
-#include "absl/container/flat_hash_map.h"
 #include "core/search/characteristic_points.h"
 #include "core/search/internal/search_query.h"
+#include "core/search/internal/settle_best.h"
 #include "core/search/warp/time_warp.h"
 #include "core/search/warp_refinement.h"
 #include "util/status_macros.h"
@@ -131,72 +130,13 @@ int64_t PlaceSeparation(int64_t gap, int64_t query_rows) {
   return std::max<int64_t>(gap + 1, query_rows / 4);
 }
 
-// Every factor-th frame of `clip` from `phase`: what a warp at 1 / factor of the rate sees when
-// `phase` is its seed's frame modulo factor, so that the seed is among them. Fixed from frame 0
-// instead, an instance whose best alignment falls between those frames scored worse at the
-// coarse rate than its peers: at 100 h of synthetic capture, recall@10 against the exact search
-// rose from 0.74 to 0.77 with the seeds' phases kept.
-CoordinateView PhasedView(CoordinateView clip, int factor, int64_t phase) {
-  return CoarseView(clip.middle_rows(phase, clip.rows - phase), factor);
-}
-
-// A candidate's frames between PhasedView's (coarse) and the clip's own: x <-> x * factor + phase.
-void ToClipFrames(int factor, int64_t phase, SearchResult& candidate) {
-  const auto scale = [&](int64_t& frame) { frame = frame * factor + phase; };
-  scale(candidate.first_frame);
-  scale(candidate.last_frame);
-  scale(candidate.seed_frame);
-  for (int64_t& frame : candidate.path) scale(frame);
-}
-void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
-  const auto unscale = [&](int64_t& frame) { frame = (frame - phase) / factor; };
-  unscale(candidate.first_frame);
-  unscale(candidate.last_frame);
-  unscale(candidate.seed_frame);
-  for (int64_t& frame : candidate.path) unscale(frame);
-}
-
-// A score that no candidate above it can rank with among the max_results best of the
-// candidates seen, nor of any more to come: the k-th least of the clips' best scores. Each
-// clip's best is ranked whatever else overlaps it (ranking keeps the best of each clip, as one
-// clip's results never overlap another's), so the k-th ranked score is at most this, and more
-// candidates only lower it. (The k-th ranked score itself can rise with a new candidate that
-// suppresses two others.) The full-rate settles abandon their bands over it, which is not
-// exact (RefineFromCoarse): over a run of the benchmark on 10 h of real capture, 42 of 19,000
-// settles were given up that would have settled under it (within 4% of it: the tail of the
-// results), at 100 h 3 of 32,000; recall@10 and the result counts the same in every scenario
-// (bench/notes/2026-12-04-scale-settle-bound.md), for settles that cost half as much.
-class ClipBestScores {
- public:
-  explicit ClipBestScores(int k) : k_(k) {}
-  double bound() const { return bound_; }
-  void Add(int clip, double score) {
-    if (score >= bound_) return;
-    const auto [it, inserted] = best_.try_emplace(clip, score);
-    if (!inserted) it->second = std::min(it->second, score);
-    if (static_cast<int>(best_.size()) < k_) return;
-    scores_.clear();
-    for (const auto& [c, s] : best_) scores_.push_back(s);
-    std::nth_element(scores_.begin(), scores_.begin() + (k_ - 1), scores_.end());
-    bound_ = scores_[k_ - 1];
-  }
-
- private:
-  const int k_;
-  double bound_ = std::numeric_limits<double>::infinity();
-  absl::flat_hash_map<int, double> best_;
-  std::vector<double> scores_;
-};
-
 // The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
-// settled at the full rate. `stop` is told the band warps' cells.
-absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, CoordinateView query,
-                                                 int anchor, int coarse_anchor, int factor,
-                                                 const WarpConstraints& constraints,
-                                                 const SearchParams& params,
-                                                 std::vector<SearchResult> candidates,
-                                                 StopPoll& stop) {
+// settled at the full rate (those `filter` admits). `stop` is told the band warps' cells.
+absl::StatusOr<std::vector<SearchResult>> Refine(
+    const LibraryIndex& library, CoordinateView query, int anchor, int coarse_anchor, int factor,
+    const WarpConstraints& constraints, const SearchParams& params, const SearchFilter& filter,
+    std::vector<SearchResult> candidates, StopPoll& stop) {
   BandWorkspace workspace;
   for (size_t i = 0; i < candidates.size(); ++i) {
     SearchResult& candidate = candidates[i];
@@ -214,30 +154,9 @@ absl::StatusOr<std::vector<SearchResult>> Refine(const LibraryIndex& library, Co
     const size_t fine_pool =
         std::max<size_t>(params.max_results,
                          std::lround(FineShare(factor) * static_cast<double>(candidates.size())));
-    const int pool = static_cast<int>(candidates.size());
-    candidates = RankResults(std::move(candidates), params.max_overlap, pool);
-    // Settled candidates can converge on one place (70 s at 120 Hz: 19.9 results of 20 on
-    // average, the exact search 20), so while the settled hold fewer than max_results distinct
-    // places, the next best candidates are settled too.
-    std::vector<SearchResult> settled;
-    ClipBestScores ranked_above(params.max_results);
-    for (size_t i = 0; i < candidates.size(); ++i) {
-      // A finite bound means max_results clips hold a settled result, each of them ranked.
-      if (i >= fine_pool &&
-          (std::isfinite(ranked_above.bound()) ||
-           RankedCount(settled, params.max_overlap, params.max_results) == params.max_results)) {
-        break;
-      }
-      SearchResult& candidate = candidates[i];
-      if (stop.Done(query.rows)) return SearchStopped();
-      if (RefineFromCoarse(query, library.clip_coordinates(candidate.clip_index), anchor, factor,
-                           constraints, ranked_above.bound(), workspace, candidate, &stop)) {
-        ranked_above.Add(candidate.clip_index, candidate.score);
-        settled.push_back(std::move(candidate));
-      }
-      if (stop.stopped()) return SearchStopped();
-    }
-    candidates = std::move(settled);
+    MOTIONDB_ASSIGN_OR_RETURN(
+        candidates, SettleBest(library, query, anchor, factor, constraints, params, filter,
+                               std::move(candidates), fine_pool, workspace, stop));
   }
   if (!params.return_path) {
     for (SearchResult& candidate : candidates) candidate.path = {};
@@ -406,8 +325,9 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   stage = Clock::now();
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
-    MOTIONDB_ASSIGN_OR_RETURN(candidates, Refine(library, query, anchor, warp_anchor, factor,
-                                                 constraints, params, std::move(candidates), stop));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params, filter,
+                           std::move(candidates), stop));
   }
   stats.refine_ms = MillisecondsSince(stage);
 
