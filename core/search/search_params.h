@@ -44,7 +44,8 @@ enum class SeedSelection {
   // as fast or slow is still a candidate), the `shape_windows` nearest at each length; the
   // windows of the first `shape_clips` distinct clips, each widened by half the query's length
   // on both sides, are re-ranked by the exact search's subsequence warp (its bounds and early
-  // abandoning) over those ranges alone. The characteristic points and the other seed
+  // abandoning) over those ranges alone, at about 15 Hz with refinement (`refine`), the best
+  // coarse warps then settled at the full rate. The characteristic points and the other seed
   // parameters do not apply; a one-frame query is a pose search as ever.
   kShapeWindows,
 };
