@@ -222,6 +222,7 @@ struct VariantFlags {
   std::vector<int> points;             // characteristic points (0: by the query's length)
   std::vector<double> second_anchor;   // SearchParams::second_anchor_scatter values
   std::vector<int> shape_clips;        // candidates from the query's shape (kShapeWindows)
+  std::vector<int> shape_windows;      // their windows a length (empty: the default)
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
@@ -255,11 +256,18 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     params.characteristic_points = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " characteristic points"), params);
   }
+  const std::vector<int> shape_windows = flags.shape_windows.empty()
+                                             ? std::vector<int>{SearchParams().shape_windows}
+                                             : flags.shape_windows;
   for (int clips : flags.shape_clips) {
-    SearchParams params;
-    params.seed_selection = SeedSelection::kShapeWindows;
-    params.shape_clips = clips;
-    variants.emplace_back(absl::StrCat("shape candidates, ", clips, " clips"), params);
+    for (int windows : shape_windows) {
+      SearchParams params;
+      params.seed_selection = SeedSelection::kShapeWindows;
+      params.shape_clips = clips;
+      params.shape_windows = windows;
+      variants.emplace_back(
+          absl::StrCat("shape candidates, ", clips, " clips, ", windows, " windows"), params);
+    }
   }
   for (double scatter : flags.second_anchor) {
     SearchParams params;
@@ -456,6 +464,11 @@ int main(int argc, char** argv) {
   app.add_option("--shapes", variants.shape_clips,
                  "also measure the search from the query's shape with these numbers of clips "
                  "re-ranked (SearchParams::shape_clips)")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--shape-windows", variants.shape_windows,
+                 "--shapes: with each of these numbers of windows a length "
+                 "(SearchParams::shape_windows; default: its default)")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,
