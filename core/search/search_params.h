@@ -77,10 +77,13 @@ struct SearchParams {
   // windows: 500), taken again, twice as many, while they fall in fewer than two places a
   // result (core/search/motion_search.cc).
   int neighbours = 0;
-  // kShapeWindows: the nearest windows asked at each length searched.
-  int shape_windows = 100;
-  // kShapeWindows: the distinct clips, nearest first, whose windows are re-ranked by the warp.
-  int shape_clips = 100;
+  // kShapeWindows: the nearest windows asked at each length searched, and the distinct clips,
+  // nearest first, whose windows are re-ranked by the warp. On 10 h of real capture (20 queries,
+  // bench/notes/2026-12-07-shape-two-rate.md) 100 and 100 gave recall@10 against the exact search
+  // 0.905, 200 and 300 gave 0.995 (p50 3.1 and 5.7 ms); on Bandai (a few hundred clips) both
+  // about 0.99-1.0, 200 and 300 0.2-0.3 ms slower at the median.
+  int shape_windows = 200;
+  int shape_clips = 300;
   // kShapeWindows: the window lengths searched either side of the one nearest the query's
   // (sqrt(2) apart: 2 reaches half and twice the query's length, the default slope limit's).
   int shape_lengths_either_side = 2;
@@ -126,7 +129,8 @@ struct SearchParams {
   double max_overlap = 0.5;
   // Move each candidate to the best warp near it, free of its seed, before ranking
   // (core/warp_refinement.h): a warp pinned to a seed in a held pose can score far worse than
-  // the best warp beside it. false runs the thesis's algorithm as is.
+  // the best warp beside it. false runs the thesis's algorithm as is (kShapeWindows: re-ranks
+  // at the full rate instead of about 15 Hz).
   bool refine = true;
   // Exact search: threads scanning the library's clips (0: one per core).
   int exact_threads = 0;
