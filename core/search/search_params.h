@@ -80,8 +80,8 @@ struct SearchParams {
   // kShapeWindows: the nearest windows asked at each length searched, and the distinct clips,
   // nearest first, whose windows are re-ranked by the warp. On 10 h of real capture (20 queries,
   // bench/notes/2026-12-07-shape-two-rate.md) 100 and 100 gave recall@10 against the exact search
-  // 0.905, 200 and 300 gave 0.995 (p50 3.1 and 5.7 ms); on Bandai (a few hundred clips) both
-  // about 0.99-1.0, 200 and 300 0.2-0.3 ms slower at the median.
+  // 0.905, 200 and 300 gave 0.995 (p50 4.7 and 6.2 ms; nearest frames 0.940, 6.6 ms); on Bandai
+  // (a few hundred clips) both 0.98-1.0, 200 and 300 0.05-0.3 ms slower at the median.
   int shape_windows = 200;
   int shape_clips = 300;
   // kShapeWindows: the window lengths searched either side of the one nearest the query's
