@@ -223,6 +223,7 @@ struct VariantFlags {
   std::vector<double> second_anchor;   // SearchParams::second_anchor_scatter values
   std::vector<int> shape_clips;        // candidates from the query's shape (kShapeWindows)
   std::vector<int> threads;            // the default search on these many threads
+  std::vector<int> shape_windows;      // their windows a length (empty: the default)
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
@@ -262,11 +263,18 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     params.characteristic_points = count;
     variants.emplace_back(absl::StrCat("fast, ", count, " characteristic points"), params);
   }
+  const std::vector<int> shape_windows = flags.shape_windows.empty()
+                                             ? std::vector<int>{SearchParams().shape_windows}
+                                             : flags.shape_windows;
   for (int clips : flags.shape_clips) {
-    SearchParams params;
-    params.seed_selection = SeedSelection::kShapeWindows;
-    params.shape_clips = clips;
-    variants.emplace_back(absl::StrCat("shape candidates, ", clips, " clips"), params);
+    for (int windows : shape_windows) {
+      SearchParams params;
+      params.seed_selection = SeedSelection::kShapeWindows;
+      params.shape_clips = clips;
+      params.shape_windows = windows;
+      variants.emplace_back(
+          absl::StrCat("shape candidates, ", clips, " clips, ", windows, " windows"), params);
+    }
   }
   for (double scatter : flags.second_anchor) {
     SearchParams params;
@@ -468,6 +476,11 @@ int main(int argc, char** argv) {
   app.add_option("--threads", variants.threads,
                  "also measure the default search with its warps and refinement on these "
                  "numbers of threads (SearchParams::threads)")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--shape-windows", variants.shape_windows,
+                 "--shapes: with each of these numbers of windows a length "
+                 "(SearchParams::shape_windows; default: its default)")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
   app.add_option("--points", variants.points,

@@ -69,10 +69,10 @@ constexpr Parameter kParameters[] = {
      "characteristic points found, one in each K-th of the query, each anchoring its part "
      "(0: one per action of the query)",
      &SearchFlags::points, &v1::SearchRequest::set_characteristic_points, 0},
-    {"--shape-windows", "shape_windows", "N", "100",
+    {"--shape-windows", "shape_windows", "N", "200",
      "--seeds shapes: windows nearest the query's shape asked at each length",
      &SearchFlags::shape_windows, &v1::SearchRequest::set_shape_windows},
-    {"--shape-clips", "shape_clips", "N", "100",
+    {"--shape-clips", "shape_clips", "N", "300",
      "--seeds shapes: distinct clips, nearest first, whose windows the warp re-ranks",
      &SearchFlags::shape_clips, &v1::SearchRequest::set_shape_clips},
     {"--shape-lengths", "shape_lengths_either_side", "N", "2",

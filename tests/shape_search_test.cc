@@ -3,6 +3,7 @@
 // the candidate ranges cover the library, the filters and the excluded range, bad parameters.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -81,9 +82,10 @@ TEST(ShapeSearch, FindsTimeScaledCopiesOfALibraryRangeFirst) {
   }
 }
 
-// With windows enough to cover every clip, the ranges are the whole clips, and the re-ranking
-// is the exact search's scan over them: the same results.
-TEST(ShapeSearch, EqualsTheExactSearchWhenTheCandidatesCoverASmallLibrary) {
+// Queries of several lengths and slope limits on a small library, with windows enough that the
+// ranges are its whole clips: `check`(library, query, params) for each.
+void ForEachCoveringQuery(
+    const std::function<void(const LibraryIndex&, const RowMatrixXf&, SearchParams)>& check) {
   const std::unique_ptr<LibraryIndex> library = NoiseLibrary(3, 240, 70);
   int trial = 0;
   for (const int frames : {12, 30, 55, 100}) {
@@ -95,23 +97,62 @@ TEST(ShapeSearch, EqualsTheExactSearchWhenTheCandidatesCoverASmallLibrary) {
       params.slope_limit = slope;
       params.max_results = 8;
       params.return_path = trial % 2 == 0;
-      const absl::StatusOr<SearchResponse> shape =
-          Search(*library, CoordinateView::Of(query), params);
-      const absl::StatusOr<SearchResponse> exact =
-          ExactSearch(*library, CoordinateView::Of(query), params);
-      ASSERT_TRUE(shape.ok()) << shape.status();
-      ASSERT_TRUE(exact.ok()) << exact.status();
-      ASSERT_EQ(shape->results.size(), exact->results.size());
-      for (size_t i = 0; i < exact->results.size(); ++i) {
-        SCOPED_TRACE(i);
-        EXPECT_EQ(shape->results[i].clip_id, exact->results[i].clip_id);
-        EXPECT_EQ(shape->results[i].first_frame, exact->results[i].first_frame);
-        EXPECT_EQ(shape->results[i].last_frame, exact->results[i].last_frame);
-        EXPECT_NEAR(shape->results[i].score, exact->results[i].score, 1e-5);
-        EXPECT_EQ(shape->results[i].path, exact->results[i].path);
-      }
+      check(*library, query, params);
     }
   }
+}
+
+// The re-ranking at the full rate (no refinement) is the exact search's scan over the ranges:
+// where they cover the library, the same results.
+TEST(ShapeSearch, EqualsTheExactSearchWhenTheCandidatesCoverASmallLibrary) {
+  ForEachCoveringQuery([](const LibraryIndex& library, const RowMatrixXf& query,
+                          SearchParams params) {
+    params.refine = false;
+    const absl::StatusOr<SearchResponse> shape = Search(library, CoordinateView::Of(query), params);
+    const absl::StatusOr<SearchResponse> exact =
+        ExactSearch(library, CoordinateView::Of(query), params);
+    ASSERT_TRUE(shape.ok()) << shape.status();
+    ASSERT_TRUE(exact.ok()) << exact.status();
+    ASSERT_EQ(shape->results.size(), exact->results.size());
+    for (size_t i = 0; i < exact->results.size(); ++i) {
+      SCOPED_TRACE(i);
+      EXPECT_EQ(shape->results[i].clip_id, exact->results[i].clip_id);
+      EXPECT_EQ(shape->results[i].first_frame, exact->results[i].first_frame);
+      EXPECT_EQ(shape->results[i].last_frame, exact->results[i].last_frame);
+      EXPECT_NEAR(shape->results[i].score, exact->results[i].score, 1e-5);
+      EXPECT_EQ(shape->results[i].path, exact->results[i].path);
+    }
+  });
+}
+
+// The same libraries re-ranked at 15 Hz (the default), the best coarse warps settled at 30 Hz
+// in a band around their paths: every result a true warp, the exact search's best found, and
+// most of its others overlapped by a result (what recall@10 counts).
+TEST(ShapeSearch, SettlesTheCoarseReRankingNearTheExactSearchsResults) {
+  ForEachCoveringQuery([](const LibraryIndex& library, const RowMatrixXf& query,
+                          SearchParams params) {
+    params.return_path = true;
+    const SearchResponse shape = *Search(library, CoordinateView::Of(query), params);
+    const SearchResponse exact = *ExactSearch(library, CoordinateView::Of(query), params);
+    ASSERT_FALSE(shape.results.empty());
+    ASSERT_FALSE(exact.results.empty());
+    EXPECT_EQ(shape.results[0].clip_id, exact.results[0].clip_id);
+    EXPECT_NEAR(shape.results[0].score, exact.results[0].score, 1e-5);
+    int found = 0;
+    for (const SearchResult& e : exact.results) {
+      found += std::any_of(shape.results.begin(), shape.results.end(), [&](const SearchResult& r) {
+        return Overlaps(e, r, 0.5) || Overlaps(r, e, 0.5);
+      });
+    }
+    EXPECT_GE(found, static_cast<int>(exact.results.size()) - 2);
+    for (const SearchResult& r : shape.results) {
+      EXPECT_EQ(r.path.front(), r.first_frame);
+      EXPECT_EQ(r.path.back(), r.last_frame);
+      const RowMatrixXf clip = library.CopyClipCoordinates(r.clip_index);
+      EXPECT_NEAR(testing::MeanPathDistance(query, clip, r.path, params.dtw_dims), r.score,
+                  1e-4 * (1 + r.score));
+    }
+  });
 }
 
 // Fewer windows than cover the library: the results are still true warps of the model, ranked,

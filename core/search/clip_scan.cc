@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/search/warp/time_warp.h"
+#include "core/search/warp_refinement.h"
 
 namespace motiondb {
 namespace {
@@ -19,18 +20,27 @@ constexpr int64_t kBlock = 32;
 // states the pauses in a row. Only the last slope_limit columns are kept.
 class ClipScan {
  public:
-  ClipScan(CoordinateView query, CoordinateView clip, int64_t first_frame, int slope_limit,
-           int dims)
+  ClipScan(CoordinateView query, CoordinateView clip, int64_t first_frame, int frame_step,
+           int slope_limit, int dims, ClipScanWorkspace& workspace)
       : query_(query),
         clip_(clip),
         first_frame_(first_frame),
+        frame_step_(frame_step),
         s_(slope_limit),
         dims_(dims),
         m_(query.rows),
-        ring_(slope_limit + 1) {
+        ring_(workspace.ring),
+        lower_bound_(workspace.lower_bound),
+        box_low_(workspace.box_low),
+        box_high_(workspace.box_high),
+        low_(workspace.low),
+        high_(workspace.high) {
+    ring_.resize(slope_limit + 1);
     for (Column& column : ring_) {
       column.cost.assign(m_ * s_, kInfinity);
       column.start.assign(m_ * s_, 0);
+      column.top = -1;
+      column.best_start = 0;
     }
     lower_bound_.resize(m_ + 1);
     ComputeBlockBoxes();
@@ -61,10 +71,10 @@ class ClipScan {
       }
       const float end_cost = FillColumn(j, threshold(), stats);
       const int64_t best_start = ring_[j % ring_.size()].best_start;
-      if (end_cost < kInfinity &&
-          filter.Admits(clip_index, first_frame_ + best_start, first_frame_ + j)) {
-        const Warp warp{
-            first_frame_ + best_start, first_frame_ + j, end_cost / static_cast<double>(m_), {}};
+      const int64_t first = first_frame_ + frame_step_ * best_start;
+      const int64_t last = first_frame_ + frame_step_ * j;
+      if (end_cost < kInfinity && filter.Admits(clip_index, first, last)) {
+        const Warp warp{first, last, end_cost / static_cast<double>(m_), {}};
         top.Offer(MakeResult(clip_index, warp, -1));
       }
     }
@@ -72,12 +82,7 @@ class ClipScan {
   }
 
  private:
-  struct Column {
-    std::vector<float> cost;     // m x s
-    std::vector<int64_t> start;  // clip frame of the path's first query frame
-    int64_t top = -1;            // highest row with a finite cost
-    int64_t best_start = 0;
-  };
+  using Column = ClipScanWorkspace::Column;
 
   bool AnyAlive() const {
     return std::any_of(ring_.begin(), ring_.end(), [](const Column& c) { return c.top >= 0; });
@@ -164,11 +169,12 @@ class ClipScan {
   // can reach, [j0, j0 + kBlock - 1 + s * (m - 1)].
   void BlockLowerBound(int64_t j0) {
     const int64_t last = std::min(clip_.rows - 1, j0 + kBlock - 1 + s_ * (m_ - 1));
-    std::vector<float> low(dims_, kInfinity), high(dims_, -kInfinity);
+    low_.assign(dims_, kInfinity);
+    high_.assign(dims_, -kInfinity);
     for (int64_t b = j0 / kBlock; b <= last / kBlock; ++b) {
       for (int k = 0; k < dims_; ++k) {
-        low[k] = std::min(low[k], box_low_[b * dims_ + k]);
-        high[k] = std::max(high[k], box_high_[b * dims_ + k]);
+        low_[k] = std::min(low_[k], box_low_[b * dims_ + k]);
+        high_[k] = std::max(high_[k], box_high_[b * dims_ + k]);
       }
     }
     lower_bound_[m_] = 0.0f;
@@ -176,7 +182,7 @@ class ClipScan {
       float sum = 0.0f;
       for (int k = 0; k < dims_; ++k) {
         const float v = query_.row(i)[k];
-        const float outside = v < low[k] ? low[k] - v : (v > high[k] ? v - high[k] : 0.0f);
+        const float outside = v < low_[k] ? low_[k] - v : (v > high_[k] ? v - high_[k] : 0.0f);
         sum += outside * outside;
       }
       // Slightly loosened so float rounding can never prune a path that would have won.
@@ -187,21 +193,25 @@ class ClipScan {
   CoordinateView query_;
   CoordinateView clip_;
   int64_t first_frame_;  // clip_'s row 0 in its clip
+  int64_t frame_step_;   // clip frames between clip_'s rows
   int s_;
   int dims_;
   int64_t m_;
-  std::vector<Column> ring_;
-  std::vector<float> lower_bound_;
-  std::vector<float> box_low_, box_high_;
+  // The workspace's buffers.
+  std::vector<Column>& ring_;
+  std::vector<float>& lower_bound_;
+  std::vector<float>&box_low_, &box_high_;
+  std::vector<float>&low_, &high_;  // the box of a block's reach
 };
 
 }  // namespace
 
 absl::Status ScanClip(CoordinateView query, CoordinateView clip, int64_t first_frame,
-                      int clip_index, const SearchParams& params, const SearchFilter& filter,
-                      StopPoll& stop, absl::FunctionRef<float()> bound, StreamingTopResults& top,
-                      SearchStats& stats) {
-  ClipScan scan(query, clip, first_frame, params.slope_limit, params.dtw_dims);
+                      int frame_step, int clip_index, const SearchParams& params,
+                      const SearchFilter& filter, StopPoll& stop, absl::FunctionRef<float()> bound,
+                      ClipScanWorkspace& workspace, StreamingTopResults& top, SearchStats& stats) {
+  ClipScan scan(query, clip, first_frame, frame_step, params.slope_limit, params.dtw_dims,
+                workspace);
   return scan.Run(clip_index, filter, stop, bound, top, stats);
 }
 
@@ -217,19 +227,18 @@ void FinishedClips::Add(std::vector<SearchResult> results) {
   }
 }
 
-// Gives each result its path. The scan keeps no back-pointers (a column of costs and starts
-// per clip frame); a result is the best warp ending at its last frame, which is what a warp
-// anchored at the query's last frame there computes again, with its path, for k results only.
 absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const SearchParams& params,
-                      std::vector<SearchResult>& results) {
+                      int factor, std::vector<SearchResult>& results) {
   WarpWorkspace workspace;
   StopPoll stop = SearchStop(params);
   for (SearchResult& result : results) {
     if (stop.Done(query.rows)) return SearchStopped();
-    std::optional<Warp> warp = AnchoredWarp(
-        query, library.clip_coordinates(result.clip_index), static_cast<int>(query.rows - 1),
-        result.last_frame, {params.slope_limit, params.dtw_dims}, /*with_path=*/true, workspace,
-        std::numeric_limits<float>::infinity(), &stop);
+    const int64_t phase = result.last_frame % factor;
+    std::optional<Warp> warp =
+        AnchoredWarp(query, PhasedView(library.clip_coordinates(result.clip_index), factor, phase),
+                     static_cast<int>(query.rows - 1), result.last_frame / factor,
+                     {params.slope_limit, params.dtw_dims}, /*with_path=*/true, workspace,
+                     std::numeric_limits<float>::infinity(), &stop);
     if (stop.stopped()) return SearchStopped();
     if (!warp) {
       return absl::InternalError(absl::StrCat("no warp ends at frame ", result.last_frame,
@@ -237,8 +246,9 @@ absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const S
                                               ", where the exact search found one"));
     }
     // Among equal warps the scan and the anchored warp may keep different starts.
-    result.first_frame = warp->first;
+    result.first_frame = warp->first * factor + phase;
     result.path = std::move(warp->path);
+    for (int64_t& frame : result.path) frame = frame * factor + phase;
   }
   return absl::OkStatus();
 }

@@ -18,6 +18,7 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   const auto warps = std::chrono::steady_clock::now();
   FinishedClips finished(params.max_results, query.rows);
   std::vector<SearchStats> stats(ThreadsFor(params.exact_threads));
+  std::vector<ClipScanWorkspace> workspaces(stats.size());
   MOTIONDB_RETURN_IF_ERROR(
       ParallelFor(library.clip_count(), static_cast<int>(stats.size()),
                   [&](int64_t index, int thread) -> absl::Status {
@@ -28,8 +29,8 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
                     if (stop.Done(query.rows)) return SearchStopped();
                     StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
                     MOTIONDB_RETURN_IF_ERROR(ScanClip(
-                        query, library.clip_coordinates(c), 0, c, params, filter, stop,
-                        [&] { return finished.bound(); }, top, stats[thread]));
+                        query, library.clip_coordinates(c), 0, 1, c, params, filter, stop,
+                        [&] { return finished.bound(); }, workspaces[thread], top, stats[thread]));
                     // Most clips hold nothing under the bound: adding nothing would only take the
                     // lock.
                     std::vector<SearchResult> results = top.Take();
@@ -42,7 +43,7 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   }
   response.stats.warps_ms = MillisecondsSince(warps);
   std::vector<SearchResult> best = finished.Take();
-  if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, best));
+  if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, 1, best));
   response.results = FinishResults(library, filter, std::move(best), params);
   response.stats.total_ms = MillisecondsSince(start);
   return response;

@@ -44,7 +44,8 @@ enum class SeedSelection {
   // as fast or slow is still a candidate), the `shape_windows` nearest at each length; the
   // windows of the first `shape_clips` distinct clips, each widened by half the query's length
   // on both sides, are re-ranked by the exact search's subsequence warp (its bounds and early
-  // abandoning) over those ranges alone. The characteristic points and the other seed
+  // abandoning) over those ranges alone, at about 15 Hz with refinement (`refine`), the best
+  // coarse warps then settled at the full rate. The characteristic points and the other seed
   // parameters do not apply; a one-frame query is a pose search as ever.
   kShapeWindows,
 };
@@ -76,10 +77,13 @@ struct SearchParams {
   // windows: 500), taken again, twice as many, while they fall in fewer than two places a
   // result (core/search/motion_search.cc).
   int neighbours = 0;
-  // kShapeWindows: the nearest windows asked at each length searched.
-  int shape_windows = 100;
-  // kShapeWindows: the distinct clips, nearest first, whose windows are re-ranked by the warp.
-  int shape_clips = 100;
+  // kShapeWindows: the nearest windows asked at each length searched, and the distinct clips,
+  // nearest first, whose windows are re-ranked by the warp. On 10 h of real capture (20 queries,
+  // bench/notes/2026-12-07-shape-two-rate.md) 100 and 100 gave recall@10 against the exact search
+  // 0.905, 200 and 300 gave 0.995 (p50 4.7 and 6.2 ms; nearest frames 0.940, 6.6 ms); on Bandai
+  // (a few hundred clips) both 0.98-1.0, 200 and 300 0.05-0.3 ms slower at the median.
+  int shape_windows = 200;
+  int shape_clips = 300;
   // kShapeWindows: the window lengths searched either side of the one nearest the query's
   // (sqrt(2) apart: 2 reaches half and twice the query's length, the default slope limit's).
   int shape_lengths_either_side = 2;
@@ -125,12 +129,14 @@ struct SearchParams {
   double max_overlap = 0.5;
   // Move each candidate to the best warp near it, free of its seed, before ranking
   // (core/warp_refinement.h): a warp pinned to a seed in a held pose can score far worse than
-  // the best warp beside it. false runs the thesis's algorithm as is.
+  // the best warp beside it. false runs the thesis's algorithm as is (kShapeWindows: re-ranks
+  // at the full rate instead of about 15 Hz).
   bool refine = true;
   // Exact search: threads scanning the library's clips (0: one per core).
   int exact_threads = 0;
   // Fast search: threads sharing the query's warps and refinement (each part's, with several
-  // characteristic points; the seeds are found on one); 0: one per core. The results are the same
+  // characteristic points; the seeds are found on one; the shape stage runs on one); 0: one per
+  // core. The results are the same
   // however many: each warp and settle is judged, in order, against what the ones before it left
   // (util/thread_team.h). One by default, as the thesis's algorithm: a
   // server gives a search every core only while it runs no other (server/search_runner.h).

@@ -100,7 +100,9 @@ std::vector<SearchResult> StreamingTopResults::Take() {
   std::vector<SearchResult> results;
   results.reserve(all.size());
   for (Kept& kept : all) results.push_back(std::move(kept.result));
-  by_clip_.clear();
+  // by_clip_ keeps its size: a set reused for many short scans (the shape search's ranges) of a
+  // library of thousands of clips would otherwise build it again for each.
+  for (const int clip : held_) by_clip_[clip] = std::vector<Kept>();  // capacity 0: unheld
   held_.clear();
   kept_count_ = 0;
   worst_score_cache_ = std::numeric_limits<double>::quiet_NaN();

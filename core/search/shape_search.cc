@@ -6,8 +6,13 @@
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
+#include "core/index/coarse_rate.h"
 #include "core/search/internal/clip_scan.h"
+#include "core/search/internal/member_state.h"
+#include "core/search/internal/settle_best.h"
+#include "core/search/warp_refinement.h"
 #include "util/status_macros.h"
+#include "util/thread_team.h"
 
 namespace motiondb {
 namespace {
@@ -16,6 +21,13 @@ using Clock = std::chrono::steady_clock;
 
 // The work of a window from the kd-trees as cells (kCellsPerStopPoll), as a seed's.
 constexpr int64_t kCellsPerWindow = 1024;
+
+// Coarse warps kept per result returned, each settled at the full rate: coarse scores order
+// nearly equal matches less surely than full-rate ones. On 10 h of real capture (300 clips, 200
+// windows a length; bench/notes/2026-12-07-shape-two-rate.md) 1 and 2 gave recall@10 0.990 and
+// 0.995 at p50 4.7 and 5.7 ms; the settling costs 0.4 ms, the coarse pool's looser bound the
+// rest.
+constexpr int kCoarsePerResult = 2;
 
 // Frames first..last of one clip to re-rank, and the nearest window's distance in it.
 struct Range {
@@ -61,6 +73,30 @@ std::vector<Range> CandidateRanges(const LibraryIndex& library, std::vector<Shap
   return merged;
 }
 
+// The k best results of the subsequence warp of `query` over the disjoint `ranges`, each range
+// read every `factor`-th frame from its first (the exact search's scan, its bounds and early
+// abandoning over the ranges alone), in clip frames. Stats: warps, the ranges with a result.
+absl::StatusOr<std::vector<SearchResult>> ScanRanges(
+    const LibraryIndex& library, CoordinateView query, const std::vector<Range>& ranges, int factor,
+    int k, const SearchParams& params, const SearchFilter& filter, StopPoll& stop,
+    ClipScanWorkspace& workspace, SearchStats& stats) {
+  FinishedClips finished(k, query.rows);
+  StreamingTopResults top(k, params.max_overlap, query.rows);  // each range's, emptied by Take
+  for (const Range& range : ranges) {
+    const CoordinateView clip = CoarseView(
+        library.clip_coordinates(range.clip).middle_rows(range.first, range.last - range.first + 1),
+        factor);
+    MOTIONDB_RETURN_IF_ERROR(ScanClip(
+        query, clip, range.first, factor, range.clip, params, filter, stop,
+        [&] { return finished.bound(); }, workspace, top, stats));
+    std::vector<SearchResult> results = top.Take();
+    if (results.empty()) continue;
+    ++stats.warps;
+    finished.Add(std::move(results));
+  }
+  return finished.Take();
+}
+
 }  // namespace
 
 absl::StatusOr<SearchResponse> ShapeSearch(const LibraryIndex& library, CoordinateView query,
@@ -68,7 +104,10 @@ absl::StatusOr<SearchResponse> ShapeSearch(const LibraryIndex& library, Coordina
   const Clock::time_point start = Clock::now();
   SearchResponse response;
   SearchStats& stats = response.stats;
-  StopPoll stop = SearchStop(params);
+  // One thread: its coarse scan of the ranges is not shared out (SearchParams::threads).
+  ThreadTeam team(1);
+  std::vector<MemberState> members = {{SearchStop(params), {}, {}}};
+  StopPoll& stop = members[0].stop;
   if (stop.Done(query.rows)) return SearchStopped();
 
   Clock::time_point stage = Clock::now();
@@ -96,25 +135,37 @@ absl::StatusOr<SearchResponse> ShapeSearch(const LibraryIndex& library, Coordina
   stats.clusters = static_cast<int64_t>(ranges.size());
   stats.clusters_ms = MillisecondsSince(stage);
 
+  // With refinement (the default), the ranges are warped at about 15 Hz as the fast search's
+  // seeds are (1 / factor^2 of the cells), and the best coarse warps settled at the full rate
+  // as the fast search's are; without, at the full rate.
+  const int factor = params.refine ? CoarseFactor(library.rate()) : 1;
+  ClipScanWorkspace workspace;
   stage = Clock::now();
-  // The ranges of one clip are disjoint, so the exact search's shared bound holds as it does
-  // over whole clips.
-  FinishedClips finished(params.max_results, query.rows);
-  for (const Range& range : ranges) {
-    StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
-    const CoordinateView clip =
-        library.clip_coordinates(range.clip).middle_rows(range.first, range.last - range.first + 1);
-    MOTIONDB_RETURN_IF_ERROR(ScanClip(
-        query, clip, range.first, range.clip, params, filter, stop,
-        [&] { return finished.bound(); }, top, stats));
-    std::vector<SearchResult> results = top.Take();
-    if (results.empty()) continue;
-    ++stats.warps;
-    finished.Add(std::move(results));
+  std::vector<SearchResult> best;
+  if (factor == 1) {
+    MOTIONDB_ASSIGN_OR_RETURN(best, ScanRanges(library, query, ranges, 1, params.max_results,
+                                               params, filter, stop, workspace, stats));
+    if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, 1, best));
+    stats.warps_ms = MillisecondsSince(stage);
+  } else {
+    const CoordinateView coarse_query = CoarseView(query, factor);
+    MOTIONDB_ASSIGN_OR_RETURN(
+        std::vector<SearchResult> coarse,
+        ScanRanges(library, coarse_query, ranges, factor, kCoarsePerResult * params.max_results,
+                   params, filter, stop, workspace, stats));
+    MOTIONDB_RETURN_IF_ERROR(AddPaths(library, coarse_query, params, factor, coarse));
+    stats.warps_ms = MillisecondsSince(stage);
+    stage = Clock::now();
+    const size_t pool = coarse.size();
+    MOTIONDB_ASSIGN_OR_RETURN(best, SettleBest(library, query, /*anchor=*/0, factor,
+                                               {params.slope_limit, params.dtw_dims}, params,
+                                               filter, std::move(coarse), pool, team, members));
+    for (SearchResult& result : best) {
+      result.seed_frame = -1;  // no seed, as the exact search's
+      if (!params.return_path) result.path = {};
+    }
+    stats.refine_ms = MillisecondsSince(stage);
   }
-  std::vector<SearchResult> best = finished.Take();
-  if (params.return_path) MOTIONDB_RETURN_IF_ERROR(AddPaths(library, query, params, best));
-  stats.warps_ms = MillisecondsSince(stage);
 
   stage = Clock::now();
   response.results = FinishResults(library, filter, std::move(best), params);

@@ -4,12 +4,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <vector>
 
-#include "absl/container/flat_hash_map.h"
 #include "core/search/characteristic_points.h"
+#include "core/search/internal/member_state.h"
 #include "core/search/internal/search_query.h"
+#include "core/search/internal/settle_best.h"
 #include "core/search/warp/time_warp.h"
 #include "core/search/warp_refinement.h"
 #include "util/parallel_for.h"
@@ -134,89 +134,25 @@ int64_t PlaceSeparation(int64_t gap, int64_t query_rows) {
   return std::max<int64_t>(gap + 1, query_rows / 4);
 }
 
-// Every factor-th frame of `clip` from `phase`: what a warp at 1 / factor of the rate sees when
-// `phase` is its seed's frame modulo factor, so that the seed is among them. Fixed from frame 0
-// instead, an instance whose best alignment falls between those frames scored worse at the
-// coarse rate than its peers: at 100 h of synthetic capture, recall@10 against the exact search
-// rose from 0.74 to 0.77 with the seeds' phases kept.
-CoordinateView PhasedView(CoordinateView clip, int factor, int64_t phase) {
-  return CoarseView(clip.middle_rows(phase, clip.rows - phase), factor);
-}
-
-// A candidate's frames between PhasedView's (coarse) and the clip's own: x <-> x * factor + phase.
-void ToClipFrames(int factor, int64_t phase, SearchResult& candidate) {
-  const auto scale = [&](int64_t& frame) { frame = frame * factor + phase; };
-  scale(candidate.first_frame);
-  scale(candidate.last_frame);
-  scale(candidate.seed_frame);
-  for (int64_t& frame : candidate.path) scale(frame);
-}
-void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
-  const auto unscale = [&](int64_t& frame) { frame = (frame - phase) / factor; };
-  unscale(candidate.first_frame);
-  unscale(candidate.last_frame);
-  unscale(candidate.seed_frame);
-  for (int64_t& frame : candidate.path) unscale(frame);
-}
-
-// A score that no candidate above it can rank with among the max_results best of the
-// candidates seen, nor of any more to come: the k-th least of the clips' best scores. Each
-// clip's best is ranked whatever else overlaps it (ranking keeps the best of each clip, as one
-// clip's results never overlap another's), so the k-th ranked score is at most this, and more
-// candidates only lower it. (The k-th ranked score itself can rise with a new candidate that
-// suppresses two others.) The full-rate settles abandon their bands over it, which is not
-// exact (RefineFromCoarse): over a run of the benchmark on 10 h of real capture, 42 of 19,000
-// settles were given up that would have settled under it (within 4% of it: the tail of the
-// results), at 100 h 3 of 32,000; recall@10 and the result counts the same in every scenario
-// (bench/notes/2026-12-04-scale-settle-bound.md), for settles that cost half as much.
-class ClipBestScores {
- public:
-  explicit ClipBestScores(int k) : k_(k) {}
-  double bound() const { return bound_; }
-  void Add(int clip, double score) {
-    if (score >= bound_) return;
-    const auto [it, inserted] = best_.try_emplace(clip, score);
-    if (!inserted) it->second = std::min(it->second, score);
-    if (static_cast<int>(best_.size()) < k_) return;
-    scores_.clear();
-    for (const auto& [c, s] : best_) scores_.push_back(s);
-    std::nth_element(scores_.begin(), scores_.begin() + (k_ - 1), scores_.end());
-    bound_ = scores_[k_ - 1];
-  }
-
- private:
-  const int k_;
-  double bound_ = std::numeric_limits<double>::infinity();
-  absl::flat_hash_map<int, double> best_;
-  std::vector<double> scores_;
-};
-
-// What each member of a search's thread team keeps for itself (SearchParams::threads).
-struct MemberState {
-  StopPoll stop;
-  WarpWorkspace warps;
-  BandWorkspace bands;
-};
-
 // The pool's candidates (warps at 1 / `factor` of the library's rate with their paths, in clip
 // frames) moved to the best warps near them; from a coarse rate, the best of them are then
-// settled at the full rate. On several threads, the same candidates as on one: refinement
-// moves each candidate alone, and each settle is judged against the bound of the settles
-// before it in order (ThreadTeam::ParallelForInOrder).
+// settled at the full rate (those `filter` admits). On several threads, the same candidates as
+// on one: refinement moves each candidate alone, and the settles are judged in order
+// (SettleBest).
 absl::StatusOr<std::vector<SearchResult>> Refine(
     const LibraryIndex& library, CoordinateView query, int anchor, int coarse_anchor, int factor,
-    const WarpConstraints& constraints, const SearchParams& params,
+    const WarpConstraints& constraints, const SearchParams& params, const SearchFilter& filter,
     std::vector<SearchResult> candidates, ThreadTeam& team, std::vector<MemberState>& members) {
   MOTIONDB_RETURN_IF_ERROR(team.ParallelFor(
-      static_cast<int64_t>(candidates.size()), [&](int64_t i, int t) -> absl::Status {
+      static_cast<int64_t>(candidates.size()), [&](int64_t i, int m) -> absl::Status {
         SearchResult& candidate = candidates[i];
-        StopPoll& stop = members[t].stop;
+        StopPoll& stop = members[m].stop;
         if (stop.Done(static_cast<int64_t>(candidate.path.size()))) return SearchStopped();
         const int64_t phase = candidate.first_frame % factor;
         ToCoarseFrames(factor, phase, candidate);
         RefineCandidate(CoarseView(query, factor),
                         PhasedView(library.clip_coordinates(candidate.clip_index), factor, phase),
-                        coarse_anchor, library.rate() / factor, constraints, members[t].bands,
+                        coarse_anchor, library.rate() / factor, constraints, members[m].bands,
                         candidate, &stop);
         if (stop.stopped()) return SearchStopped();
         ToClipFrames(factor, phase, candidate);
@@ -226,59 +162,9 @@ absl::StatusOr<std::vector<SearchResult>> Refine(
     const size_t fine_pool =
         std::max<size_t>(params.max_results,
                          std::lround(FineShare(factor) * static_cast<double>(candidates.size())));
-    const int pool = static_cast<int>(candidates.size());
-    candidates = RankResults(std::move(candidates), params.max_overlap, pool);
-    // Settled candidates can converge on one place (70 s at 120 Hz: 19.9 results of 20 on
-    // average, the exact search 20), so while the settled hold fewer than max_results distinct
-    // places, the next best candidates are settled too.
-    std::vector<SearchResult> settled;
-    ClipBestScores ranked_above(params.max_results);
-    struct SettleAttempt {
-      SearchResult candidate;  // settled, or as it was
-      bool settled = false;
-      double abandon_score = 0;  // the bound it was settled against
-    };
-    std::vector<SettleAttempt> attempts(candidates.size());
-    const auto settle = [&](size_t i, double abandon_score, MemberState& member) {
-      SettleAttempt& s = attempts[i];
-      if (member.stop.Done(query.rows)) return SearchStopped();
-      s.candidate = candidates[i];
-      s.abandon_score = abandon_score;
-      s.settled =
-          RefineFromCoarse(query, library.clip_coordinates(s.candidate.clip_index), anchor, factor,
-                           constraints, abandon_score, member.bands, s.candidate, &member.stop);
-      return member.stop.stopped() ? SearchStopped() : absl::OkStatus();
-    };
-    const auto keep = [&](size_t i) {
-      if (!attempts[i].settled) return;
-      ranked_above.Add(attempts[i].candidate.clip_index, attempts[i].candidate.score);
-      settled.push_back(std::move(attempts[i].candidate));
-    };
-    // The bound only falls as settles are kept, so a settle given up against an older bound is
-    // given up against today's too; one kept against an older bound is settled again.
-    std::atomic<double> bound{ranked_above.bound()};
-    const size_t always_settled = std::min(fine_pool, candidates.size());
-    MOTIONDB_RETURN_IF_ERROR(team.ParallelForInOrder(
-        static_cast<int64_t>(always_settled),
-        [&](int64_t i, int t) { return settle(i, bound.load(), members[t]); },
-        [&](int64_t i, int t) -> absl::Status {
-          if (attempts[i].settled && attempts[i].abandon_score > ranked_above.bound()) {
-            MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), members[t]));
-          }
-          keep(i);
-          bound = ranked_above.bound();
-          return absl::OkStatus();
-        }));
-    for (size_t i = always_settled; i < candidates.size(); ++i) {
-      // A finite bound means max_results clips hold a settled result, each of them ranked.
-      if (std::isfinite(ranked_above.bound()) ||
-          RankedCount(settled, params.max_overlap, params.max_results) == params.max_results) {
-        break;
-      }
-      MOTIONDB_RETURN_IF_ERROR(settle(i, ranked_above.bound(), members[0]));
-      keep(i);
-    }
-    candidates = std::move(settled);
+    MOTIONDB_ASSIGN_OR_RETURN(
+        candidates, SettleBest(library, query, anchor, factor, constraints, params, filter,
+                               std::move(candidates), fine_pool, team, members));
   }
   if (!params.return_path) {
     for (SearchResult& candidate : candidates) candidate.path = {};
@@ -481,7 +367,7 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   std::vector<SearchResult> candidates = top.Take();
   if (params.refine) {
     MOTIONDB_ASSIGN_OR_RETURN(
-        candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params,
+        candidates, Refine(library, query, anchor, warp_anchor, factor, constraints, params, filter,
                            std::move(candidates), team, members));
   }
   stats.refine_ms = MillisecondsSince(stage);

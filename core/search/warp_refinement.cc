@@ -65,6 +65,21 @@ void Adopt(Warp warp, int anchor, SearchResult& candidate) {
 
 }  // namespace
 
+void ToClipFrames(int factor, int64_t phase, SearchResult& candidate) {
+  const auto scale = [&](int64_t& frame) { frame = frame * factor + phase; };
+  scale(candidate.first_frame);
+  scale(candidate.last_frame);
+  scale(candidate.seed_frame);
+  for (int64_t& frame : candidate.path) scale(frame);
+}
+void ToCoarseFrames(int factor, int64_t phase, SearchResult& candidate) {
+  const auto unscale = [&](int64_t& frame) { frame = (frame - phase) / factor; };
+  unscale(candidate.first_frame);
+  unscale(candidate.last_frame);
+  unscale(candidate.seed_frame);
+  for (int64_t& frame : candidate.path) unscale(frame);
+}
+
 void RefineCandidate(CoordinateView query, CoordinateView clip, int anchor, double rate,
                      const WarpConstraints& constraints, BandWorkspace& workspace,
                      SearchResult& candidate, StopPoll* stop) {

@@ -21,16 +21,33 @@
 
 namespace motiondb {
 
-// Offers to `top` the best warp of `query` ending at each frame of `clip`, the frames
-// first_frame.. of the library's clip `clip_index` (the whole clip: first_frame 0), that
-// `filter` admits, in the clip's frames. `bound()`: a warp cost (a sum over the query's frames)
+// The scan's buffers, kept by the caller across scans (one per thread), so that scans allocate
+// nothing once these have held the longest query and range: the shape search scans hundreds of
+// short ranges a query.
+struct ClipScanWorkspace {
+  struct Column {
+    std::vector<float> cost;     // m x s
+    std::vector<int64_t> start;  // clip frame of the path's first query frame
+    int64_t top = -1;            // highest row with a finite cost
+    int64_t best_start = 0;
+  };
+  std::vector<Column> ring;  // the last slope_limit + 1 columns
+  std::vector<float> lower_bound;
+  std::vector<float> box_low, box_high;  // per block of clip frames
+  std::vector<float> low, high;
+};
+
+// Offers to `top` the best warp of `query` ending at each row of `clip`, the frames
+// first_frame, first_frame + frame_step, ... of the library's clip `clip_index` (the whole clip:
+// first_frame 0, frame_step 1; a CoarseView of a range: its factor), that `filter` admits, in
+// the clip's frames. `bound()`: a warp cost (a sum over the query's frames)
 // that no result at or above it can rank with; paths that cannot stay under it and under `top`'s
 // threshold are dropped. Uses slope_limit and dtw_dims of `params`; `stop` is told every
 // column's cells. Adds its cells and skipped blocks to `stats`.
 absl::Status ScanClip(CoordinateView query, CoordinateView clip, int64_t first_frame,
-                      int clip_index, const SearchParams& params, const SearchFilter& filter,
-                      StopPoll& stop, absl::FunctionRef<float()> bound, StreamingTopResults& top,
-                      SearchStats& stats);
+                      int frame_step, int clip_index, const SearchParams& params,
+                      const SearchFilter& filter, StopPoll& stop, absl::FunctionRef<float()> bound,
+                      ClipScanWorkspace& workspace, StreamingTopResults& top, SearchStats& stats);
 
 // The k best results of the clips (or disjoint ranges of clips) scanned so far, shared by the
 // scanning threads, and the warp cost bound they set for the clips still being scanned.
@@ -63,8 +80,10 @@ class FinishedClips {
 // Gives each result its path. The scan keeps no back-pointers (a column of costs and starts
 // per clip frame); a result is the best warp ending at its last frame, which is what a warp
 // anchored at the query's last frame there computes again, with its path, for k results only.
+// `factor`: the scan's frame_step, `query` then the CoarseView the scan warped (the results'
+// frames and paths stay the clip's own).
 absl::Status AddPaths(const LibraryIndex& library, CoordinateView query, const SearchParams& params,
-                      std::vector<SearchResult>& results);
+                      int factor, std::vector<SearchResult>& results);
 
 }  // namespace motiondb
 
