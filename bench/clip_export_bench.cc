@@ -127,15 +127,18 @@ void BM_EulerDecomposition(benchmark::State& state) {
   ReportFrames(state, kRangeFrames);
 }
 
-// server::ExportClip: the range read and decoded alone, its BVH and the file name.
+// server::ExportClip: the range read and decoded alone, its file (BVH, or binary glTF with
+// the argument 1) and the file name.
 void BM_ExportClip(benchmark::State& state) {
   Fixture& fixture = TheFixture();
   const server::ClipSelection range{fixture.clip_id, 0, kRangeFrames - 1};
+  const server::ExportFormat format =
+      state.range(0) == 1 ? server::ExportFormat::kGlb : server::ExportFormat::kBvh;
   for (auto _ : state) {
-    absl::StatusOr<server::ExportedBvh> exported =
-        server::ExportClip(*fixture.database, range, server::AnswerLimit(), [] { return false; });
+    absl::StatusOr<server::ExportedFile> exported = server::ExportClip(
+        *fixture.database, range, format, server::AnswerLimit(), [] { return false; });
     if (!exported.ok()) return Fail(state, exported.status());
-    benchmark::DoNotOptimize(exported->bvh.data());
+    benchmark::DoNotOptimize(exported->bytes.data());
   }
   ReportFrames(state, kRangeFrames);
 }
@@ -144,14 +147,14 @@ void BM_ExportClip(benchmark::State& state) {
 // (the client).
 void BM_ExportClipResponseCopies(benchmark::State& state) {
   Fixture& fixture = TheFixture();
-  absl::StatusOr<server::ExportedBvh> exported =
+  absl::StatusOr<server::ExportedFile> exported =
       server::ExportClip(*fixture.database, {fixture.clip_id, 0, kRangeFrames - 1},
-                         server::AnswerLimit(), [] { return false; });
+                         server::ExportFormat::kBvh, server::AnswerLimit(), [] { return false; });
   if (!exported.ok()) return Fail(state, exported.status());
   std::string wire;
   for (auto _ : state) {
     v1::ExportClipResponse response;
-    response.set_bvh(exported->bvh);
+    response.set_bvh(exported->bytes);
     response.SerializeToString(&wire);
     v1::ExportClipResponse received;
     if (!received.ParseFromString(wire)) return Fail(state, absl::DataLossError("parse"));
@@ -164,7 +167,7 @@ BENCHMARK(BM_GetClip)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WriteBvh)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FormatNumbers)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EulerDecomposition)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ExportClip)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ExportClip)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ExportClipResponseCopies)->Unit(benchmark::kMillisecond);
 
 // Stores the file's clip in a fresh database in a temporary folder. False (after saying why)

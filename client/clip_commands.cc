@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
@@ -309,7 +310,17 @@ struct ExportFlags {
   int64_t id = 0;
   FrameRangeFlags range;
   std::string out;
+  std::string format;  // empty: by the file's extension (.gltf, .glb), else BVH
 };
+
+// The export's format: --format, else the output file's extension.
+std::string ExportFormatOf(const ExportFlags& flags) {
+  if (!flags.format.empty()) return flags.format;
+  for (const char* format : {"gltf", "glb"}) {
+    if (absl::EndsWithIgnoreCase(flags.out, absl::StrCat(".", format))) return format;
+  }
+  return "bvh";
+}
 
 // ExportClipStream: the file written as its pieces arrive, so that a clip of any size exports
 // while the client holds a piece of it; renamed into place only once whole.
@@ -318,6 +329,7 @@ absl::Status Export(const ExportFlags& flags, bool json, const ServerConnection&
   request.mutable_clip()->set_clip_id(flags.id);
   if (flags.range.from) request.mutable_clip()->set_first_frame(*flags.range.from);
   if (flags.range.to) request.mutable_clip()->set_last_frame(*flags.range.to);
+  request.set_format(ExportFormatOf(flags));
   v1::ClipService::Stub stub(connection.channel());
   AtomicFileWriter file(flags.out);
   absl::Status written;
@@ -473,15 +485,20 @@ void AddClipCommands(Commands& commands) {
 
   auto flags = std::make_shared<ExportFlags>();
   CLI::App* exporter = commands.AddServer(commands.root(), "export",
-                                          "download a clip, or a range of it, as a BVH file",
+                                          "download a clip, or a range of it (a hit), as a BVH "
+                                          "or glTF file",
                                           [flags, &global](const ServerConnection& connection) {
                                             return Export(*flags, global.json, connection);
                                           });
   AddClipId(exporter, &flags->id);
   AddFrameRangeFlags(exporter, "the clip", &flags->range);
-  exporter->add_option("-o,--out", flags->out, "the BVH file to write")
+  exporter->add_option("-o,--out", flags->out, "the file to write")
       ->type_name("OUT.bvh")
       ->required();
+  OneOf(exporter->add_option("--format", flags->format,
+                             "bvh, gltf (its buffer embedded) or glb (binary glTF), which "
+                             "three.js and DCCs read (default: by OUT's extension, else bvh)"),
+        {"bvh", "gltf", "glb"});
 }
 
 }  // namespace motiondb::cli

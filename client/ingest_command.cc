@@ -1,7 +1,8 @@
 // motiondb ingest PATH... [--tag T]... [--recursive] [--name N] [--on-conflict error|skip|replace]
 // [--json]
-// Uploads BVH files, or the .bvh files of folders, to the server. Each file's error is listed
-// while the others continue; the exit code is 1 if any failed.
+// Uploads motion files (BVH, FBX, glTF), or those of folders, to the server: a clip a BVH, a
+// clip a take of an FBX or glTF file. Each file's error is listed while the others continue;
+// the exit code is 1 if any failed.
 #include <unistd.h>
 
 #include <algorithm>
@@ -25,24 +26,24 @@ namespace fs = std::filesystem;
 
 // Files larger than this are streamed in chunks of this size.
 constexpr size_t kChunkBytes = 1 << 20;
-// Larger than any BVH file a studio will have; the server has its own limit.
+// Larger than any motion file a studio will have; the server has its own limit.
 constexpr int64_t kMaxFileBytes = int64_t{4} << 30;
 
-bool IsBvh(const fs::path& path) {
+bool IsMotionFile(const fs::path& path) {
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-  return extension == ".bvh";
+  return extension == ".bvh" || extension == ".fbx" || extension == ".glb" || extension == ".gltf";
 }
 
 // A file to upload, and the clip name to ask for: empty for a file named directly (the server
-// takes its base name), else its path relative to the folder named, without `.bvh`, so that
+// takes its base name), else its path relative to the folder named, without its extension, so that
 // takes of one name in several session folders ("session1/take_001") do not collide.
 struct FileToIngest {
   fs::path path;
   std::string name;
 };
 
-// The files named, and the .bvh files of the folders named (their subfolders too with
+// The files named, and the motion files of the folders named (their subfolders too with
 // `recursive`), sorted within each folder. Paths that do not exist are kept, to fail later.
 std::vector<FileToIngest> ExpandPaths(const std::vector<std::string>& paths, bool recursive) {
   std::vector<FileToIngest> files;
@@ -54,7 +55,7 @@ std::vector<FileToIngest> ExpandPaths(const std::vector<std::string>& paths, boo
     }
     std::vector<FileToIngest> found;
     const auto add = [&](const fs::directory_entry& entry) {
-      if (!entry.is_regular_file() || !IsBvh(entry.path())) return;
+      if (!entry.is_regular_file() || !IsMotionFile(entry.path())) return;
       // generic_string: '/' between the segments whatever the platform writes.
       found.push_back({entry.path(),
                        entry.path().lexically_relative(name).replace_extension().generic_string()});
@@ -173,20 +174,37 @@ absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection&
       std::cerr << "motiondb ingest: " << path.string() << ": " << error << "\n";
       failed.push_back({{"file", path.string()}, {"error", error}});
     } else {
-      const v1::Clip& clip = response.clip();
-      ingested.push_back({{"file", path.string()},
-                          {"clip_id", clip.clip_id()},
-                          {"name", clip.name()},
-                          {"result", ResultName(response.result())},
-                          {"frames", clip.frame_count()},
-                          {"fps", clip.fps()},
-                          {"warnings", std::vector<std::string>(response.warnings().begin(),
-                                                                response.warnings().end())}});
-      if (response.result() == v1::INGEST_RESULT_REPLACED) {
-        ingested.back()["replaced_clip_id"] = response.replaced_clip_id();
+      // A file of several takes answers with a clip for each.
+      std::vector<const v1::IngestClipResponse*> takes = {&response};
+      for (const v1::IngestClipResponse& take : response.more_takes()) takes.push_back(&take);
+      for (const v1::IngestClipResponse* take : takes) {
+        const v1::Clip& clip = take->clip();
+        ingested.push_back({{"file", path.string()},
+                            {"clip_id", clip.clip_id()},
+                            {"name", clip.name()},
+                            {"result", ResultName(take->result())},
+                            {"frames", clip.frame_count()},
+                            {"fps", clip.fps()},
+                            {"warnings", std::vector<std::string>(take->warnings().begin(),
+                                                                  take->warnings().end())}});
+        if (!take->take().empty()) ingested.back()["take"] = take->take();
+        if (take->result() == v1::INGEST_RESULT_REPLACED) {
+          ingested.back()["replaced_clip_id"] = take->replaced_clip_id();
+        }
+        for (const std::string& warning : take->warnings()) {
+          std::cerr << "motiondb ingest: " << path.string() << ": warning: " << warning << "\n";
+        }
+        if (!json && !progress_bar) {
+          std::cout << absl::StrFormat("[%zu/%zu] %s -> clip %d '%s' (%d frames): %s\n", i + 1,
+                                       files.size(), path.string(), clip.clip_id(), clip.name(),
+                                       clip.frame_count(),
+                                       DescribeResult(*take, flags.on_conflict));
+        }
       }
-      for (const std::string& warning : response.warnings()) {
-        std::cerr << "motiondb ingest: " << path.string() << ": warning: " << warning << "\n";
+      if (const v1::FileFacts& facts = response.file(); !json && !facts.up_axis().empty()) {
+        std::cout << absl::StrFormat(
+            "  %s, %g m a unit, %s up%s%s\n", facts.format(), facts.unit_m(), facts.up_axis(),
+            facts.generator().empty() ? "" : ", written by ", facts.generator());
       }
     }
     if (progress_bar) {
@@ -195,18 +213,14 @@ absl::Status Ingest(const IngestFlags& flags, bool json, const ServerConnection&
                                    std::string(width - done, ' '), i + 1, files.size(),
                                    path.filename().string())
                 << std::flush;
-    } else if (!json && error.empty()) {
-      std::cout << absl::StrFormat("[%zu/%zu] %s -> clip %d '%s' (%d frames): %s\n", i + 1,
-                                   files.size(), path.string(), response.clip().clip_id(),
-                                   response.clip().name(), response.clip().frame_count(),
-                                   DescribeResult(response, flags.on_conflict));
     }
   }
   if (progress_bar) std::cerr << "\n";
   if (json) {
     std::cout << nlohmann::json{{"ingested", ingested}, {"failed", failed}}.dump() << "\n";
   } else {
-    std::cout << absl::StrFormat("ingested %zu of %zu files", ingested.size(), files.size())
+    std::cout << absl::StrFormat("ingested %zu of %zu files", files.size() - failed.size(),
+                                 files.size())
               << (failed.empty() ? "" : absl::StrFormat(", %zu failed", failed.size())) << "\n";
   }
   return failed.empty() ? absl::OkStatus() : ReportedFailure();
@@ -218,17 +232,18 @@ void AddIngest(Commands& commands) {
   auto flags = std::make_shared<IngestFlags>();
   const GlobalOptions& global = commands.global();
   CLI::App* ingest = commands.AddServer(commands.root(), "ingest",
-                                        "upload BVH files, or the .bvh files of folders",
+                                        "upload motion files (BVH, FBX, glTF), or those of folders",
                                         [flags, &global](const ServerConnection& connection) {
                                           return Ingest(*flags, global.json, connection);
                                         });
-  ingest->add_option("PATH", flags->paths, "BVH files or folders")->required();
+  ingest->add_option("PATH", flags->paths, "BVH, FBX, .glb or .gltf files, or folders")->required();
   ingest->add_option("--tag", flags->tags, "tag every clip with T; repeat for more")
       ->type_name("T")
       ->allow_extra_args(false);
   ingest->add_flag("--recursive", flags->recursive,
                    "the folders' subfolders too; a clip found in a folder is named by its path "
-                   "relative to the folder, without .bvh (session1/take_001)");
+                   "relative to the folder, without its extension (session1/take_001); a take of "
+                   "a file of several takes (FBX, glTF) stores each as NAME/TAKE");
   ingest->add_option("--name", flags->name, "the clip's name instead of the file's (one file only)")
       ->type_name("N");
   OneOf(ingest->add_option("--on-conflict", flags->on_conflict,

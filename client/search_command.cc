@@ -242,7 +242,7 @@ void AddSearch(Commands& commands) {
   const CLI::Option* clip = search->add_option("--clip", flags->clip, "the query: a stored clip")
                                 ->type_name("ID")
                                 ->check(WholeAtLeast(1));
-  const CLI::Option* bvh = search->add_option("--bvh", flags->bvh, "... or a BVH file")
+  const CLI::Option* bvh = search->add_option("--bvh", flags->bvh, "... or a motion file (BVH, or an FBX or glTF file of one take)")
                                ->type_name("FILE")
                                ->check(ExistingFile());
   search->final_callback([clip, bvh] {

@@ -1,6 +1,7 @@
-// Exporting a stored clip, or a range of it, as a BVH file: whole in one answer
-// (ClipService.ExportClip), within the server's answer limit, or written piece by piece as its
-// frames are read (ExportClipStream), whatever its size.
+// Exporting a stored clip, or a range of it (a search's hit), as a BVH or glTF file: whole in
+// one answer (ClipService.ExportClip), within the server's answer limit, or in pieces
+// (ExportClipStream): a BVH written as its frames are read, whatever its size; a glTF file,
+// whose header counts every frame, made whole within the answer limit and sent in pieces.
 #ifndef MOTIONDB_SERVER_CLIP_EXPORT_H_
 #define MOTIONDB_SERVER_CLIP_EXPORT_H_
 
@@ -25,30 +26,39 @@ inline constexpr int kBvhAnswerThreads = 0;
 // message's costs vanish.
 inline constexpr int64_t kExportPieceBytes = int64_t{1} << 20;
 
-struct ExportedBvh {
-  // Suggested: "<name>.bvh", or "<name>_<first>-<last>.bvh" for a range, with each '/' (or
-  // backslash) in the name as '_': "session1/take_001" suggests "session1_take_001.bvh".
+enum class ExportFormat {
+  kBvh,
+  kGltf,  // a .gltf, its buffer embedded
+  kGlb,   // a binary glTF
+};
+
+struct ExportedFile {
+  // Suggested: "<name>.bvh" (.gltf, .glb), or "<name>_<first>-<last>.bvh" for a range, with
+  // each '/' (or backslash) in the name as '_': "session1/take_001" suggests
+  // "session1_take_001.bvh".
   std::string file_name;
-  std::string bvh;
+  std::string bytes;
   FrameRange frames;  // at the clip's rate
 };
 
 // NOT_FOUND for an unknown clip; INVALID_ARGUMENT naming "clip" for a range outside it;
-// RESOURCE_EXHAUSTED, before the frames are read, when the text could exceed `answers` (the
-// error names the streamed export); CANCELLED once `should_stop` says so. The text is
-// StreamClipExport's pieces joined.
-absl::StatusOr<ExportedBvh> ExportClip(storage::Database& database, const ClipSelection& selection,
-                                       const AnswerLimit& answers,
-                                       const std::function<bool()>& should_stop);
+// RESOURCE_EXHAUSTED, before the frames are read, when the file could exceed `answers` (the
+// error names the streamed export, for a BVH); CANCELLED once `should_stop` says so. The file
+// is StreamClipExport's pieces joined.
+absl::StatusOr<ExportedFile> ExportClip(storage::Database& database, const ClipSelection& selection,
+                                        ExportFormat format, const AnswerLimit& answers,
+                                        const std::function<bool()>& should_stop);
 
-// The text ExportClip makes, of any length, handed to `emit` in pieces as the frames are read in
-// batches (storage::Database::ReadClipFrames): memory holds a piece whatever the clip's size.
-// The first piece carries file_name and frames, and the header; each other piece (file name
-// empty) the rows of frames, at most kExportPieceBytes long. `emit`'s first error (a client gone)
-// ends the export and is returned; `should_stop` is asked before each piece (CANCELLED). Errors
-// before the first piece as ExportClip's.
+// The file ExportClip makes handed to `emit` in pieces of at most kExportPieceBytes. A BVH, of
+// any length, as the frames are read in batches (storage::Database::ReadClipFrames): memory
+// holds a piece whatever the clip's size; the first piece carries file_name and frames, and the
+// header, each other piece (file name empty) the rows of frames. A glTF file is made whole
+// first, within `answers`. `emit`'s first error (a client gone) ends the export and is
+// returned; `should_stop` is asked before each piece (CANCELLED). Errors before the first piece
+// as ExportClip's.
 absl::Status StreamClipExport(storage::Database& database, const ClipSelection& selection,
-                              const std::function<absl::Status(ExportedBvh piece)>& emit,
+                              ExportFormat format, const AnswerLimit& answers,
+                              const std::function<absl::Status(ExportedFile piece)>& emit,
                               const std::function<bool()>& should_stop);
 
 }  // namespace motiondb::server

@@ -1,5 +1,5 @@
-// Ingesting an uploaded BVH file (ClipService.IngestClip and IngestClipStream): the clip's name,
-// the parse, and the catalogue write that stores and indexes it.
+// Ingesting an uploaded motion file (ClipService.IngestClip and IngestClipStream): the clips'
+// names, the parse, and the catalogue writes that store and index them, a clip a take.
 #ifndef MOTIONDB_SERVER_CLIP_INGEST_H_
 #define MOTIONDB_SERVER_CLIP_INGEST_H_
 
@@ -19,7 +19,8 @@ struct IngestRequest {
   // The uploaded file's name, as the client knows it (required; errors begin with it).
   std::string file_name;
   // The clip's name, which may be a relative path ("session1/take_001"); empty: the file name
-  // without folders and ".bvh".
+  // without folders and its extension (".bvh", ".fbx", ".glb", ".gltf"). A file of several
+  // takes stores each as this name, '/', and the take's name.
   std::string name;
   std::vector<std::string> tags;
   // When a clip of that name exists.
@@ -34,22 +35,34 @@ struct IngestOutcome {
   // The reader's (e.g. a Frames: header that disagrees), then one line a duplicate.
   std::vector<std::string> warnings;
   std::vector<std::string> spaces;  // projected into
+  std::string take;                 // the file's animation it holds; empty for a BVH
+};
+
+// A file's clips, one a take in the file's order, and what the file said of itself.
+struct IngestedFile {
+  std::vector<IngestOutcome> clips;
+  MotionFileFormat format = MotionFileFormat::kBvh;
+  double unit_m = 0;  // UploadedFile's
+  char up_axis = 0;
+  std::string generator;
 };
 
 // The clip's name for `request`; INVALID_ARGUMENT without a file name, or when the file name
 // leaves no name. Lengths and characters of names and tags are the database's to check.
 absl::StatusOr<std::string> ClipName(const IngestRequest& request);
 
-// Parses, stores and indexes one uploaded file, or skips it. `should_stop` is asked while the
-// file is parsed (ReadUpload) and before the catalogue commits (Catalog::IngestClip).
-absl::StatusOr<IngestOutcome> IngestUpload(Catalog& catalog, const IngestRequest& request,
-                                           absl::string_view bvh, const UploadLimits& limits,
-                                           const std::function<bool()>& should_stop = {});
+// Parses, stores and indexes one uploaded file, a clip a take, or skips them. `should_stop` is
+// asked while the file is parsed (ReadUpload) and before the catalogue commits each take
+// (Catalog::IngestClip). Every take is parsed before the first is stored; a take that fails
+// to store leaves the takes before it stored, and its error names them.
+absl::StatusOr<IngestedFile> IngestUpload(Catalog& catalog, const IngestRequest& request,
+                                          absl::string_view bytes, const UploadLimits& limits,
+                                          const std::function<bool()>& should_stop = {});
 
 // The same for a file parsed as it arrived (StreamedUpload).
-absl::StatusOr<IngestOutcome> IngestParsedUpload(Catalog& catalog, const IngestRequest& request,
-                                                 BvhReadResult read,
-                                                 const std::function<bool()>& should_stop = {});
+absl::StatusOr<IngestedFile> IngestParsedUpload(Catalog& catalog, const IngestRequest& request,
+                                                UploadedFile file,
+                                                const std::function<bool()>& should_stop = {});
 
 }  // namespace motiondb::server
 

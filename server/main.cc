@@ -46,6 +46,8 @@ struct ServerFlags {
   int min_upload_kbps = 64;
   int max_bvh_mb = 0;
   int max_upload_buffer_mb = 0;
+  int max_import_mb = 0;
+  int max_import_s = 0;
   std::string auth_token_file, tls_cert, tls_key;
   bool quiet = false;
 };
@@ -133,8 +135,20 @@ void AddFlags(CLI::App& app, motiondb::server::ServerOptions* options, ServerFla
          "largest answer, in MiB: larger ones are refused before they are made", "MB", 1,
          motiondb::server::kMaxAnswerMbCeiling);
   flags->max_bvh_mb = static_cast<int>(options->uploads.max_bvh_bytes >> 20);
-  number("--max-bvh-mb", flags->max_bvh_mb, "largest BVH upload, streamed or not, in MiB", "MB", 1,
+  number("--max-bvh-mb", flags->max_bvh_mb,
+         "largest motion file upload (BVH, FBX, glTF), streamed or not, in MiB", "MB", 1, 1 << 20);
+  app.add_option("--scene-importer", options->uploads.scene_importer,
+                 "the program that reads FBX and glTF uploads, in a process of its own (default: "
+                 "motiondb-scene-import beside this program)")
+      ->type_name("PATH");
+  flags->max_import_mb = static_cast<int>(options->uploads.max_import_bytes >> 20);
+  number("--max-import-mb", flags->max_import_mb,
+         "memory (address space) an FBX or glTF file's reading may take, in MiB", "MB", 64,
          1 << 20);
+  flags->max_import_s = static_cast<int>(
+      std::chrono::duration_cast<std::chrono::seconds>(options->uploads.max_import_time).count());
+  number("--max-import-s", flags->max_import_s,
+         "longest an FBX or glTF file's reading may take, in seconds", "S", 1, 1 << 20);
   number("--max-uploads", options->uploads.max_uploads, "most ingests in progress at once", "N", 1,
          1 << 16);
   flags->max_upload_buffer_mb = static_cast<int>(options->uploads.max_buffered_bytes >> 20);
@@ -209,6 +223,8 @@ void FitConnectionsToDescriptors(const CLI::App& app, motiondb::server::Connecti
 absl::Status ReadFlagFiles(const ServerFlags& flags, motiondb::server::ServerOptions* options) {
   options->uploads.max_bvh_bytes = int64_t{flags.max_bvh_mb} << 20;
   options->uploads.max_buffered_bytes = int64_t{flags.max_upload_buffer_mb} << 20;
+  options->uploads.max_import_bytes = int64_t{flags.max_import_mb} << 20;
+  options->uploads.max_import_time = std::chrono::seconds(flags.max_import_s);
   options->uploads.min_bytes_per_s = flags.min_upload_kbps * 1024.0;
   options->uploads.rate_grace = std::chrono::seconds(flags.http_request_timeout_s);
   if (!flags.auth_token_file.empty()) {

@@ -105,9 +105,14 @@ absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapsho
 absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnapshot& snapshot,
                                     const UploadLimits& limits, int max_rows,
                                     const std::function<bool()>& should_stop) {
-  MOTIONDB_ASSIGN_OR_RETURN(const BvhReadResult read,
+  MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile read,
                             ReadUpload(upload.bvh, "bvh", limits, should_stop));
-  const Clip& clip = read.clip;
+  if (read.takes.size() != 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("bvh: the file holds ", read.takes.size(),
+                     " takes; a query is one (ingest the file and query a take by its clip)"));
+  }
+  const Clip& clip = read.takes[0].clip;
   if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
     return absl::FailedPreconditionError(absl::StrCat(
         "bvh: the query's skeleton (", clip.skeleton().joint_count(), " joints, root '",

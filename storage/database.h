@@ -54,6 +54,14 @@ struct DatabaseOptions {
 };
 
 // A clip as stored: its frames, and what the catalogue shows.
+// What an uploaded file said of itself, kept with each of its clips: an FBX or glTF file its
+// format, unit and up axis; a BVH says nothing (empty and 0).
+struct SourceFacts {
+  std::string format;   // "fbx", "gltf", "glb"; empty for a BVH or an operator's clip
+  double unit_m = 0;    // metres per unit of the clip's positions; 0: not said
+  std::string up_axis;  // "X", "Y" or "Z" as the file had it (the clip is stored Y up)
+};
+
 struct ClipRecord {
   int64_t clip_id = 0;  // assigned by InsertClip
   // Unique. Printable text (util/name_text.h) of 1 to 512 bytes; '/' separates the segments of
@@ -72,6 +80,7 @@ struct ClipRecord {
   // Where a clip made by an operator came from, as JSON text the application writes and reads
   // (server/edit/provenance.h); empty for an ingested clip. Stored as given.
   std::string provenance;
+  SourceFacts source_facts;  // stored as given
 };
 
 // What every write may be told. A write is checked once its transaction is ready to commit, so

@@ -114,8 +114,10 @@ absl::Status WriteRotations(SqliteConnection& db, int64_t clip_id, const RowMatr
 // kClipRecordColumns of clips as `c`.
 // The text a clip's record holds: what ClipFilter::max_text_bytes counts.
 int64_t TextBytes(const ClipRecord& record) {
-  int64_t bytes = static_cast<int64_t>(record.name.size() + record.source_file.size() +
-                                       record.content_hash.size() + record.provenance.size());
+  int64_t bytes =
+      static_cast<int64_t>(record.name.size() + record.source_file.size() +
+                           record.content_hash.size() + record.provenance.size() +
+                           record.source_facts.format.size() + record.source_facts.up_axis.size());
   for (const std::string& tag : record.tags) bytes += static_cast<int64_t>(tag.size());
   return bytes;
 }
@@ -290,6 +292,17 @@ absl::StatusOr<int64_t> Database::InsertClip(
                                  .BindText(13, record.provenance)
                                  .Run());
     clip_id = db.last_insert_rowid();
+    if (!record.source_facts.format.empty()) {
+      MOTIONDB_ASSIGN_OR_RETURN(
+          SqliteStatement source,
+          db.Prepare("INSERT INTO clip_sources (clip_id, format, unit_m, up_axis) "
+                     "VALUES (?, ?, ?, ?)"));
+      MOTIONDB_RETURN_IF_ERROR(source.BindInt64(1, clip_id)
+                                   .BindText(2, record.source_facts.format)
+                                   .BindDouble(3, record.source_facts.unit_m)
+                                   .BindText(4, record.source_facts.up_axis)
+                                   .Run());
+    }
     MOTIONDB_RETURN_IF_ERROR(WriteRotations(db, clip_id, clip.rotations()));
     MOTIONDB_RETURN_IF_ERROR(InsertTags(db, clip_id, tags));
     return InsertProjectionsOfClip(db, clip_id, skeleton_id, projections);

@@ -23,6 +23,9 @@ ClipRecord ReadClipRecord(const SqliteStatement& row) {
   record.joint_count = static_cast<int>(row.ColumnInt64(7));
   record.content_hash = row.ColumnText(8);
   record.provenance = row.ColumnText(9);
+  record.source_facts.format = row.ColumnText(10);
+  record.source_facts.unit_m = row.ColumnDouble(11);
+  record.source_facts.up_axis = row.ColumnText(12);
   return record;
 }
 

@@ -238,6 +238,17 @@ CREATE TABLE skeleton_slot_overrides (
 ) WITHOUT ROWID;
 )sql";
 
+// What an FBX or glTF file said of itself (issue 40), kept for each of its clips. A table of
+// its own: a column of clips would follow the rotations and must hold no bytes (migration 5).
+constexpr const char* kMigration8 = R"sql(
+CREATE TABLE clip_sources (
+  clip_id INTEGER PRIMARY KEY REFERENCES clips (clip_id) ON DELETE CASCADE,
+  format TEXT NOT NULL CHECK (length(format) > 0),
+  unit_m REAL NOT NULL CHECK (unit_m >= 0),
+  up_axis TEXT NOT NULL
+);
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -289,6 +300,7 @@ constexpr std::array kMigrations = {
     Migration{kMigration5, CopyRotationsLast, kMigration5Finish},
     Migration{kMigration6},
     Migration{kMigration7},
+    Migration{kMigration8},
 };
 // clang-format on
 

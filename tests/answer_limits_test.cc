@@ -265,26 +265,46 @@ TEST_F(AnswerLimitTest, ClipFramesReadInBatchesAreTheStoredFrames) {
 
 TEST_F(AnswerLimitTest, ExportIsRefusedPastTheLimitAndStreamsAnySize) {
   const int64_t id = library->ids[0];
+  ExportFormat format = ExportFormat::kBvh;
+  int64_t limit = kLimit;
   const auto probe = [&](int frames) {
     v1::ClipRange range = Range(0, 0, frames - 1);
-    absl::StatusOr<ExportedBvh> exported =
-        ExportClip(*library->database, FromProto(range), AnswerLimit(kLimit), kNever);
+    absl::StatusOr<ExportedFile> exported =
+        ExportClip(*library->database, FromProto(range), format, AnswerLimit(limit), kNever);
     if (!exported.ok()) return exported.status();
     v1::ExportClipResponse response;
     ToProto(*std::move(exported), &response);
-    EXPECT_LE(static_cast<int64_t>(response.ByteSizeLong()), kLimit);
+    EXPECT_LE(static_cast<int64_t>(response.ByteSizeLong()), limit);
     return absl::OkStatus();
   };
   const int admitted = LargestAdmitted(1, kFrames, probe);
   const absl::Status refused =
-      ExportClip(*library->database, {id, 0, admitted}, AnswerLimit(kLimit), kNever).status();
+      ExportClip(*library->database, {id, 0, admitted}, format, AnswerLimit(kLimit), kNever)
+          .status();
   EXPECT_THAT(refused.message(), HasSubstr("ExportClipStream"));
   // The bound is an upper bound, not a wild one: the largest text admitted takes a good part
   // of the limit.
-  const absl::StatusOr<ExportedBvh> largest =
-      ExportClip(*library->database, {id, 0, admitted - 1}, AnswerLimit(kLimit), kNever);
+  const absl::StatusOr<ExportedFile> largest =
+      ExportClip(*library->database, {id, 0, admitted - 1}, format, AnswerLimit(kLimit), kNever);
   ASSERT_TRUE(largest.ok());
-  EXPECT_GE(static_cast<int64_t>(largest->bvh.size()), (kLimit - kAnswerFixedBytes) / 2);
+  EXPECT_GE(static_cast<int64_t>(largest->bytes.size()), (kLimit - kAnswerFixedBytes) / 2);
+
+  // A glTF file is made whole, streamed or not: both are bounded, the bound not a wild one. Its
+  // binary numbers are terser than BVH text: a limit of half the whole clip's file.
+  format = ExportFormat::kGlb;
+  const absl::StatusOr<ExportedFile> whole_glb = ExportClip(
+      *library->database, {id, std::nullopt, std::nullopt}, format, AnswerLimit(), kNever);
+  ASSERT_TRUE(whole_glb.ok()) << whole_glb.status();
+  limit = kAnswerFixedBytes + static_cast<int64_t>(whole_glb->bytes.size()) / 2;
+  const int admitted_glb = LargestAdmitted(1, kFrames, probe);
+  const absl::StatusOr<ExportedFile> largest_glb =
+      ExportClip(*library->database, {id, 0, admitted_glb - 1}, format, AnswerLimit(limit), kNever);
+  ASSERT_TRUE(largest_glb.ok());
+  EXPECT_GE(static_cast<int64_t>(largest_glb->bytes.size()), (limit - kAnswerFixedBytes) / 2);
+  const absl::Status streamed_glb = StreamClipExport(
+      *library->database, {id, 0, admitted_glb}, format, AnswerLimit(limit),
+      [](ExportedFile) { return absl::OkStatus(); }, kNever);
+  EXPECT_EQ(streamed_glb.code(), absl::StatusCode::kResourceExhausted) << streamed_glb;
 
   // The stream's pieces: the header with the file name first, then rows of at most a piece's
   // bytes, joined the stored clip's WriteBvh text; the unary export is the same text.
@@ -293,12 +313,13 @@ TEST_F(AnswerLimitTest, ExportIsRefusedPastTheLimitAndStreamsAnySize) {
   const absl::StatusOr<std::string> expected = WriteBvh(stored->clip);
   ASSERT_TRUE(expected.ok());
   std::string streamed;
-  std::vector<ExportedBvh> pieces;
+  std::vector<ExportedFile> pieces;
   ASSERT_TRUE(StreamClipExport(
-                  *library->database, {id, std::nullopt, std::nullopt},
-                  [&](ExportedBvh piece) {
-                    streamed += piece.bvh;
-                    piece.bvh.resize(std::min<size_t>(piece.bvh.size(), 16));
+                  *library->database, {id, std::nullopt, std::nullopt}, ExportFormat::kBvh,
+                  AnswerLimit(kLimit),
+                  [&](ExportedFile piece) {
+                    streamed += piece.bytes;
+                    piece.bytes.resize(std::min<size_t>(piece.bytes.size(), 16));
                     pieces.push_back(std::move(piece));
                     return absl::OkStatus();
                   },
@@ -309,16 +330,17 @@ TEST_F(AnswerLimitTest, ExportIsRefusedPastTheLimitAndStreamsAnySize) {
   EXPECT_EQ(pieces[0].file_name, "take1.bvh");
   EXPECT_EQ(pieces[0].frames.last, kFrames - 1);
   EXPECT_EQ(pieces[1].file_name, "");
-  const absl::StatusOr<ExportedBvh> whole =
-      ExportClip(*library->database, {id, std::nullopt, std::nullopt}, AnswerLimit(), kNever);
+  const absl::StatusOr<ExportedFile> whole =
+      ExportClip(*library->database, {id, std::nullopt, std::nullopt}, ExportFormat::kBvh,
+                 AnswerLimit(), kNever);
   ASSERT_TRUE(whole.ok());
-  EXPECT_EQ(whole->bvh, *expected);
+  EXPECT_EQ(whole->bytes, *expected);
   // A range streams the range's text.
   std::string range_text;
   ASSERT_TRUE(StreamClipExport(
-                  *library->database, {id, 100, 250},
-                  [&](ExportedBvh piece) {
-                    range_text += piece.bvh;
+                  *library->database, {id, 100, 250}, ExportFormat::kBvh, AnswerLimit(),
+                  [&](ExportedFile piece) {
+                    range_text += piece.bytes;
                     return absl::OkStatus();
                   },
                   kNever)
@@ -326,18 +348,18 @@ TEST_F(AnswerLimitTest, ExportIsRefusedPastTheLimitAndStreamsAnySize) {
   EXPECT_EQ(range_text, *WriteBvh(stored->clip, FrameRange{100, 250}));
   // Stopped between pieces, and by the receiver.
   int calls = 0;
-  const auto count = [&](ExportedBvh) {
+  const auto count = [&](ExportedFile) {
     ++calls;
     return absl::OkStatus();
   };
-  EXPECT_EQ(StreamClipExport(*library->database, {id, std::nullopt, std::nullopt}, count,
-                             [] { return true; })
+  EXPECT_EQ(StreamClipExport(*library->database, {id, std::nullopt, std::nullopt},
+                             ExportFormat::kBvh, AnswerLimit(), count, [] { return true; })
                 .code(),
             absl::StatusCode::kCancelled);
   EXPECT_EQ(calls, 1) << "the header only";
   EXPECT_EQ(StreamClipExport(
-                *library->database, {id, std::nullopt, std::nullopt},
-                [](ExportedBvh) { return absl::CancelledError("gone"); }, kNever)
+                *library->database, {id, std::nullopt, std::nullopt}, ExportFormat::kBvh,
+                AnswerLimit(), [](ExportedFile) { return absl::CancelledError("gone"); }, kNever)
                 .code(),
             absl::StatusCode::kCancelled);
 }

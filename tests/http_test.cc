@@ -355,6 +355,21 @@ TEST_F(HttpTest, ExportAnswersTheBvhAsAFile) {
   EXPECT_EQ(exported.file_name(), "take_0_3-9.bvh");
   EXPECT_THAT(result->get_header_value("Content-Disposition"),
               HasSubstr("attachment; filename=\"take_0_3-9.bvh\""));
+
+  // The same range as binary glTF, through the route of every format.
+  const auto glb = GrpcAnswer(
+      *v1::ClipService::NewStub(channel), &v1::ClipService::Stub::ExportClip,
+      Parse<v1::ExportClipRequest>(absl::StrCat("clip { clip_id: ", ids_[0],
+                                                " first_frame: 3 last_frame: 9 } format: 'glb'")));
+  const httplib::Result file =
+      http.Get(absl::StrCat("/v1/clips/", ids_[0], "/file?from=3&to=9&format=glb").c_str());
+  ASSERT_TRUE(file);
+  EXPECT_EQ(file->status, 200);
+  EXPECT_EQ(file->body, glb.bvh());
+  EXPECT_EQ(file->body.substr(0, 4), "glTF");
+  EXPECT_EQ(file->get_header_value("Content-Type"), "model/gltf-binary");
+  EXPECT_THAT(file->get_header_value("Content-Disposition"),
+              HasSubstr("attachment; filename=\"take_0_3-9.glb\""));
 }
 
 TEST_F(HttpTest, SearchAnswersAsGrpc) {

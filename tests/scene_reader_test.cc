@@ -16,54 +16,11 @@
 namespace motiondb {
 namespace {
 
-using ::motiondb::testing::MakeSceneFiles;
 using ::motiondb::testing::ReadFileOrDie;
-using ::motiondb::testing::SceneFileRequest;
 
 // World positions agree within this fraction of the skeleton's height: Blender keeps 32-bit
 // floats, and the BVH text six decimals.
 constexpr double kPositionTolerance = 1e-4;
-
-struct Files {
-  std::filesystem::path dir;
-  std::filesystem::path first_take;
-  std::filesystem::path second_take;
-  std::string skip;  // why the files could not be made
-};
-
-// Made once for the suite: Blender takes about two seconds a file.
-const Files& SceneFiles() {
-  static const Files* files = [] {
-    auto* made = new Files;
-    const auto mocap = testing::MocapDir();
-    if (!mocap) {
-      made->skip = "../shared/mocap is absent; skipped";
-      return made;
-    }
-    made->first_take = *mocap / "bandai2-normal" / "dataset-2_raise-up-both-hands_normal_001.bvh";
-    made->second_take = *mocap / "bandai2-normal" / "dataset-2_raise-up-both-hands_normal_002.bvh";
-    made->dir = testing::MakeTempDir("scene_files");
-    const std::vector<std::pair<SceneFileRequest, std::string>> requests = {
-        {{{made->first_take}}, "one"},
-        {{{made->first_take, made->second_take}, 'Y', "fbx"}, "two"},
-        {{{made->first_take}, 'Z', "fbx"}, "zup"},
-        {{{}}, "mesh"},
-    };
-    for (const auto& [request, name] : requests) {
-      if (absl::Status status = MakeSceneFiles(request, made->dir / name); !status.ok()) {
-        made->skip = std::string(status.message());
-        if (status.code() != absl::StatusCode::kUnavailable) ADD_FAILURE() << status;
-        break;
-      }
-    }
-    return made;
-  }();
-  return *files;
-}
-
-#define MOTIONDB_REQUIRE_SCENE_FILES() \
-  const Files& files = SceneFiles();   \
-  if (!files.skip.empty()) GTEST_SKIP() << files.skip
 
 absl::StatusOr<SceneReadResult> ReadSceneFile(const std::filesystem::path& path,
                                               MotionFileFormat format) {
@@ -108,10 +65,10 @@ void ExpectSameMotion(const Clip& bvh, const Clip& scene, double unit_m, int min
 }
 
 TEST(SceneReaderTest, FbxOfABvhTakeMovesItsJointsAsTheBvhDoes) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
-  auto bvh = ReadBvhFile(files.first_take.string());
+  MOTIONDB_BLENDER_FILE(fbx, "one.fbx");
+  auto bvh = ReadBvhFile(testing::FirstTake().string());
   ASSERT_TRUE(bvh.ok()) << bvh.status();
-  auto scene = ReadSceneFile(files.dir / "one.fbx", MotionFileFormat::kFbx);
+  auto scene = ReadSceneFile(fbx, MotionFileFormat::kFbx);
   ASSERT_TRUE(scene.ok()) << scene.status();
   ASSERT_EQ(scene->takes.size(), 1u);
   EXPECT_EQ(scene->facts.up_axis, 'Y');
@@ -124,10 +81,10 @@ TEST(SceneReaderTest, FbxOfABvhTakeMovesItsJointsAsTheBvhDoes) {
 }
 
 TEST(SceneReaderTest, GlbOfABvhTakeMovesItsJointsAsTheBvhDoes) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
-  auto bvh = ReadBvhFile(files.first_take.string());
+  MOTIONDB_BLENDER_FILE(glb, "one.glb");
+  auto bvh = ReadBvhFile(testing::FirstTake().string());
   ASSERT_TRUE(bvh.ok()) << bvh.status();
-  auto scene = ReadSceneFile(files.dir / "one.glb", MotionFileFormat::kGlb);
+  auto scene = ReadSceneFile(glb, MotionFileFormat::kGlb);
   ASSERT_TRUE(scene.ok()) << scene.status();
   ASSERT_EQ(scene->takes.size(), 1u);
   EXPECT_EQ(scene->facts.format, MotionFileFormat::kGlb);
@@ -138,10 +95,10 @@ TEST(SceneReaderTest, GlbOfABvhTakeMovesItsJointsAsTheBvhDoes) {
 }
 
 TEST(SceneReaderTest, ZUpFbxIsTurnedYUpAndSaysSo) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
-  auto bvh = ReadBvhFile(files.first_take.string());
+  MOTIONDB_BLENDER_FILE(zup, "zup.fbx");
+  auto bvh = ReadBvhFile(testing::FirstTake().string());
   ASSERT_TRUE(bvh.ok()) << bvh.status();
-  auto scene = ReadSceneFile(files.dir / "zup.fbx", MotionFileFormat::kFbx);
+  auto scene = ReadSceneFile(zup, MotionFileFormat::kFbx);
   ASSERT_TRUE(scene.ok()) << scene.status();
   EXPECT_EQ(scene->facts.up_axis, 'Z');
   // Turned Y up, the world is the BVH's but for the turn about the vertical that the Z-up
@@ -167,11 +124,11 @@ TEST(SceneReaderTest, ZUpFbxIsTurnedYUpAndSaysSo) {
 }
 
 TEST(SceneReaderTest, EveryTakeOfAFileIsAClip) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
-  auto scene = ReadSceneFile(files.dir / "two.fbx", MotionFileFormat::kFbx);
+  MOTIONDB_BLENDER_FILE(two, "two.fbx");
+  auto scene = ReadSceneFile(two, MotionFileFormat::kFbx);
   ASSERT_TRUE(scene.ok()) << scene.status();
   ASSERT_EQ(scene->takes.size(), 2u);
-  auto second = ReadBvhFile(files.second_take.string());
+  auto second = ReadBvhFile(testing::SecondTake().string());
   ASSERT_TRUE(second.ok()) << second.status();
   EXPECT_NE(scene->takes[0].name, scene->takes[1].name);
   EXPECT_NE(scene->takes[1].name.find("normal_002"), std::string::npos) << scene->takes[1].name;
@@ -180,10 +137,10 @@ TEST(SceneReaderTest, EveryTakeOfAFileIsAClip) {
 }
 
 TEST(SceneReaderTest, AFileWithoutAnimationSaysWhatIsMissing) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
   for (const auto& [file, format] : {std::pair{"mesh.fbx", MotionFileFormat::kFbx},
                                      std::pair{"mesh.glb", MotionFileFormat::kGlb}}) {
-    auto scene = ReadSceneFile(files.dir / file, format);
+    MOTIONDB_BLENDER_FILE(path, file);
+    auto scene = ReadSceneFile(path, format);
     ASSERT_FALSE(scene.ok()) << file;
     EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(scene.status().message().find("no skeletal animation"), std::string::npos)
@@ -192,10 +149,10 @@ TEST(SceneReaderTest, AFileWithoutAnimationSaysWhatIsMissing) {
 }
 
 TEST(SceneReaderTest, TruncatedAndCorruptFilesAreRefused) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
   for (const auto& [file, format] : {std::pair{"one.fbx", MotionFileFormat::kFbx},
                                      std::pair{"one.glb", MotionFileFormat::kGlb}}) {
-    const std::string bytes = ReadFileOrDie(files.dir / file);
+    MOTIONDB_BLENDER_FILE(path, file);
+    const std::string bytes = ReadFileOrDie(path);
     for (const size_t keep : {bytes.size() / 2, size_t{40}, size_t{0}}) {
       auto scene = ReadScene(absl::string_view(bytes).substr(0, keep), format);
       ASSERT_FALSE(scene.ok()) << file << " cut at " << keep;
@@ -209,10 +166,10 @@ TEST(SceneReaderTest, TruncatedAndCorruptFilesAreRefused) {
 }
 
 TEST(SceneReaderTest, AnOversizeTakeIsRefusedBeforeItIsBuilt) {
-  MOTIONDB_REQUIRE_SCENE_FILES();
+  MOTIONDB_BLENDER_FILE(fbx, "one.fbx");
   SceneReadOptions options;
   options.max_clip_bytes = 1000;
-  auto scene = ReadScene(ReadFileOrDie(files.dir / "one.fbx"), MotionFileFormat::kFbx, options);
+  auto scene = ReadScene(ReadFileOrDie(fbx), MotionFileFormat::kFbx, options);
   ASSERT_FALSE(scene.ok());
   EXPECT_EQ(scene.status().code(), absl::StatusCode::kResourceExhausted) << scene.status();
 }

@@ -63,6 +63,25 @@ TEST_F(StorageTest, ClipRoundTripKeepsFramesLayoutAndRecord) {
   EXPECT_EQ(stored_empty->clip.frame_count(), 0);
 }
 
+// An FBX or glTF file's facts are kept for its clip, listed with it, and go with it.
+TEST_F(StorageTest, AClipKeepsWhatItsFileSaidOfItself) {
+  ClipRecord record = Named("take");
+  record.source_facts = {"fbx", 0.01, "Z"};
+  const int64_t id = Insert(record, Motion(testing::ChainSkeleton(), 5));
+  const int64_t plain = Insert(Named("plain"), Motion(testing::ChainSkeleton(), 5));
+  const absl::StatusOr<ClipRecord> stored = Db().GetClipRecord(id);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  EXPECT_EQ(stored->source_facts.format, "fbx");
+  EXPECT_DOUBLE_EQ(stored->source_facts.unit_m, 0.01);
+  EXPECT_EQ(stored->source_facts.up_axis, "Z");
+  const absl::StatusOr<ClipRecord> bvh = Db().GetClipRecord(plain);
+  ASSERT_TRUE(bvh.ok()) << bvh.status();
+  EXPECT_EQ(bvh->source_facts.format, "");
+  EXPECT_EQ(bvh->source_facts.unit_m, 0);
+  ASSERT_TRUE(Db().DeleteClip(id).ok());
+  EXPECT_EQ(*Raw()->QueryInt64("SELECT count(*) FROM clip_sources"), 0);
+}
+
 // A range is read without the other frames and is the same as the whole clip's slice.
 TEST_F(StorageTest, AFrameRangeReadsAsTheSliceOfTheClip) {
   const Clip clip = Motion(testing::ChainSkeleton(), 50, 3);

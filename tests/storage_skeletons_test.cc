@@ -91,7 +91,10 @@ TEST_F(StorageTest, ASchemaSixFileGainsTheOverridesTable) {
   const int64_t skeleton_id = Db().GetClipRecord(clip)->skeleton_id;
   Close();
   // The file as version 6 left it.
-  ASSERT_TRUE(Raw()->Execute("DROP TABLE skeleton_slot_overrides; PRAGMA user_version = 6").ok());
+  ASSERT_TRUE(Raw()
+                  ->Execute("DROP TABLE skeleton_slot_overrides; DROP TABLE clip_sources; "
+                            "PRAGMA user_version = 6")
+                  .ok());
   const absl::StatusOr<SkeletonRecord> record = Db().GetSkeleton(skeleton_id);
   ASSERT_TRUE(record.ok()) << record.status();
   EXPECT_TRUE(record->slot_overrides.empty());

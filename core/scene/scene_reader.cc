@@ -250,16 +250,22 @@ absl::StatusOr<TakeTiming> Timing(const aiAnimation& animation, MotionFileFormat
   if (format == MotionFileFormat::kFbx) {
     timing.ticks_per_frame = 1;
   } else {
-    std::vector<double> gaps;
-    for (size_t i = 1; i < times.size(); ++i) {
-      if (times[i] - times[i - 1] > 1e-6 * std::max(1.0, span))
-        gaps.push_back(times[i] - times[i - 1]);
+    // Distinct key times; a file keyed at every frame has them evenly spaced, and the frame is
+    // their mean spacing (exact at every key, where 32-bit times make single gaps uneven).
+    std::vector<double> distinct = {times.front()};
+    for (const double t : times) {
+      if (t - distinct.back() > 1e-6 * std::max(1.0, span)) distinct.push_back(t);
     }
-    if (!gaps.empty()) {
-      std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-      timing.ticks_per_frame = gaps[gaps.size() / 2];
-    } else {
+    std::vector<double> gaps;
+    for (size_t i = 1; i < distinct.size(); ++i) gaps.push_back(distinct[i] - distinct[i - 1]);
+    if (gaps.empty()) {
       timing.ticks_per_frame = ticks_per_second / 30;
+    } else {
+      const double mean = span / static_cast<double>(gaps.size());
+      const bool even = std::all_of(gaps.begin(), gaps.end(),
+                                    [&](double gap) { return std::abs(gap - mean) < 1e-2 * mean; });
+      std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+      timing.ticks_per_frame = even ? mean : gaps[gaps.size() / 2];
     }
   }
   timing.frame_time = timing.ticks_per_frame / ticks_per_second;
@@ -393,16 +399,16 @@ absl::StatusOr<RestSkeleton> FindSkeleton(const aiScene& scene, const Quat& to_y
         absl::StrCat("no skeletal animation: the file animates one node ('", root->mName.C_Str(),
                      "'), not a hierarchy of joints"));
   }
-  if (root == scene.mRootNode && root->mNumChildren > 1) {
+  // A still scene root over several moving trees: several characters, read as one skeleton.
+  if (root == scene.mRootNode && !animated.contains(root->mName.C_Str())) {
     int moving_children = 0;
     for (unsigned c = 0; c < root->mNumChildren; ++c) {
       std::vector<SkeletonNode> below;
       moving_children += CollectJoints(root->mChildren[c], -1, animated, below) ? 1 : 0;
     }
     if (moving_children > 1) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("the file's animations move ", moving_children,
-                       " separate hierarchies under its root; one skeleton a file is read"));
+      warnings.push_back(absl::StrCat("the file's animations move ", moving_children,
+                                      " separate hierarchies; they were read as one skeleton"));
     }
   }
   // Everything above the root, from the scene's root down, turned Y up.

@@ -55,8 +55,8 @@ struct SceneReadResult {
 };
 
 // Reads `bytes`, a file of `format` (kFbx, kGltf or kGlb). INVALID_ARGUMENT, saying what is
-// missing or wrong, for a file assimp cannot read, one without a skeletal animation (a mesh or
-// a still scene), or one whose animations move several separate hierarchies.
+// missing or wrong, for a file assimp cannot read or one without a skeletal animation (a mesh
+// or a still scene). Several characters' hierarchies are read as one skeleton, with a warning.
 absl::StatusOr<SceneReadResult> ReadScene(absl::string_view bytes, MotionFileFormat format,
                                           const SceneReadOptions& options = {});
 

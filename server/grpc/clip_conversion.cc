@@ -131,10 +131,18 @@ void ToProto(const storage::ClipRecord& record, v1::Clip* clip) {
     }
     out->set_parameters_json(provenance->parameters_json);
   }
+  if (!record.source_facts.format.empty()) {
+    v1::FileFacts* source = clip->mutable_source();
+    source->set_format(record.source_facts.format);
+    source->set_unit_m(record.source_facts.unit_m);
+    source->set_up_axis(record.source_facts.up_axis);
+  }
 }
 
-void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
+// Outside the anonymous namespace, whose ToProto would hide the record's.
+static void TakeToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
   ToProto(outcome.clip, response->mutable_clip());
+  response->set_take(outcome.take);
   for (const std::string& warning : outcome.warnings) response->add_warnings(warning);
   for (const std::string& space : outcome.spaces) response->add_projected_spaces(space);
   response->set_result(ToProto(outcome.result));
@@ -146,8 +154,27 @@ void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response) {
   }
 }
 
-void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response) {
-  response->set_bvh(std::move(exported.bvh));
+void ToProto(const IngestedFile& file, v1::IngestClipResponse* response) {
+  for (size_t i = 0; i < file.clips.size(); ++i) {
+    TakeToProto(file.clips[i], i == 0 ? response : response->add_more_takes());
+  }
+  v1::FileFacts* facts = response->mutable_file();
+  facts->set_format(std::string(MotionFileFormatName(file.format)));
+  facts->set_unit_m(file.unit_m);
+  if (file.up_axis != 0) facts->set_up_axis(std::string(1, file.up_axis));
+  facts->set_generator(file.generator);
+}
+
+absl::StatusOr<ExportFormat> ExportFormatFromProto(const std::string& format) {
+  if (format.empty() || format == "bvh") return ExportFormat::kBvh;
+  if (format == "gltf") return ExportFormat::kGltf;
+  if (format == "glb") return ExportFormat::kGlb;
+  return absl::InvalidArgumentError(
+      absl::StrCat("format: '", format, "' is none of bvh, gltf, glb"));
+}
+
+void ToProto(ExportedFile&& exported, v1::ExportClipResponse* response) {
+  response->set_bvh(std::move(exported.bytes));
   response->set_file_name(exported.file_name);
   response->set_first_frame(exported.frames.first);
   response->set_last_frame(exported.frames.last);

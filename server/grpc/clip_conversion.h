@@ -39,9 +39,11 @@ void ToProto(const ClipPoses& poses, v1::ClipPoses* response);
 void ToProto(const std::vector<storage::SkeletonSummary>& skeletons,
              v1::ListSkeletonsResponse* response);
 void ToProto(const SkeletonMapView& view, v1::SkeletonDetail* detail);
-void ToProto(const IngestOutcome& outcome, v1::IngestClipResponse* response);
+void ToProto(const IngestedFile& file, v1::IngestClipResponse* response);
 // The BVH text is moved into the message (1-2 MB for 10 s at 120 fps: a copy cost 0.8 ms).
-void ToProto(ExportedBvh&& exported, v1::ExportClipResponse* response);
+void ToProto(ExportedFile&& exported, v1::ExportClipResponse* response);
+// INVALID_ARGUMENT naming `format` for another than "bvh", "gltf", "glb" or empty.
+absl::StatusOr<ExportFormat> ExportFormatFromProto(const std::string& format);
 
 }  // namespace motiondb::server
 

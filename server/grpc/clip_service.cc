@@ -25,10 +25,10 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
     MOTIONDB_ASSIGN_OR_RETURN(const IngestRequest ingest, FromProto(*request));
     MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
     MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(request->bvh().size())));
-    MOTIONDB_ASSIGN_OR_RETURN(const IngestOutcome outcome,
+    MOTIONDB_ASSIGN_OR_RETURN(const IngestedFile ingested,
                               IngestUpload(catalog_, ingest, request->bvh(), limits_, should_stop));
-    metrics_.CountIngest(outcome);
-    ToProto(outcome, response);
+    for (const IngestOutcome& outcome : ingested.clips) metrics_.CountIngest(outcome);
+    ToProto(ingested, response);
     return absl::OkStatus();
   });
 }
@@ -53,12 +53,12 @@ absl::Status ClipServiceImpl::IngestStreamed(ReadUpload read, const ShouldStop& 
   // Read() also ends when the call is cancelled or its deadline passes: what arrived is then a
   // part of the file, which may well parse (cut at a row) and must not be stored as the clip.
   if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
-  MOTIONDB_ASSIGN_OR_RETURN(BvhReadResult parsed, read.upload.bvh.Finish());
+  MOTIONDB_ASSIGN_OR_RETURN(UploadedFile parsed, read.upload.bvh.Finish(should_stop));
   MOTIONDB_ASSIGN_OR_RETURN(
-      const IngestOutcome outcome,
+      const IngestedFile ingested,
       IngestParsedUpload(catalog_, read.upload.request, std::move(parsed), should_stop));
-  metrics_.CountIngest(outcome);
-  ToProto(outcome, response);
+  for (const IngestOutcome& outcome : ingested.clips) metrics_.CountIngest(outcome);
+  ToProto(ingested, response);
   return absl::OkStatus();
 }
 
@@ -167,9 +167,10 @@ grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
                                          const v1::ExportClipRequest* request,
                                          v1::ExportClipResponse* response) {
   return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const ExportFormat format, ExportFormatFromProto(request->format()));
     MOTIONDB_ASSIGN_OR_RETURN(
-        ExportedBvh exported,
-        server::ExportClip(database_, FromProto(request->clip()), answers_, should_stop));
+        ExportedFile exported,
+        server::ExportClip(database_, FromProto(request->clip()), format, answers_, should_stop));
     ToProto(std::move(exported), response);
     return absl::OkStatus();
   });
@@ -178,16 +179,18 @@ grpc::Status ClipServiceImpl::ExportClip(grpc::ServerContext* context,
 grpc::Status ClipServiceImpl::ExportClipStream(grpc::ServerContext* context,
                                                const v1::ExportClipRequest* request,
                                                grpc::ServerWriter<v1::ExportClipResponse>* writer) {
-  return Serve(gate_, context, [&](const ShouldStop& should_stop) {
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const ExportFormat format, ExportFormatFromProto(request->format()));
     // Write blocks while the client's window is full, so a client that stops reading holds a
     // piece here, not the clip; it returns false once the call has ended.
-    const auto send = [&](ExportedBvh piece) -> absl::Status {
+    const auto send = [&](ExportedFile piece) -> absl::Status {
       v1::ExportClipResponse message;
       ToProto(std::move(piece), &message);
       if (!writer->Write(message)) return absl::CancelledError("the client stopped reading");
       return absl::OkStatus();
     };
-    return StreamClipExport(database_, FromProto(request->clip()), send, should_stop);
+    return StreamClipExport(database_, FromProto(request->clip()), format, answers_, send,
+                            should_stop);
   });
 }
 

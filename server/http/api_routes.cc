@@ -36,6 +36,9 @@ std::vector<ApiRoute> MakeRoutes() {
       Get("/v1/clips/{id}", absl::StrCat(kClipService, "GetClip"), {{"id", "clip_id"}}),
       AsFile(Get("/v1/clips/{id}/bvh", absl::StrCat(kClipService, "ExportClipStream"),
                  {{"id", "clip.clip_id"}, from, to})),
+      // ?format=gltf|glb (or bvh): the same export in another format.
+      AsFile(Get("/v1/clips/{id}/file", absl::StrCat(kClipService, "ExportClipStream"),
+                 {{"id", "clip.clip_id"}, from, to})),
       Get("/v1/clips/{id}/poses", absl::StrCat(kClipService, "GetClipPoses"),
           {{"id", "clip.clip_id"}, from, to}),
       Get("/v1/clips/{id}/labels", absl::StrCat(kLabelService, "GetClipLabels"),

@@ -6,6 +6,7 @@
 #include <grpcpp/client_context.h>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "grpc/health/v1/health.pb.h"
@@ -48,6 +49,13 @@ std::string Attachment(absl::string_view file_name) {
   return absl::StrCat("attachment; filename=\"", ascii, "\"; filename*=UTF-8''", encoded);
 }
 
+// An export's media type, by the extension of the file name it suggests.
+std::string ContentType(absl::string_view file_name) {
+  if (absl::EndsWith(file_name, ".glb")) return "model/gltf-binary";
+  if (absl::EndsWith(file_name, ".gltf")) return "model/gltf+json";
+  return "text/plain; charset=utf-8";
+}
+
 // A file whose request did not convert: no call, the error its reply.
 class RefusedFile final : public FileStream {
  public:
@@ -74,7 +82,7 @@ class ExportStream final : public FileStream {
       head_ = ErrorReply(status.error_code(), status.error_message());
       return;
     }
-    head_.content_type = "text/plain; charset=utf-8";
+    head_.content_type = ContentType(message_.file_name());
     head_.headers.push_back({"Content-Disposition", Attachment(message_.file_name())});
     pending_ = std::move(*message_.mutable_bvh());
   }

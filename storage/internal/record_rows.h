@@ -27,8 +27,11 @@ namespace motiondb::storage {
 // The columns ReadClipRecord reads, of the clips table as `c`.
 inline constexpr absl::string_view kClipRecordColumns =
     "c.clip_id, c.name, c.source_file, c.skeleton_id, c.created_unix_ms, c.frame_time, "
-    "c.frame_count, c.joint_count, c.content_hash, c.provenance";
-inline constexpr int kClipRecordColumnCount = 10;
+    "c.frame_count, c.joint_count, c.content_hash, c.provenance, "
+    "coalesce((SELECT format FROM clip_sources s WHERE s.clip_id = c.clip_id), ''), "
+    "coalesce((SELECT unit_m FROM clip_sources s WHERE s.clip_id = c.clip_id), 0), "
+    "coalesce((SELECT up_axis FROM clip_sources s WHERE s.clip_id = c.clip_id), '')";
+inline constexpr int kClipRecordColumnCount = 13;
 // The columns ReadClipLayout reads, listed after kClipRecordColumns.
 inline constexpr absl::string_view kClipLayoutColumns = "c.position_joint_count, c.layout";
 // The columns ReadSpaceRecord reads, of the spaces table.

@@ -100,6 +100,18 @@ class PackageTest(unittest.TestCase):
         cmu = pathlib.Path("/usr/share/assimp/models/BVH/01_01.bvh")
         if cmu.exists():  # another skeleton beside the space's
             self.assertEqual(client.ingest(cmu).clip.name, "01_01")
+        fbx = pathlib.Path("/usr/share/assimp/models/FBX/animation_with_skeleton.fbx")
+        if fbx.exists():  # an FBX file, read by the server's importer: a clip a take
+            ingested = client.ingest(fbx, tags=["fbx"])
+            self.assertEqual(ingested.clip.name, "animation_with_skeleton")
+            self.assertEqual(ingested.clip.frame_count, 21)
+            self.assertEqual((ingested.file.format, ingested.file.up_axis), ("fbx", "Y"))
+            self.assertEqual(len(ingested.more_takes), 0)
+            with tempfile.TemporaryDirectory() as folder:  # and out again as glTF
+                glb = pathlib.Path(folder) / "hit.glb"
+                header = client.export(ingested.clip.clip_id, glb, first=2, last=9)
+                self.assertEqual(header.file_name, "animation_with_skeleton_2-9.glb")
+                self.assertEqual(glb.read_bytes()[:4], b"glTF")
         pages = list(client.clips(tag="raise", page_size=3))
         self.assertEqual([[c.name for c in page] for page in pages],
                          [["raise_0", "raise_1", "raise_2"], ["raise_3"]])

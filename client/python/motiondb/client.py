@@ -137,10 +137,13 @@ class Client:
     def ingest(self, source: PathOrBytes, name: Optional[str] = None, tags: Iterable[str] = (),
                on_conflict: Optional[str] = None,
                file_name: Optional[str] = None) -> clip_service_pb2.IngestClipResponse:
-        """Stores a BVH file, given as a path or as its bytes; returns the IngestClipResponse
-        (.clip the clip as stored, .result, .warnings).
+        """Stores a motion file (BVH, FBX, .glb or .gltf), given as a path or as its bytes;
+        returns the IngestClipResponse (.clip the clip as stored, .result, .warnings; for an FBX
+        or glTF file of several takes .more_takes the second and later, each a clip NAME/TAKE;
+        .file the file's format, unit and up axis).
 
-        name defaults to the file name without folders and .bvh (bytes need name or file_name).
+        name defaults to the file name without folders and extension (bytes need name or
+        file_name).
         on_conflict: None (skip an identical clip of the name, refuse another), "error", "skip"
         or "replace". Files over 8 MB go up in chunks (IngestClipStream).
         """
@@ -197,13 +200,19 @@ class Client:
 
     @_rpc
     def export(self, clip: ClipRef, path: Union[str, os.PathLike], first: Optional[int] = None,
-               last: Optional[int] = None) -> clip_service_pb2.ExportClipResponse:
-        """Writes a clip, or its frames first..last, as a BVH file at path (ExportClipStream: a
-        clip of any size, written as its pieces arrive, into path + ".tmp" renamed into place
-        once whole). Returns the first message without its text: file_name (the server's
+               last: Optional[int] = None,
+               format: Optional[str] = None) -> clip_service_pb2.ExportClipResponse:
+        """Writes a clip, or its frames first..last (a hit), as a file at path
+        (ExportClipStream: written as its pieces arrive, into path + ".tmp" renamed into place
+        once whole). format: "bvh", "gltf" or "glb"; None: by path's extension (.gltf, .glb),
+        else BVH. Returns the first message without its bytes: file_name (the server's
         suggestion), first_frame, last_frame."""
-        request = clip_service_pb2.ExportClipRequest(clip=self._range(clip, first, last))
         target = pathlib.Path(path)
+        if format is None:
+            suffix = target.suffix.lower()
+            format = suffix[1:] if suffix in (".gltf", ".glb") else "bvh"
+        request = clip_service_pb2.ExportClipRequest(clip=self._range(clip, first, last),
+                                                     format=format)
         partial = target.with_name(target.name + ".tmp")
         header = None
         try:
