@@ -31,7 +31,7 @@ struct SearchFlags {
   std::string seeds = "frames";
   std::optional<double> epsilon;
   std::string neutral = "mean";
-  bool exact = false, path = false, no_refine = false, explain = false;
+  bool exact = false, path = false, no_refine = false, explain = false, mirror = false;
   bool exclude_query = true;  // a --clip query's own range is not a result
   std::vector<int64_t> in_clips;
   std::vector<std::string> tags;
@@ -135,6 +135,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   request.set_exact(flags.exact);
   request.set_return_path(flags.path);
   request.set_explain(flags.explain);
+  request.set_mirror(flags.mirror);
   if (flags.no_refine) request.set_refine(false);
   if (flags.clip) request.set_exclude_query(flags.exclude_query);
   return request;
@@ -168,7 +169,7 @@ nlohmann::json ResponseJson(const v1::SearchResponse& response) {
     nlohmann::json item = {
         {"clip_id", r.clip_id()}, {"clip_name", r.clip_name()},     {"start_s", r.start_s()},
         {"end_s", r.end_s()},     {"start_frame", r.start_frame()}, {"end_frame", r.end_frame()},
-        {"score", r.score()},     {"seed_frame", r.seed_frame()}};
+        {"score", r.score()},     {"seed_frame", r.seed_frame()},   {"mirrored", r.mirrored()}};
     if (r.path_size() > 0) item["path"] = std::vector<int>(r.path().begin(), r.path().end());
     if (r.has_explanation()) item["explanation"] = ExplanationJson(r.explanation());
     results.push_back(std::move(item));
@@ -208,12 +209,16 @@ absl::Status Search(const SearchFlags& flags, bool json, const ServerConnection&
     std::cout << ResponseJson(response).dump() << "\n";
     return absl::OkStatus();
   }
-  absl::PrintF("%4s %8s  %-40s %9s %9s %13s %10s\n", "RANK", "CLIP", "NAME", "START (s)", "END (s)",
-               "FRAMES", "SCORE");
+  // With --mirror, a last column says which results the query's mirror found.
+  absl::PrintF("%4s %8s  %-40s %9s %9s %13s %10s%s\n", "RANK", "CLIP", "NAME", "START (s)",
+               "END (s)", "FRAMES", "SCORE", flags.mirror ? "  MIRRORED" : "");
   int rank = 0;
   for (const v1::SearchResult& r : response.results()) {
-    absl::PrintF("%4d %8d  %-40s %9.3f %9.3f %6d-%-6d %10.5f\n", ++rank, r.clip_id(), r.clip_name(),
-                 r.start_s(), r.end_s(), r.start_frame(), r.end_frame(), r.score());
+    absl::PrintF("%4d %8d  %-40s %9.3f %9.3f %6d-%-6d %10.5f%s\n", ++rank, r.clip_id(),
+                 r.clip_name(), r.start_s(), r.end_s(), r.start_frame(), r.end_frame(), r.score(),
+                 !flags.mirror  ? ""
+                 : r.mirrored() ? "  yes"
+                                : "  no");
     if (r.has_explanation()) PrintExplanation(r.explanation());
   }
   const v1::SearchTimings& t = response.timings();
@@ -311,6 +316,9 @@ void AddSearch(Commands& commands) {
                  "--clip: leave out (or keep) results overlapping the query's own range")
       ->default_str("exclude");
   search->add_flag("--path", flags->path, "each result's warp path (with --json)");
+  search->add_flag("--mirror", flags->mirror,
+                   "also search the query's left/right mirror (by its skeleton's humanoid map): a "
+                   "left-hand wave finds right-hand waves too; each result says which found it");
   search->add_flag("--explain", flags->explain,
                    "each result's share of its distance per joint (the top three printed) and "
                    "its speed against the query");

@@ -78,8 +78,8 @@ int64_t PosesAnswerBytes(const Skeleton& skeleton, int64_t frames) {
 
 int64_t SearchAnswerBytes(int64_t results, int64_t path_rows, bool explained,
                           const Skeleton& skeleton) {
-  // Clip id, seconds, frames, score, seed frame; the clip's name; the hit's framing.
-  constexpr int64_t kHitNumbers = 7;
+  // Clip id, seconds, frames, score, seed frame, mirrored; the clip's name; the hit's framing.
+  constexpr int64_t kHitNumbers = 8;
   int64_t hit =
       kHitNumbers * kNumberFieldBytes + TextFieldBytes(storage::kMaxNameBytes) + kFieldFramingBytes;
   if (path_rows > 0) hit += TextFieldBytes(path_rows * kPathFrameBytes);

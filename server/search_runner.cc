@@ -12,6 +12,7 @@
 #include "core/search/motion_search.h"
 #include "core/search/warp/time_warp.h"
 #include "core/space/search_coordinates.h"
+#include "server/skeleton_map.h"
 #include "server/space_lookup.h"
 #include "util/parallel_for.h"
 #include "util/status_macros.h"
@@ -24,7 +25,10 @@ struct Query {
   std::optional<RowMatrixXf> uploaded;  // an uploaded file's projection
   CoordinateView stored;                // a stored clip's projection, in the snapshot's index
   FrameConversion frames{1, 1, 1, 1};
-  FrameRange range;       // at the clip's rate
+  FrameRange range;  // at the clip's rate
+  // The query clip's frame that is frame 0 of the rows' clip: a stored range read alone (to be
+  // mirrored) starts at its first frame.
+  int frame_offset = 0;
   int64_t first_row = 0;  // of the range, at the space rate
   int64_t row_count = 0;
 
@@ -35,7 +39,8 @@ struct Query {
 };
 
 void SetRows(Query* query) {
-  const auto [first, last] = query->frames.ToSpace(query->range);
+  const auto [first, last] = query->frames.ToSpace(FrameRange{
+      query->range.first - query->frame_offset, query->range.last - query->frame_offset});
   query->first_row = first;
   query->row_count = last - first + 1;
 }
@@ -102,17 +107,23 @@ absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapsho
   return query;
 }
 
-absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnapshot& snapshot,
-                                    const UploadLimits& limits, int max_rows,
-                                    const std::function<bool()>& should_stop) {
-  MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile read,
-                            ReadUpload(upload.bvh, "bvh", limits, should_stop));
-  if (read.takes.size() != 1) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("bvh: the file holds ", read.takes.size(),
-                     " takes; a query is one (ingest the file and query a take by its clip)"));
-  }
-  const Clip& clip = read.takes[0].clip;
+// `clip` projected whole, as a stored clip is, as the query of the frames `range` (numbered from
+// `frame_offset`, the query clip's frame that is `clip`'s first).
+absl::StatusOr<Query> ProjectedQuery(const Clip& clip, FrameRange range, int frame_offset,
+                                     const SpaceSnapshot& snapshot) {
+  Query query;
+  MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip));
+  query.frames = FrameConversion(clip.fps(), clip.frame_count(), snapshot.space->sample_rate(),
+                                 query.uploaded->rows());
+  query.range = range;
+  query.frame_offset = frame_offset;
+  SetRows(&query);
+  return query;
+}
+
+// `clip`, an uploaded file's, as the query of its frames `upload` asks for.
+absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& clip,
+                                    const SpaceSnapshot& snapshot, int max_rows) {
   if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
     return absl::FailedPreconditionError(absl::StrCat(
         "bvh: the query's skeleton (", clip.skeleton().joint_count(), " joints, root '",
@@ -120,9 +131,9 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnap
         "' (", snapshot.space->skeleton().joint_count(), " joints, root '",
         snapshot.space->skeleton().joint(0).name, "')"));
   }
-  Query query;
-  MOTIONDB_ASSIGN_OR_RETURN(query.range, ResolveFrameRange(upload.first_frame, upload.last_frame,
-                                                           clip.frame_count(), "bvh"));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const FrameRange range,
+      ResolveFrameRange(upload.first_frame, upload.last_frame, clip.frame_count(), "bvh"));
   // The whole file is projected, as a stored clip is, so that a range of an uploaded file gives
   // the same query as the same range of the file once stored: its whole length counts.
   MOTIONDB_RETURN_IF_ERROR(CheckQueryLength(
@@ -132,11 +143,27 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const SpaceSnap
       absl::StrCat("the file's ", clip.frame_count(), " frames at its ", clip.fps(),
                    " fps; a range of it is searched after the whole file is projected"),
       max_rows));
-  MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip));
-  query.frames = FrameConversion(clip.fps(), clip.frame_count(), snapshot.space->sample_rate(),
-                                 query.uploaded->rows());
-  SetRows(&query);
-  return query;
+  return ProjectedQuery(clip, range, /*frame_offset=*/0, snapshot);
+}
+
+// The mirror of `query` (of `uploaded`, an uploaded file's clip, or else of a stored clip's
+// range, read alone), projected on the spot.
+absl::StatusOr<Query> MirroredQuery(const Query& query, const std::optional<Clip>& uploaded,
+                                    const SearchRequest& request, const SpaceSnapshot& snapshot,
+                                    storage::Database& database) {
+  std::optional<Clip> stored;
+  if (!uploaded) {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        storage::StoredClip range,
+        database.GetClip(std::get<ClipSelection>(request.query).clip_id, query.range));
+    stored = std::move(range.clip);
+  }
+  const Clip& clip = uploaded ? *uploaded : *stored;
+  MOTIONDB_ASSIGN_OR_RETURN(const SkeletonMirror mirror,
+                            MirrorOfSkeleton(database, snapshot.record.skeleton_id, clip.skeleton(),
+                                             snapshot.space->data().references));
+  MOTIONDB_ASSIGN_OR_RETURN(const Clip mirrored, MirrorClip(clip, mirror));
+  return ProjectedQuery(mirrored, query.range, uploaded ? 0 : query.range.first, snapshot);
 }
 
 // A query frame (at its clip's rate, in its numbering) as a row of the query at the space rate.
@@ -146,8 +173,8 @@ absl::StatusOr<int> QueryRow(const Query& query, int frame, absl::string_view fi
                                                    " is outside the query's frames ",
                                                    query.range.first, "..", query.range.last));
   }
-  return static_cast<int>(
-      std::clamp<int64_t>(query.frames.ToSpace(frame) - query.first_row, 0, query.row_count - 1));
+  return static_cast<int>(std::clamp<int64_t>(
+      query.frames.ToSpace(frame - query.frame_offset) - query.first_row, 0, query.row_count - 1));
 }
 
 absl::StatusOr<SearchParams> ResolveParams(const SearchRequest& request, const Query& query,
@@ -234,28 +261,75 @@ std::optional<ExcludedRange> OwnRange(const SpaceSnapshot& snapshot, int64_t cli
   return ExcludedRange{clip_id, first, last};
 }
 
-// Runs the search once and makes its results hits.
-absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot, const Query& query,
-                                            SearchParams params, const HitOptions& options,
-                                            SearchStats* stats) {
-  params.return_path = params.return_path || options.explain;
-  MOTIONDB_ASSIGN_OR_RETURN(const SearchResponse found,
-                            options.exact ? ExactSearch(*snapshot.index, query.rows(), params)
-                                          : Search(*snapshot.index, query.rows(), params));
-  *stats = found.stats;
+// One search of a request: the query or its mirror, with its own parameters (their rows).
+struct Half {
+  const Query* query = nullptr;
+  SearchParams params;
+  bool mirrored = false;
+};
+
+// The work of `more` added to `stats`: counts and times; the points stay `stats`'.
+void AddWork(const SearchStats& more, SearchStats* stats) {
+  stats->seeds += more.seeds;
+  stats->clusters += more.clusters;
+  stats->warps += more.warps;
+  stats->cells += more.cells;
+  stats->pruned_blocks += more.pruned_blocks;
+  stats->characteristic_ms += more.characteristic_ms;
+  stats->seeds_ms += more.seeds_ms;
+  stats->clusters_ms += more.clusters_ms;
+  stats->warps_ms += more.warps_ms;
+  stats->refine_ms += more.refine_ms;
+  stats->ranking_ms += more.ranking_ms;
+  stats->total_ms += more.total_ms;
+}
+
+// Runs the search of each half and makes their results hits: one half's as they come, two
+// halves' ranked together (RankedIndices) under the first's max_results and max_overlap. The
+// stats are the first half's, with the second's work added.
+absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot,
+                                            const std::vector<Half>& halves,
+                                            const HitOptions& options, SearchStats* stats) {
+  std::vector<SearchResult> candidates;
+  std::vector<size_t> half_of;  // by candidate
+  for (size_t h = 0; h < halves.size(); ++h) {
+    SearchParams params = halves[h].params;
+    params.return_path = params.return_path || options.explain;
+    const CoordinateView rows = halves[h].query->rows();
+    MOTIONDB_ASSIGN_OR_RETURN(SearchResponse found, options.exact
+                                                        ? ExactSearch(*snapshot.index, rows, params)
+                                                        : Search(*snapshot.index, rows, params));
+    if (h == 0) {
+      *stats = found.stats;
+    } else {
+      AddWork(found.stats, stats);
+    }
+    for (SearchResult& result : found.results) {
+      candidates.push_back(std::move(result));
+      half_of.push_back(h);
+    }
+  }
+  std::vector<size_t> kept(candidates.size());
+  for (size_t i = 0; i < kept.size(); ++i) kept[i] = i;
+  if (halves.size() > 1) {
+    kept = RankedIndices(candidates, halves[0].params.max_overlap, halves[0].params.max_results);
+  }
   std::vector<SearchHit> hits;
-  hits.reserve(found.results.size());
-  for (const SearchResult& result : found.results) {
-    MOTIONDB_ASSIGN_OR_RETURN(hits.emplace_back(), FullHit(snapshot, query, result, options));
+  hits.reserve(kept.size());
+  for (const size_t i : kept) {
+    const Half& half = halves[half_of[i]];
+    MOTIONDB_ASSIGN_OR_RETURN(hits.emplace_back(),
+                              FullHit(snapshot, *half.query, candidates[i], options));
+    hits.back().mirrored = half.mirrored;
   }
   return hits;
 }
 
-// The answer's size at most (SearchAnswerBytes), checked with what the batch's earlier answers
-// took against request.answers.
+// The answer's size at most (SearchAnswerBytes) for queries of up to `query_rows` rows, checked
+// with what the batch's earlier answers took against request.answers.
 absl::StatusOr<int64_t> CheckAnswer(const SearchRequest& request, const SearchParams& params,
-                                    const Query& query, const Skeleton& skeleton) {
-  const int64_t path_rows = request.params.return_path ? query.row_count : 0;
+                                    int64_t query_rows, const Skeleton& skeleton) {
+  const int64_t path_rows = request.params.return_path ? query_rows : 0;
   const int64_t bytes = SearchAnswerBytes(params.max_results, path_rows, request.explain, skeleton);
   MOTIONDB_RETURN_IF_ERROR(request.answers->Check(
       request.answers_used + bytes + kAnswerFixedBytes,
@@ -289,6 +363,7 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                             FindSpace(registry_, request.space));
   const int dims = snapshot->space->dims();
   Query query;
+  std::optional<Clip> uploaded;  // an uploaded query's clip, kept to be mirrored
   const HitOptions options{request.exact, request.explain, request.params.return_path};
   std::optional<ExcludedRange> own;
   if (const auto* stored = std::get_if<ClipSelection>(&request.query)) {
@@ -296,32 +371,48 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
     if (request.exclude_query.value_or(true))
       own = OwnRange(*snapshot, stored->clip_id, query.range);
   } else if (const auto* upload = std::get_if<UploadedQuery>(&request.query)) {
-    MOTIONDB_ASSIGN_OR_RETURN(
-        query, QueryOfUpload(*upload, *snapshot, limits_, max_query_frames_, should_stop));
+    MOTIONDB_ASSIGN_OR_RETURN(UploadedFile read,
+                              ReadUpload(upload->bvh, "bvh", limits_, should_stop));
+    if (read.takes.size() != 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("bvh: the file holds ", read.takes.size(),
+                       " takes; a query is one (ingest the file and query a take by its clip)"));
+    }
+    uploaded = std::move(read.takes[0].clip);
+    MOTIONDB_ASSIGN_OR_RETURN(query,
+                              QueryOfUpload(*upload, *uploaded, *snapshot, max_query_frames_));
   } else {
     return absl::InvalidArgumentError("query: give a stored clip (clip) or a BVH file (bvh)");
   }
-  MOTIONDB_ASSIGN_OR_RETURN(SearchParams params,
-                            ResolveParams(request, query, dims, searches_running));
-  params.excluded = own;
-  {
+  std::optional<Query> mirrored;
+  if (request.mirror) {
+    MOTIONDB_ASSIGN_OR_RETURN(mirrored,
+                              MirroredQuery(query, uploaded, request, *snapshot, database_));
+  }
+  std::vector<Half> halves;
+  for (const Query* half : {&query, mirrored ? &*mirrored : nullptr}) {
+    if (half == nullptr) continue;
+    MOTIONDB_ASSIGN_OR_RETURN(SearchParams params,
+                              ResolveParams(request, *half, dims, searches_running));
+    params.excluded = own;
     SearchParams searched = params;
     searched.return_path = params.return_path || request.explain;  // as Hits asks
-    MOTIONDB_RETURN_IF_ERROR(CheckWarpMemory(query.row_count, searched, request.exact,
+    MOTIONDB_RETURN_IF_ERROR(CheckWarpMemory(half->row_count, searched, request.exact,
                                              snapshot->space->sample_rate(), max_query_frames_));
+    params.should_stop = should_stop;
+    halves.push_back({half, std::move(params), half != &query});
   }
-  params.should_stop = should_stop;
 
   SearchOutcome outcome;
   if (request.answers != nullptr) {
-    MOTIONDB_ASSIGN_OR_RETURN(outcome.answer_bytes,
-                              CheckAnswer(request, params, query, snapshot->space->skeleton()));
+    const int64_t rows = std::max(query.row_count, mirrored ? mirrored->row_count : 0);
+    MOTIONDB_ASSIGN_OR_RETURN(outcome.answer_bytes, CheckAnswer(request, halves[0].params, rows,
+                                                                snapshot->space->skeleton()));
   }
   outcome.query_frames = query.row_count;
   if (snapshot->index) {
     outcome.library_frames = snapshot->index->total_frames();
-    MOTIONDB_ASSIGN_OR_RETURN(outcome.hits,
-                              Hits(*snapshot, query, params, options, &outcome.stats));
+    MOTIONDB_ASSIGN_OR_RETURN(outcome.hits, Hits(*snapshot, halves, options, &outcome.stats));
     if (outcome.stats.characteristic_frame >= 0) {
       outcome.characteristic_frame =
           query.frames.ToOriginal(query.first_row + outcome.stats.characteristic_frame);

@@ -55,6 +55,12 @@ struct SearchRequest {
   // A stored-clip query: drop hits in its clip overlapping its range (unset: true), filling
   // params.max_results with others. Ignored for an uploaded query.
   std::optional<bool> exclude_query;
+  // Also search the query's left/right mirror (core/motion/clip_mirror.h, by the skeleton's
+  // humanoid map): its rows projected on the spot, searched with the same parameters and
+  // excluded range, its results ranked with the query's own under the one max_results and
+  // overlap suppression, each marked SearchHit::mirrored. FAILED_PRECONDITION when the
+  // skeleton's map cannot mirror.
+  bool mirror = false;
   // Each hit with its SearchExplanation (the path is computed for it, and returned only when
   // params.return_path asks).
   bool explain = false;
@@ -80,7 +86,8 @@ struct SearchHit {
   int end_frame = 0;
   double score = 0;       // mean pose distance along the warp; lower is better
   int seed_frame = -1;    // the frame matched to the characteristic query frame; -1 in exact mode
-  std::vector<int> path;  // per query sample at the space rate, when requested
+  bool mirrored = false;  // found by the query's mirror (SearchRequest::mirror)
+  std::vector<int> path;  // per query sample at the space rate (of the mirror's when mirrored)
   std::optional<SearchExplanation> explanation;  // when requested
 };
 

@@ -1,5 +1,6 @@
 #include "server/skeleton_map.h"
 
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -56,6 +57,25 @@ absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t
       storage::SkeletonRecord record,
       database.UpdateSlotOverrides(skeleton_id, change, {.should_stop = should_stop}));
   return View(std::move(record));
+}
+
+absl::StatusOr<SkeletonMirror> MirrorOfSkeleton(storage::Database& database, int64_t skeleton_id,
+                                                const Skeleton& skeleton,
+                                                const RowMatrixXd& mean_pose) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::SkeletonRecord record,
+                            database.GetSkeleton(skeleton_id));
+  MOTIONDB_ASSIGN_OR_RETURN(const HumanoidMap map, MapHumanoid(skeleton, record.slot_overrides));
+  absl::StatusOr<SkeletonMirror> mirror = MakeSkeletonMirror(skeleton, map);
+  if (mirror.ok()) return mirror;
+  const absl::StatusOr<SkeletonMirror> about_mean = MakeSkeletonMirror(skeleton, map, mean_pose);
+  if (about_mean.ok()) return about_mean;
+  const std::string why =
+      about_mean.status().message() == mirror.status().message()
+          ? std::string(mirror.status().message())
+          : absl::StrCat(mirror.status().message(), "; and about the space's mean pose, ",
+                         about_mean.status().message());
+  return absl::Status(mirror.status().code(),
+                      absl::StrCat("mirror: skeleton ", skeleton_id, " cannot be mirrored: ", why));
 }
 
 }  // namespace motiondb::server

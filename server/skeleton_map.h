@@ -8,7 +8,9 @@
 #include <functional>
 
 #include "absl/status/statusor.h"
+#include "core/motion/clip_mirror.h"
 #include "core/motion/humanoid_map.h"
+#include "core/motion/matrix.h"
 #include "server/answer_limit.h"
 #include "storage/database.h"
 
@@ -31,6 +33,15 @@ absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t
                                             const storage::SlotOverrideChange& change,
                                             const AnswerLimit& answers,
                                             const std::function<bool()>& should_stop);
+
+// The mirror (core/motion/clip_mirror.h) of a clip of skeleton `skeleton_id` whose own joints
+// are `skeleton` (offsets differ between a skeleton's clips), by the skeleton's map as
+// ShowSkeleton shows it: about the rest pose when that is symmetric, else about `mean_pose`
+// (joints x 4: a space's mean orientations; Bandai's rest pose is no standing human). NOT_FOUND
+// for an unknown skeleton; FAILED_PRECONDITION, saying why, when the map cannot mirror it.
+absl::StatusOr<SkeletonMirror> MirrorOfSkeleton(storage::Database& database, int64_t skeleton_id,
+                                                const Skeleton& skeleton,
+                                                const RowMatrixXd& mean_pose);
 
 }  // namespace motiondb::server
 

@@ -21,11 +21,8 @@ bool RanksBefore(const SearchResult& a, const SearchResult& b) {
          std::tie(b.score, b.clip_index, b.last_frame, b.first_frame);
 }
 
-namespace {
-
-// The indices of the candidates RankResults keeps, in its order.
-std::vector<size_t> RankedOrder(const std::vector<SearchResult>& candidates, double max_overlap,
-                                int max_results) {
+std::vector<size_t> RankedIndices(const std::vector<SearchResult>& candidates, double max_overlap,
+                                  int max_results) {
   std::vector<size_t> order(candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(),
@@ -41,19 +38,17 @@ std::vector<size_t> RankedOrder(const std::vector<SearchResult>& candidates, dou
   return kept;
 }
 
-}  // namespace
-
 std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
                                       int max_results) {
   std::vector<SearchResult> kept;
-  for (size_t i : RankedOrder(candidates, max_overlap, max_results)) {
+  for (size_t i : RankedIndices(candidates, max_overlap, max_results)) {
     kept.push_back(std::move(candidates[i]));
   }
   return kept;
 }
 
 int RankedCount(const std::vector<SearchResult>& candidates, double max_overlap, int max_results) {
-  return static_cast<int>(RankedOrder(candidates, max_overlap, max_results).size());
+  return static_cast<int>(RankedIndices(candidates, max_overlap, max_results).size());
 }
 
 void StreamingTopResults::Offer(SearchResult candidate) {

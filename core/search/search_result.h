@@ -70,6 +70,10 @@ bool RanksBefore(const SearchResult& a, const SearchResult& b);
 // `max_overlap` of its length, and keeps at most `max_results`.
 std::vector<SearchResult> RankResults(std::vector<SearchResult> candidates, double max_overlap,
                                       int max_results);
+// The indices of the candidates RankResults would keep, in its order, the candidates left as
+// they are (for a caller that knows more of each candidate than its result).
+std::vector<size_t> RankedIndices(const std::vector<SearchResult>& candidates, double max_overlap,
+                                  int max_results);
 // How many results RankResults would keep, the candidates left as they are.
 int RankedCount(const std::vector<SearchResult>& candidates, double max_overlap, int max_results);
 

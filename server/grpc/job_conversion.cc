@@ -18,6 +18,9 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
        "search.query: the job's queries are its manual labels"},
       {search.tags_size() > 0, "search.tags: give the tags as tags"},
       {search.explain(), "search.explain: a propagation keeps no explanations"},
+      {search.mirror(),
+       "search.mirror: a propagation gives a label to ranges like its own, not to their mirror "
+       "images"},
       {search.has_exclude_query(), "search.exclude_query: a query's own range is always excluded"},
       {search.has_characteristic_frame(), "search.characteristic_frame: each query finds its own"},
       {search.characteristic_frames_size() > 0,

@@ -102,6 +102,7 @@ absl::StatusOr<SearchRequest> FromProto(const v1::SearchRequest& request) {
   out.exact = request.exact();
   out.exclude_query = Optional(request.has_exclude_query(), request.exclude_query());
   out.explain = request.explain();
+  out.mirror = request.mirror();
   return out;
 }
 
@@ -128,6 +129,7 @@ void ToProto(const SearchOutcome& outcome, v1::SearchResponse* response) {
     out->set_end_frame(hit.end_frame);
     out->set_score(hit.score);
     out->set_seed_frame(hit.seed_frame);
+    out->set_mirrored(hit.mirrored);
     for (const int frame : hit.path) out->add_path(frame);
     if (hit.explanation) ToProto(*hit.explanation, out->mutable_explanation());
   }

@@ -130,6 +130,11 @@ class PackageTest(unittest.TestCase):
         self.assertNotIn(ids[4], [r.clip_id for r in ranged[:3]])
         by_file = client.search("arms", bvh=arm_raise_bvh(85, 0.9).encode(), max_results=3)
         self.assertEqual(len(by_file), 3)
+        # mirror=: the arm of Hips, Shoulder, Elbow has no side to mirror to, and says so.
+        with self.assertRaises(motiondb.Error) as raised:
+            client.search("arms", clip="raise_1", mirror=True)
+        self.assertEqual(raised.exception.code, "FAILED_PRECONDITION")
+        self.assertIn("cannot be mirrored", raised.exception.message)
 
     def test_1b_skeletons_and_their_humanoid_maps(self):
         client = self.client

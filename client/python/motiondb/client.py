@@ -323,8 +323,10 @@ class Client:
         """Finds the ranges that move like the query, best first: a stored clip (id or name) or a
         range of it (first, last: frames at its rate, inclusive), or a BVH file (path or bytes,
         first/last a range of it). params: SearchRequest's fields (max_results, exact,
-        neighbours, tags, clip_ids, exclude_query, ...). Each result has clip_id, clip_name,
-        start_s, end_s, start_frame, end_frame and score (lower is closer)."""
+        neighbours, tags, clip_ids, exclude_query, mirror, ...). Each result has clip_id,
+        clip_name, start_s, end_s, start_frame, end_frame and score (lower is closer); with
+        mirror=True the query's left/right mirror is searched too, and each result's mirrored
+        says whether the mirror found it."""
         request = self._search_request(params)
         request.space = space
         if (clip is None) == (bvh is None):
