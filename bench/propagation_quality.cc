@@ -23,8 +23,15 @@
 // jobs), and a third calibration shows what one fixed s0 would do: the first space's, used in
 // every space.
 //
+// With --split (issue 39), only bandai1 across styles, sources and targets within one half of
+// its styles (kSplits: tuning or reporting), each job run with each --variant (a search's seed
+// selection, dtw_dims, the exact search, or a space with a metric learned from the job's
+// examples), and per run the coverage and accuracy a threshold or margin rule on the strongest
+// covering label would give.
+//
 // usage: propagation_quality [--seeds N] [--max-results M]... [--take-clips N]
 //                            [--space body|uniform|scaled]...
+//                            [--split tuning|reporting [--variant V]... [--k K]...]
 #include <signal.h>
 #include <unistd.h>
 
@@ -65,6 +72,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr int kPool = 3;  // bandai2-normal examples set aside per content and seed (k <= kPool)
+
 struct Flags {
   int seeds = 3;
   std::vector<int> max_results = {20, 100};
@@ -72,9 +81,55 @@ struct Flags {
   // The spaces the experiments run in, each trained on every clip: body (the defaults),
   // uniform (every joint weighted 1), scaled (each dimension scaled by its eigenvalue).
   std::vector<std::string> spaces = {"body"};
+  // Set: only bandai1 across styles, within this half of its styles (kSplits), with each of
+  // `variants` and `ks` source styles.
+  std::string split;
+  std::vector<std::string> variants = {"baseline"};
+  std::vector<int> ks = {1, kPool};
+  // With a split: each variant's jobs also with each of these rival_share values (0: unset).
+  std::vector<double> rival_shares = {0};
 };
 
-constexpr int kPool = 3;  // bandai2-normal examples set aside per content and seed (k <= kPool)
+// Issue 39's held-out rule for propagation across styles: bandai1's 14 styles recorded by one
+// actor (`normal`, four skeletons, left out as in every bandai1 take here), in alphabetical
+// order, split by turns: the tuning half, on which a job's defaults are chosen, and the
+// reporting half, never chosen on. Sources and targets of an experiment are in one half.
+const std::map<std::string, std::set<std::string>> kSplits = {
+    {"tuning", {"active", "childish", "feminine", "happy", "musical", "old", "sad"}},
+    {"reporting", {"angry", "chimpira", "giant", "masculinity", "not-confident", "proud", "tired"}},
+};
+
+// How a job of the split experiments searches: its space (`learned`: a space with a metric
+// learned from the experiment's examples, created for the job, or `body` when they cannot fit
+// one: fewer than two styles; `others`: learned from the examples and every clip of the other
+// half's styles, labelled by its content, whose labels are deleted before the job) and its
+// search parameters.
+struct Variant {
+  bool learned = false;
+  bool others = false;
+  v1::SeedSelection seeds = v1::SEED_SELECTION_UNSPECIFIED;
+  int dtw_dims = 0;  // 0: the default
+  bool exact = false;
+};
+
+const std::map<std::string, Variant> kVariants = {
+    {"baseline", {}},
+    {"shapes", {.seeds = v1::SEED_SELECTION_SHAPE_WINDOWS}},
+    {"dtw10", {.dtw_dims = 10}},
+    {"shapes-dtw10", {.seeds = v1::SEED_SELECTION_SHAPE_WINDOWS, .dtw_dims = 10}},
+    {"exact", {.exact = true}},
+    {"learned", {.learned = true}},
+    {"learned-dtw10", {.learned = true, .dtw_dims = 10}},
+    {"learned-shapes", {.learned = true, .seeds = v1::SEED_SELECTION_SHAPE_WINDOWS}},
+    {"learned-shapes-dtw10",
+     {.learned = true, .seeds = v1::SEED_SELECTION_SHAPE_WINDOWS, .dtw_dims = 10}},
+    {"others", {.learned = true, .others = true}},
+    {"others-dtw10", {.learned = true, .others = true, .dtw_dims = 10}},
+    {"others-shapes", {.learned = true, .others = true, .seeds = v1::SEED_SELECTION_SHAPE_WINDOWS}},
+    {"others-shapes-dtw10",
+     {.learned = true, .others = true, .seeds = v1::SEED_SELECTION_SHAPE_WINDOWS, .dtw_dims = 10}},
+};
+
 constexpr char kNone[] = "-";  // the prediction of a clip or frame without a label
 // The value a user asking for confident labels would filter on (FindLabels' min_value): where
 // the score scale s0 matters. Which labels a job keeps and which is strongest do not depend on
@@ -141,15 +196,25 @@ class Api {
     return response.clip();
   }
 
-  // A space of Flags::spaces, trained on every clip.
-  absl::Status CreateSpace(const std::string& name) {
+  // A space of Flags::spaces, trained on every clip; `learned`: in the metric learned from the
+  // manual labels (the defaults otherwise).
+  absl::Status CreateSpace(const std::string& name, bool learned = false) {
     v1::CreateSpaceRequest request;
     request.set_name(name);
     if (name == "uniform") request.set_weight_preset(v1::WEIGHT_PRESET_UNIFORM);
     if (name == "scaled") request.set_metric(v1::SPACE_METRIC_EIGENVALUE_SCALED);
+    if (learned) request.mutable_learned_metric();
     v1::Space space;
     grpc::ClientContext context;
     return FromGrpc(spaces_->CreateSpace(&context, request, &space), "CreateSpace");
+  }
+
+  absl::Status DeleteSpace(const std::string& name) {
+    v1::DeleteSpaceRequest request;
+    request.set_name(name);
+    v1::DeleteSpaceResponse response;
+    grpc::ClientContext context;
+    return FromGrpc(spaces_->DeleteSpace(&context, request, &response), "DeleteSpace");
   }
 
   // Deletes every manual label (and so every propagated one) and adds `examples`.
@@ -176,10 +241,16 @@ class Api {
   // job and returns the propagated labels.
   absl::StatusOr<std::vector<v1::Label>> Propagate(const std::string& space,
                                                    const std::vector<std::string>& tags,
-                                                   int max_results) {
+                                                   int max_results, const Variant& variant = {},
+                                                   double rival_share = 0) {
     v1::StartPropagationRequest start;
     start.set_space(space);
-    start.mutable_search()->set_max_results(max_results);
+    v1::SearchRequest& search = *start.mutable_search();
+    search.set_max_results(max_results);
+    search.set_seed_selection(variant.seeds);
+    if (variant.dtw_dims > 0) search.set_dtw_dims(variant.dtw_dims);
+    search.set_exact(variant.exact);
+    if (rival_share > 0) start.set_rival_share(rival_share);
     for (const std::string& tag : tags) start.add_tags(tag);
     v1::Job job;
     grpc::ClientContext context;
@@ -429,15 +500,16 @@ std::vector<Experiment> Bandai1WithinStyle(const std::vector<CorpusClip>& corpus
   return experiments;
 }
 
-// bandai1 across styles: k source styles drawn from `seed`, one clip per content from each;
-// evaluated on the other styles' clips, and on their takes.
+// bandai1 across `styles`: for each of `ks`, k source styles drawn from `seed`, one clip per
+// content from each; evaluated on the other styles' clips, and on their takes among
+// `style_takes`.
 std::vector<Experiment> Bandai1AcrossStyles(const std::vector<CorpusClip>& corpus,
-                                            const std::vector<Take>& style_takes, int seed) {
-  std::vector<std::string> styles;
-  for (const Take& take : style_takes) styles.push_back(take.tag.substr(take.tag.rfind(':') + 1));
+                                            std::vector<std::string> styles,
+                                            const std::vector<Take>& style_takes, int seed,
+                                            const std::vector<int>& ks) {
   Shuffle(styles, seed);
   std::vector<Experiment> experiments;
-  for (const int k : {1, kPool}) {
+  for (const int k : ks) {
     const std::set<std::string> sources(styles.begin(), styles.begin() + k);
     Experiment clips{"bandai1, across styles", k, {}, {}, {}, {}};
     Experiment takes{"bandai1 long takes, across styles", k, {}, {}, {}, {}};
@@ -465,7 +537,7 @@ std::vector<Experiment> Bandai1AcrossStyles(const std::vector<CorpusClip>& corpu
     }
     takes.examples = clips.examples;
     experiments.push_back(std::move(clips));
-    experiments.push_back(std::move(takes));
+    if (!takes.takes.empty()) experiments.push_back(std::move(takes));
   }
   return experiments;
 }
@@ -490,8 +562,18 @@ absl::StatusOr<std::vector<Take>> IngestStyleTakes(Api& api,
 // ---------------------------------------------------------------------------------------------
 // Scoring.
 
+// A scored clip's strongest covering label's value, the strongest of another descriptor's
+// (0: none), and whether the strongest is right: what a threshold or margin rule would keep.
+struct ClipCall {
+  double best = 0, second = 0;
+  bool right = false;
+};
+
 // Counts of (true content, prediction), and the frame and segment counts of takes.
 struct Score {
+  std::vector<ClipCall> calls;  // the covered clips
+  int64_t clips = 0;            // scored, covered or not
+  int learned_fallbacks = 0;    // `learned` jobs run in `body`: the examples fit no metric
   std::map<std::string, std::map<std::string, int64_t>> confusion;
   // Per calibration: clips whose strongest covering label has a value of at least
   // kConfidentValue, how many of those are right, and each job's s0.
@@ -538,6 +620,18 @@ void ScoreClips(const Experiment& experiment, const LabelsByClip& labels,
         found == labels.end() ? nullptr : Strongest(found->second, (clip->frames + 1) / 2);
     const std::string predicted = best == nullptr ? kNone : best->descriptor_name();
     ++score->confusion[clip->content][predicted];
+    ++score->clips;
+    if (best != nullptr) {
+      ClipCall& call = score->calls.emplace_back();
+      call.best = best->value();
+      call.right = predicted == clip->content;
+      for (const v1::Label* label : found->second) {
+        if (label->descriptor_name() != predicted &&
+            2 * (label->last_frame() - label->first_frame() + 1) >= clip->frames + 1) {
+          call.second = std::max(call.second, label->value());
+        }
+      }
+    }
     for (int c = 0; c < kCalibrations; ++c) {
       if (best != nullptr && Factor(best->score(), scales[c]) >= kConfidentValue) {
         ++score->confident[c];
@@ -624,13 +718,33 @@ void ScoreTakes(const Experiment& experiment, const LabelsByClip& labels, Score*
   }
 }
 
+constexpr char kLearnedSpace[] = "learned";
+
 // `fixed_scale`: the fixed s0 of every space, set from the first job's space scale when 0.
-absl::Status RunExperiment(Api& api, const std::string& space, const Experiment& experiment,
-                           int max_results, double* fixed_scale, Score* score) {
+// `others`: labelled too while an `others` variant's space is created.
+absl::Status RunExperiment(Api& api, const std::string& body, const Variant& variant,
+                           double rival_share, const Experiment& experiment,
+                           const std::vector<const CorpusClip*>& others, int max_results,
+                           double* fixed_scale, Score* score) {
   if (experiment.clips.empty() && experiment.takes.empty()) return absl::OkStatus();
-  MOTIONDB_RETURN_IF_ERROR(api.SetExamples(experiment.examples));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<v1::Label> labels,
-                            api.Propagate(space, experiment.tags, max_results));
+  std::vector<const CorpusClip*> fitted = experiment.examples;
+  if (variant.others) fitted.insert(fitted.end(), others.begin(), others.end());
+  MOTIONDB_RETURN_IF_ERROR(api.SetExamples(fitted));
+  std::string space = body;
+  if (variant.learned) {
+    const absl::Status created = api.CreateSpace(kLearnedSpace, /*learned=*/true);
+    if (variant.others) MOTIONDB_RETURN_IF_ERROR(api.SetExamples(experiment.examples));
+    if (created.ok()) {
+      space = kLearnedSpace;
+    } else if (absl::IsFailedPrecondition(created)) {
+      ++score->learned_fallbacks;
+    } else {
+      return created;
+    }
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const std::vector<v1::Label> labels,
+      api.Propagate(space, experiment.tags, max_results, variant, rival_share));
   LabelsByClip by_clip;
   for (const v1::Label& label : labels) by_clip[label.clip_id()].push_back(&label);
   ++score->jobs;
@@ -643,7 +757,7 @@ absl::Status RunExperiment(Api& api, const std::string& space, const Experiment&
   for (int c = 0; c < kCalibrations; ++c) score->scales[c].push_back(scales[c]);
   ScoreTakes(experiment, by_clip, score);
   ScoreClips(experiment, by_clip, scales, score);
-  return absl::OkStatus();
+  return space == body ? absl::OkStatus() : api.DeleteSpace(space);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -721,17 +835,59 @@ void PrintRow(const std::string& name, int k, int max_results, const Score& scor
               Ratio(all.right, all.total), takes.c_str(), calibrated.c_str());
 }
 
+// What a rule deciding which clips keep their strongest label would give: coverage and accuracy
+// of the covered clips, the strongest kept when its value is at least a threshold, or when the
+// strongest of another descriptor is below a share of it.
+void PrintRules(const std::string& name, int k, int max_results, const Score& score) {
+  if (score.clips == 0) return;
+  const auto row = [&](const std::string& rule, const std::function<bool(const ClipCall&)>& keep) {
+    int64_t kept = 0, right = 0;
+    for (const ClipCall& call : score.calls) {
+      if (!keep(call)) continue;
+      ++kept;
+      right += call.right;
+    }
+    std::printf("| %s | %d | %d | %s | %.3f | %.3f | %.3f |\n", name.c_str(), k, max_results,
+                rule.c_str(), Ratio(kept, score.clips), Ratio(right, kept),
+                Ratio(right, score.clips));
+  };
+  row("strongest", [](const ClipCall&) { return true; });
+  for (const double at_least : {0.001, 0.01, 0.05, 0.1, 0.2, 0.3, 0.5}) {
+    row(absl::StrFormat("value >= %g", at_least),
+        [&](const ClipCall& call) { return call.best >= at_least; });
+  }
+  for (const double share : {0.95, 0.9, 0.85, 0.8, 0.75, 0.7, 0.6, 0.5, 0.3}) {
+    row(absl::StrFormat("other < %g x strongest", share),
+        [&](const ClipCall& call) { return call.second < share * call.best; });
+  }
+}
+
 absl::StatusOr<std::vector<Experiment>> AllExperiments(Api& api,
                                                        const std::vector<CorpusClip>& corpus,
                                                        const Flags& flags,
                                                        std::deque<Take>* bandai2_takes,
                                                        const std::vector<Take>& style_takes) {
   std::vector<Experiment> experiments;
+  if (!flags.split.empty()) {
+    const std::set<std::string>& half = kSplits.at(flags.split);
+    for (int seed = 1; seed <= flags.seeds; ++seed) {
+      std::vector<Experiment> some =
+          Bandai1AcrossStyles(corpus, {half.begin(), half.end()}, {}, seed, flags.ks);
+      for (Experiment& experiment : some) experiment.name += ", " + flags.split + " split";
+      experiments.insert(experiments.end(), some.begin(), some.end());
+    }
+    return experiments;
+  }
+  std::vector<std::string> take_styles;
+  for (const Take& take : style_takes) {
+    take_styles.push_back(take.tag.substr(take.tag.rfind(':') + 1));
+  }
   for (int seed = 1; seed <= flags.seeds; ++seed) {
     MOTIONDB_ASSIGN_OR_RETURN(std::vector<Experiment> some,
                               Bandai2Experiments(api, corpus, seed, flags, bandai2_takes));
     for (const std::vector<Experiment>& more :
-         {some, Bandai1WithinStyle(corpus, seed), Bandai1AcrossStyles(corpus, style_takes, seed)}) {
+         {some, Bandai1WithinStyle(corpus, seed),
+          Bandai1AcrossStyles(corpus, take_styles, style_takes, seed, {1, kPool})}) {
       experiments.insert(experiments.end(), more.begin(), more.end());
     }
   }
@@ -746,19 +902,42 @@ absl::Status Measure(Api& api, const fs::path& mocap, const Flags& flags) {
   corpus.insert(corpus.end(), bandai2.begin(), bandai2.end());
   // Trained on the clips; the takes, ingested after, are projected into them.
   for (const std::string& space : flags.spaces) MOTIONDB_RETURN_IF_ERROR(api.CreateSpace(space));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Take> style_takes, IngestStyleTakes(api, corpus));
+  std::vector<Take> style_takes;  // the split experiments evaluate clips only
+  if (flags.split.empty()) {
+    MOTIONDB_ASSIGN_OR_RETURN(style_takes, IngestStyleTakes(api, corpus));
+  }
   std::deque<Take> bandai2_takes;  // the experiments point into it
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<Experiment> experiments,
                             AllExperiments(api, corpus, flags, &bandai2_takes, style_takes));
-  // By space and experiment ("body: bandai2-normal, within style"), k and max_results.
+  // Each space with the default search, or with a split each variant and rival share in the
+  // first space.
+  std::vector<std::tuple<std::string, std::string, double>> runs;  // space, variant, share
+  for (const std::string& space : flags.spaces) {
+    if (flags.split.empty()) runs.emplace_back(space, "baseline", 0);
+  }
+  for (const std::string& variant : flags.variants) {
+    for (const double share : flags.rival_shares) {
+      if (!flags.split.empty()) runs.emplace_back(flags.spaces.front(), variant, share);
+    }
+  }
+  // The clips of bandai1's other half (its one-actor styles), for the `others` variants.
+  const std::vector<const CorpusClip*> others = Select(corpus, [&](const CorpusClip& c) {
+    return !flags.split.empty() && c.dataset == "bandai1" && c.style != "normal" &&
+           !kSplits.at(flags.split).contains(c.style);
+  });
+  // By space or variant and experiment ("body: bandai2-normal, within style"), k and
+  // max_results.
   std::map<std::tuple<std::string, int, int>, Score> scores;
   double fixed_scale = 0;
-  for (const std::string& space : flags.spaces) {
+  for (const auto& [space, variant, share] : runs) {
+    const std::string run = flags.split.empty() ? space
+                            : share > 0         ? absl::StrCat(variant, " rival ", share)
+                                                : variant;
     for (const int max_results : flags.max_results) {
       for (const Experiment& experiment : experiments) {
         MOTIONDB_RETURN_IF_ERROR(RunExperiment(
-            api, space, experiment, max_results, &fixed_scale,
-            &scores[{absl::StrCat(space, ": ", experiment.name), experiment.k, max_results}]));
+            api, space, kVariants.at(variant), share, experiment, others, max_results, &fixed_scale,
+            &scores[{absl::StrCat(run, ": ", experiment.name), experiment.k, max_results}]));
       }
     }
   }
@@ -772,6 +951,19 @@ absl::Status Measure(Api& api, const fs::path& mocap, const Flags& flags) {
       "\n");
   for (const auto& [key, score] : scores) {
     PrintRow(std::get<0>(key), std::get<1>(key), std::get<2>(key), score);
+  }
+  std::printf(
+      "\n| run: experiment | k | max_results | rule | coverage | accuracy (covered) | accuracy "
+      "(all) |\n|---|---:|---:|---|---:|---:|---:|\n");
+  for (const auto& [key, score] : scores) {
+    PrintRules(std::get<0>(key), std::get<1>(key), std::get<2>(key), score);
+  }
+  for (const auto& [key, score] : scores) {
+    if (score.learned_fallbacks > 0) {
+      std::printf("%s, k = %d: %d jobs in %s (their examples fit no metric)\n",
+                  std::get<0>(key).c_str(), std::get<1>(key), score.learned_fallbacks,
+                  flags.spaces.front().c_str());
+    }
   }
   for (const auto& [key, score] : scores) {
     std::printf("\n%s, k = %d, max_results %d: per content, right/all (covered): wrong\n",
@@ -828,6 +1020,24 @@ int main(int argc, char** argv) {
                  "uniform (uniform joint weights), scaled (eigenvalue-scaled metric)")
       ->capture_default_str()
       ->check(CLI::IsMember({"body", "uniform", "scaled"}));
+  app.add_option("--split", flags.split,
+                 "only bandai1 across styles within this half of its styles: tuning or reporting")
+      ->check(CLI::IsMember({"tuning", "reporting"}));
+  std::vector<std::string> variant_names;
+  for (const auto& [name, variant] : motiondb::kVariants) variant_names.push_back(name);
+  app.add_option("--variant", flags.variants,
+                 "with --split: how the jobs search (repeat for several); learned: in a space "
+                 "with a metric learned from the examples, created for each job")
+      ->capture_default_str()
+      ->check(CLI::IsMember(variant_names));
+  app.add_option("--rival-share", flags.rival_shares,
+                 "with --split: each job also with this StartPropagation rival_share (repeat; "
+                 "0: unset)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--k", flags.ks, "with --split: source styles of the examples (repeat)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 6));
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }

@@ -15,6 +15,7 @@
 
 #include "absl/status/status.h"
 #include "client/server_connection.h"
+#include "motiondb/v1/search_service.pb.h"
 
 namespace motiondb::cli {
 
@@ -71,6 +72,11 @@ struct FrameRangeFlags {
 };
 // Adds --from and --to to `command`; `what` is what they cut ("the query", "the clip").
 void AddFrameRangeFlags(CLI::App* command, const std::string& what, FrameRangeFlags* range);
+
+// The --seeds flag of `search` and `propagate` (search_command.cc): its names, and the seed
+// selection one names.
+inline const std::vector<std::string> kSeedNames = {"frames", "places", "windows", "shapes"};
+v1::SeedSelection SeedSelectionNamed(const std::string& name);
 
 // The commands, each in its own file (clip_commands.cc has `skeletons` too).
 void AddInspect(Commands& commands);                       // inspect_command.cc

@@ -1,4 +1,5 @@
-// motiondb propagate --space S [--descriptor D]... [--max-results N] [--tag T]... [--wait] |
+// motiondb propagate --space S [--descriptor D]... [--max-results N] [--tag T]... [--exact]
+// [--seeds frames|places|windows|shapes] [--dtw-dims N] [--rival-share R] [--wait] |
 // jobs | job show|watch|cancel ID
 #include <unistd.h>
 
@@ -120,13 +121,19 @@ struct PropagateFlags {
   std::optional<int> max_results;
   std::vector<std::string> tags;
   bool exact = false;
+  std::optional<std::string> seeds;
+  std::optional<int> dtw_dims;
+  std::optional<double> rival_share;
   bool wait = false;
 };
 
 absl::Status Propagate(const PropagateFlags& flags, bool json, const ServerConnection& connection) {
   v1::StartPropagationRequest request;
   request.set_space(flags.space);
-  FlagNames names = {{"space", "--space"}, {"max_results", "--max-results"}};
+  FlagNames names = {{"space", "--space"},
+                     {"max_results", "--max-results"},
+                     {"dtw_dims", "--dtw-dims"},
+                     {"rival_share", "--rival-share"}};
   for (size_t i = 0; i < flags.descriptors.size(); ++i) {
     request.add_descriptor_names(flags.descriptors[i]);
     names.emplace_back(absl::StrCat("descriptors[", i, "]"),
@@ -134,6 +141,9 @@ absl::Status Propagate(const PropagateFlags& flags, bool json, const ServerConne
   }
   if (flags.max_results) request.mutable_search()->set_max_results(*flags.max_results);
   request.mutable_search()->set_exact(flags.exact);
+  if (flags.seeds) request.mutable_search()->set_seed_selection(SeedSelectionNamed(*flags.seeds));
+  if (flags.dtw_dims) request.mutable_search()->set_dtw_dims(*flags.dtw_dims);
+  if (flags.rival_share) request.set_rival_share(*flags.rival_share);
   for (const std::string& tag : flags.tags) request.add_tags(tag);
   MOTIONDB_ASSIGN_OR_RETURN(
       const v1::Job job,
@@ -208,14 +218,25 @@ void AddPropagate(Commands& commands) {
       ->type_name("T")
       ->allow_extra_args(false);
   propagate->add_flag("--exact", flags->exact, "exhaustive searches: slower, the true best");
+  OneOf(propagate->add_option("--seeds", flags->seeds,
+                              "each search's seeds, as search --seeds (default frames)"),
+        kSeedNames);
+  propagate
+      ->add_option("--dtw-dims", flags->dtw_dims,
+                   "each search's time-warp distance dimensions, as search --dtw-dims (default 5)")
+      ->type_name("N");
+  propagate
+      ->add_option("--rival-share", flags->rival_share,
+                   "write a range only where every overlapping range of another descriptor has "
+                   "less than R times its value (0 < R <= 1; default: write every descriptor's)")
+      ->type_name("R");
   propagate->add_flag("--wait", flags->wait,
                       "follow the job to its end (a progress bar on stderr); exit 1 unless it "
                       "succeeds");
   propagate->footer(
       "Each manual label is searched for in the space; every result range gets its descriptor\n"
-      "with value = label value x 2^-((score/s0)^2), s0 the median score of the searches' last\n"
-      "results. A re-run replaces the job's earlier output. Follow a job with 'motiondb job\n"
-      "watch ID'.");
+      "with value = label value x 2^-((score/s0)^2), s0 the space's score scale. A re-run\n"
+      "replaces the job's earlier output. Follow a job with 'motiondb job watch ID'.");
 }
 
 void AddJobSubcommands(Commands& commands, CLI::App* job) {

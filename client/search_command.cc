@@ -122,10 +122,7 @@ absl::StatusOr<v1::SearchRequest> BuildRequest(const SearchFlags& flags) {
   if (flags.second_anchor) request.set_second_anchor_scatter(*flags.second_anchor);
   if (flags.threads && flags.exact) request.set_exact_threads(*flags.threads);
   if (flags.threads && !flags.exact) request.set_threads(*flags.threads);
-  request.set_seed_selection(flags.seeds == "places"    ? v1::SEED_SELECTION_DISTINCT_PLACES
-                             : flags.seeds == "windows" ? v1::SEED_SELECTION_NEAREST_WINDOWS
-                             : flags.seeds == "shapes"  ? v1::SEED_SELECTION_SHAPE_WINDOWS
-                                                        : v1::SEED_SELECTION_NEAREST_FRAMES);
+  request.set_seed_selection(SeedSelectionNamed(flags.seeds));
   if (flags.epsilon) request.set_epsilon(static_cast<float>(*flags.epsilon));
   request.set_neutral(flags.neutral == "boundary" ? v1::NEUTRAL_POSE_BOUNDARY_MEAN
                       : flags.neutral == "origin" ? v1::NEUTRAL_POSE_ORIGIN
@@ -233,6 +230,13 @@ absl::Status Search(const SearchFlags& flags, bool json, const ServerConnection&
 
 }  // namespace
 
+v1::SeedSelection SeedSelectionNamed(const std::string& name) {
+  return name == "places"    ? v1::SEED_SELECTION_DISTINCT_PLACES
+         : name == "windows" ? v1::SEED_SELECTION_NEAREST_WINDOWS
+         : name == "shapes"  ? v1::SEED_SELECTION_SHAPE_WINDOWS
+                             : v1::SEED_SELECTION_NEAREST_FRAMES;
+}
+
 void AddSearch(Commands& commands) {
   auto flags = std::make_shared<SearchFlags>();
   const GlobalOptions& global = commands.global();
@@ -298,7 +302,7 @@ void AddSearch(Commands& commands) {
                            "seeds: the thesis's nearest frames, distinct places, the frames "
                            "nearest by their poses a quarter second either side too, or "
                            "candidates from the query's whole shape"),
-        {"frames", "places", "windows", "shapes"})
+        kSeedNames)
       ->capture_default_str();
   search->add_flag("--exact", flags->exact, "the exhaustive search: the true best, slower");
   search

@@ -750,6 +750,13 @@ TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
   EXPECT_EQ(job["done"], 1);
   EXPECT_EQ(job["parameters"]["max_results"], 3);
   const std::string id = job["job_id"];
+  r = Remote({"propagate", "--space", "body", "--descriptor", "step", "--seeds", "shapes",
+              "--dtw-dims", "10", "--rival-share", "0.8", "--wait", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json parameters = nlohmann::json::parse(r.out)["parameters"];
+  EXPECT_EQ(parameters["seed_selection"], "shape_windows");
+  EXPECT_EQ(parameters["dtw_dims"], 10);
+  EXPECT_EQ(parameters["rival_share"], 0.8);
   r = Remote({"propagate", "--space", "body", "--wait"});  // every manual descriptor
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr(" succeeded: step, turn in space body, 2/2 labels searched"));
@@ -757,8 +764,8 @@ TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
   r = Remote({"jobs", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json jobs = nlohmann::json::parse(r.out)["jobs"];
-  ASSERT_EQ(jobs.size(), 2u);
-  EXPECT_EQ(jobs[1]["job_id"], id);
+  ASSERT_EQ(jobs.size(), 3u);
+  EXPECT_EQ(jobs[2]["job_id"], id);
   // Unset, a job's max_results is propagation's 100, not a search's 20.
   EXPECT_EQ(jobs[0]["parameters"]["max_results"], 100);
   r = Remote({"jobs"});
@@ -777,7 +784,9 @@ TEST_F(CliServerTest, PropagateWaitJobsAndJobCommands) {
            {{"job", "show", "job-999"}, "NOT_FOUND"},
            {{"job", "watch", "job-999"}, "NOT_FOUND"},
            {{"propagate", "--space", "nosuch", "--descriptor", "step"}, "NOT_FOUND"},
-           {{"propagate", "--space", "body", "--descriptor", ""}, "--descriptor ''"}}) {
+           {{"propagate", "--space", "body", "--descriptor", ""}, "--descriptor ''"},
+           {{"propagate", "--space", "body", "--rival-share", "1.5"}, "--rival-share: 1.5"},
+           {{"propagate", "--space", "body", "--dtw-dims", "999"}, "--dtw-dims"}}) {
     r = Remote(args);
     EXPECT_EQ(r.exit_code, 1) << args[0] << " " << args[1];
     EXPECT_THAT(r.err, HasSubstr(error)) << args[0] << " " << args[1];

@@ -75,6 +75,38 @@ TEST(KeepStrongest, KeepsRangesSharingHalfOrLessOfTheShorterOne) {
   EXPECT_EQ(kept.size(), 2u);
 }
 
+storage::LabelRecord Rival(int64_t first, int64_t last, double value) {
+  storage::LabelRecord label = Range(first, last, value);
+  label.descriptor = "shrug";
+  return label;
+}
+
+// Two descriptors nearly as strong on one range: neither is written; a clearly stronger one is.
+TEST(DropContested, KeepsARangeOnlyWhereNoOtherDescriptorComesNearIt) {
+  EXPECT_TRUE(DropContested({Range(0, 99, 1.0), Rival(10, 109, 0.95)}, 0.9).empty());
+  const std::vector<storage::LabelRecord> kept =
+      DropContested({Range(0, 99, 1.0), Rival(10, 109, 0.5)}, 0.9);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].descriptor, "raise");
+  // Share 1: of two equal values neither is written, the stronger of two different ones is.
+  EXPECT_TRUE(DropContested({Range(0, 99, 0.5), Rival(0, 99, 0.5)}, 1).empty());
+  EXPECT_EQ(DropContested({Range(0, 99, 0.6), Rival(0, 99, 0.5)}, 1).size(), 1u);
+}
+
+// Rivals are ranges of another descriptor on the same clip sharing more than half of the
+// shorter one; ranges of one descriptor are never rivals (KeepStrongest settled those).
+TEST(DropContested, OnlyOverlappingRangesOfAnotherDescriptorOnItsClipAreRivals) {
+  storage::LabelRecord elsewhere = Rival(0, 99, 1.0);
+  elsewhere.clip_id = 2;
+  const std::vector<storage::LabelRecord> candidates = {Range(0, 99, 0.5), Range(50, 149, 0.5),
+                                                        Rival(140, 159, 1.0), elsewhere};
+  const std::vector<storage::LabelRecord> kept = DropContested(candidates, 0.9);
+  ASSERT_EQ(kept.size(), 4u);  // the rival shares exactly half of its 20 frames with the second
+  for (size_t i = 0; i < kept.size(); ++i)
+    EXPECT_EQ(kept[i].first_frame, candidates[i].first_frame);
+  EXPECT_EQ(DropContested({Range(0, 99, 0.5), Rival(85, 104, 1.0)}, 0.9).size(), 1u);
+}
+
 // 20 minutes of synthetic capture at 30 Hz in clips of a minute (tagged "even" and "odd" by
 // turns), a space over them, and manual labels "raise" and "shrug" on its first actions.
 class SpaceScaleTest : public ::testing::Test {

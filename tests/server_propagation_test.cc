@@ -142,6 +142,32 @@ TEST_F(ServerTest, PropagationLabelsSimilarRangesAndReRunsReplaceItsOutput) {
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(refused.error_message(), HasSubstr("succeeded"));
   EXPECT_THAT(server->Log(), HasSubstr("/motiondb.v1.JobService/StartPropagation OK "));
+
+  // Both descriptors with rival_share 1: of two ranges of the two descriptors sharing more than
+  // half of the shorter one, at most the stronger is written, and fewer labels than without it.
+  const v1::Job both =
+      PollJob(client, StartOrFail(client, Propagation({"other", "raise-right"})).job_id());
+  ASSERT_EQ(both.state(), v1::JOB_STATE_SUCCEEDED) << both.error();
+  v1::StartPropagationRequest exclusive = Propagation({"other", "raise-right"});
+  exclusive.set_rival_share(1);
+  const v1::Job uncontested = PollJob(client, StartOrFail(client, exclusive).job_id());
+  ASSERT_EQ(uncontested.state(), v1::JOB_STATE_SUCCEEDED) << uncontested.error();
+  EXPECT_GT(uncontested.labels_written(), 0);
+  EXPECT_LT(uncontested.labels_written(), both.labels_written());
+  const std::vector<v1::Label> written = Propagated(client);
+  ASSERT_EQ(static_cast<int64_t>(written.size()), uncontested.labels_written());
+  for (const v1::Label& label : written) {
+    for (const v1::Label& other : written) {
+      if (other.descriptor_name() == label.descriptor_name() ||
+          other.clip_id() != label.clip_id()) {
+        continue;
+      }
+      const int64_t shared = std::min(label.last_frame(), other.last_frame()) -
+                             std::max(label.first_frame(), other.first_frame()) + 1;
+      EXPECT_LE(2 * shared, std::min(label.last_frame() - label.first_frame() + 1,
+                                     other.last_frame() - other.first_frame() + 1));
+    }
+  }
 }
 
 // A space whose search metric is learned from the manual labels: refused with a clear error
@@ -269,6 +295,13 @@ TEST_F(ServerTest, BadPropagationsGetTheirStatusCodes) {
   v1::StartPropagationRequest request = Propagation({"step"});
   request.set_space("nowhere");
   EXPECT_EQ(start(request).error_code(), grpc::StatusCode::NOT_FOUND);
+  for (const double share : {0.0, -0.5, 1.5}) {
+    request = Propagation({"step"});
+    request.set_rival_share(share);
+    status = start(request);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << share;
+    EXPECT_THAT(status.error_message(), HasSubstr("rival_share"));
+  }
   request = Propagation({"step", ""});
   status = start(request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);

@@ -34,6 +34,7 @@ absl::StatusOr<PropagationRequest> FromProto(const v1::StartPropagationRequest& 
   MOTIONDB_ASSIGN_OR_RETURN(out.search, Prefixed("search", FromProto(search)));
   out.search.params.tags.assign(request.tags().begin(), request.tags().end());
   if (!search.has_max_results()) out.search.params.max_results = kPropagationMaxResults;
+  if (request.has_rival_share()) out.rival_share = request.rival_share();
   return out;
 }
 

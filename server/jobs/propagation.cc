@@ -92,6 +92,10 @@ absl::StatusOr<PropagationRequest> ResolvePropagation(storage::Database& databas
   std::sort(request.descriptors.begin(), request.descriptors.end());
   request.descriptors.erase(std::unique(request.descriptors.begin(), request.descriptors.end()),
                             request.descriptors.end());
+  if (request.rival_share && !(*request.rival_share > 0 && *request.rival_share <= 1)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rival_share: ", *request.rival_share, " is not in (0, 1]"));
+  }
   MOTIONDB_RETURN_IF_ERROR(CheckSearch(request.search, snapshot->space->dims()));
   return request;
 }
@@ -114,6 +118,7 @@ std::string ParametersJson(const PropagationRequest& request) {
                {"tags", params.tags}};
   if (search.ann_dims) json["ann_dims"] = *search.ann_dims;
   if (search.dtw_dims) json["dtw_dims"] = *search.dtw_dims;
+  if (request.rival_share) json["rival_share"] = *request.rival_share;
   return json.dump();
 }
 
@@ -228,6 +233,28 @@ std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord
   return kept;
 }
 
+std::vector<storage::LabelRecord> DropContested(std::vector<storage::LabelRecord> kept,
+                                                double share) {
+  std::map<int64_t, std::vector<const storage::LabelRecord*>> by_clip;
+  for (const storage::LabelRecord& label : kept) by_clip[label.clip_id].push_back(&label);
+  std::vector<bool> contested(kept.size(), false);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const storage::LabelRecord& label = kept[i];
+    for (const storage::LabelRecord* rival : by_clip[label.clip_id]) {
+      if (rival->descriptor != label.descriptor && OverlapsByHalf(label, *rival) &&
+          rival->value >= share * label.value) {
+        contested[i] = true;
+        break;
+      }
+    }
+  }
+  std::vector<storage::LabelRecord> uncontested;
+  for (size_t i = 0; i < kept.size(); ++i) {
+    if (!contested[i]) uncontested.push_back(std::move(kept[i]));
+  }
+  return uncontested;
+}
+
 absl::StatusOr<storage::PropagationOutput> RunPropagation(
     storage::Database& database, const IndexRegistry& registry, const SearchRunner& runner,
     ScoreScales& scales, const PropagationRequest& request, const std::string& job_id, int threads,
@@ -311,6 +338,8 @@ absl::StatusOr<storage::PropagationOutput> RunPropagation(
   output.space_id = snapshot->record.space_id;
   output.descriptors = request.descriptors;
   output.labels = KeepStrongest(std::move(candidates), manual);
+  if (request.rival_share)
+    output.labels = DropContested(std::move(output.labels), *request.rival_share);
   output.job.queries = progress.queries;
   output.job.queries_skipped = progress.skipped;
   output.job.done = progress.done;

@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ struct PropagationRequest {
   // of them are searched), ann_dims, dtw_dims, exact. Its space, query and exclude_query are
   // the job's to set; params.clip_ids and return_path must be unset.
   SearchRequest search;
+  // Set, in (0, 1]: a range is written only when each of its rivals (DropContested) has less
+  // than this share of its value. Unset: every descriptor's ranges are written.
+  std::optional<double> rival_share;
 };
 
 // Checks `request` and fills its descriptors when empty. NOT_FOUND for an unknown space;
@@ -119,6 +123,14 @@ class ScoreScales {
 // Kept in that order.
 std::vector<storage::LabelRecord> KeepStrongest(std::vector<storage::LabelRecord> candidates,
                                                 const std::vector<storage::LabelRecord>& manual);
+
+// Of KeepStrongest's output, the ranges each of whose rivals (the ranges of another descriptor on
+// its clip sharing more than half of the shorter one's frames) has less than `share` of its
+// value: where two descriptors come out nearly as strong on one range, neither is written. Kept
+// in their order. Measured on bandai1 across styles (bench/notes/2026-12-07-propagation-across-
+// styles.md): a clip's label is right more often where no other descriptor comes near it.
+std::vector<storage::LabelRecord> DropContested(std::vector<storage::LabelRecord> kept,
+                                                double share);
 
 struct PropagationProgress {
   int64_t done = 0, total = 0;  // manual labels searched, of those to search

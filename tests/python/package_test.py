@@ -205,6 +205,10 @@ class PackageTest(unittest.TestCase):
         with self.assertRaises(motiondb.Error) as raised:
             client.cancel(job.job_id)
         self.assertEqual(raised.exception.code, "FAILED_PRECONDITION")
+        with self.assertRaises(motiondb.Error) as raised:
+            client.start_propagation("arms", ["raise-arm"], rival_share=2)
+        self.assertEqual(raised.exception.code, "INVALID_ARGUMENT")
+        self.assertIn("rival_share", str(raised.exception))
 
         found = list(client.find_labels("raise-arm", min_value=0.0))
         self.assertGreater(len(found), 1)

@@ -444,14 +444,17 @@ class Client:
     # -- jobs -----------------------------------------------------------------------------------
     @_rpc
     def start_propagation(self, space: str, descriptors: Iterable[str] = (),
-                          tags: Iterable[str] = (), **search_params: Any) -> Job:
+                          tags: Iterable[str] = (), rival_share: Optional[float] = None,
+                          **search_params: Any) -> Job:
         """Queues a propagation job in a space: each manual label of the descriptors (empty:
         every descriptor of a manual label) runs as a search, whose results get the descriptor.
         search_params: each query's SearchRequest parameters (max_results, exact, ...); tags:
-        only clips carrying one of them are searched. Returns the job (queued)."""
+        only clips carrying one of them are searched; rival_share (0 < R <= 1): a range is
+        written only where every overlapping range of another descriptor has less than R times
+        its value (None: every descriptor's). Returns the job (queued)."""
         return self._call(self._jobs.StartPropagation, job_service_pb2.StartPropagationRequest(
             space=space, descriptor_names=list(descriptors), tags=list(tags),
-            search=self._search_request(search_params)))
+            rival_share=rival_share, search=self._search_request(search_params)))
 
     @_rpc
     def job(self, job_id: str) -> Job:
