@@ -87,16 +87,33 @@ std::pair<char, Quat> UpAxis(const aiScene& scene, MotionFileFormat format) {
   return {static_cast<char>('X' + axis), Quat::FromTwoVectors(up, Eigen::Vector3d::UnitY())};
 }
 
-// The nodes an animation of the file moves, by name.
-absl::flat_hash_set<std::string> AnimatedNodeNames(const aiScene& scene) {
-  absl::flat_hash_set<std::string> names;
+// Every take's channels, by the name of the node each keys. Built once: a file may key tens of
+// thousands of nodes.
+using ChannelIndex = absl::flat_hash_map<std::string, std::vector<const aiNodeAnim*>>;
+
+ChannelIndex IndexChannels(const aiScene& scene) {
+  ChannelIndex channels;
   for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
     const aiAnimation& animation = *scene.mAnimations[a];
     for (unsigned c = 0; c < animation.mNumChannels; ++c) {
-      names.insert(animation.mChannels[c]->mNodeName.C_Str());
+      const aiNodeAnim* channel = animation.mChannels[c];
+      channels[channel->mNodeName.C_Str()].push_back(channel);
     }
   }
-  return names;
+  return channels;
+}
+
+const std::vector<const aiNodeAnim*>& ChannelsOf(const ChannelIndex& channels, const aiNode& node) {
+  static const std::vector<const aiNodeAnim*> kNone;
+  const auto found = channels.find(node.mName.C_Str());
+  return found == channels.end() ? kNone : found->second;
+}
+
+// Calls `visit` on `node` and every node below it, parents first.
+template <typename Visit>
+void VisitNodes(const aiNode& node, const Visit& visit) {
+  visit(node);
+  for (unsigned c = 0; c < node.mNumChildren; ++c) VisitNodes(*node.mChildren[c], visit);
 }
 
 int Depth(const aiNode* node) {
@@ -125,7 +142,7 @@ struct SkeletonNode {
 
 // Appends `node` and those of its descendants on the way to an animated node; true when it
 // appended anything.
-bool CollectJoints(const aiNode* node, int parent, const absl::flat_hash_set<std::string>& animated,
+bool CollectJoints(const aiNode* node, int parent, const ChannelIndex& animated,
                    std::vector<SkeletonNode>& joints) {
   const size_t index = joints.size();
   joints.push_back({node, parent});
@@ -180,14 +197,14 @@ std::vector<Joint> BvhJoints(const RestSkeleton& rest) {
     joints.push_back(std::move(joint));
   }
   // A still leaf below a joint is where that joint ends.
+  absl::flat_hash_set<const aiNode*> joint_nodes;
+  for (const SkeletonNode& n : rest.nodes) joint_nodes.insert(n.node);
   for (size_t j = 0; j < rest.nodes.size(); ++j) {
     const aiNode& node = *rest.nodes[j].node;
     for (unsigned c = 0; c < node.mNumChildren; ++c) {
       const aiNode& child = *node.mChildren[c];
       if (child.mNumChildren != 0 || child.mNumMeshes != 0) continue;
-      const bool is_joint = std::any_of(rest.nodes.begin(), rest.nodes.end(),
-                                        [&](const SkeletonNode& n) { return n.node == &child; });
-      if (is_joint || joints[j].end_site) continue;
+      if (joint_nodes.contains(&child) || joints[j].end_site) continue;
       joints[j].end_site = rest.world_scale[j] * Decompose(child.mTransformation).translation;
     }
   }
@@ -364,16 +381,11 @@ absl::StatusOr<Clip> SampleTake(const aiAnimation& animation, const RestSkeleton
 }
 
 // Whether a joint's translation keys leave its rest translation in some take.
-bool TranslationMoves(const aiScene& scene, const aiNode& node, const Eigen::Vector3d& rest) {
+bool TranslationMoves(const std::vector<const aiNodeAnim*>& channels, const Eigen::Vector3d& rest) {
   const double tolerance = 1e-6 * std::max(1.0, rest.norm());
-  for (unsigned a = 0; a < scene.mNumAnimations; ++a) {
-    const aiAnimation& animation = *scene.mAnimations[a];
-    for (unsigned c = 0; c < animation.mNumChannels; ++c) {
-      const aiNodeAnim& channel = *animation.mChannels[c];
-      if (channel.mNodeName != node.mName) continue;
-      for (unsigned k = 0; k < channel.mNumPositionKeys; ++k) {
-        if ((ToVector(channel.mPositionKeys[k].mValue) - rest).norm() > tolerance) return true;
-      }
+  for (const aiNodeAnim* channel : channels) {
+    for (unsigned k = 0; k < channel->mNumPositionKeys; ++k) {
+      if ((ToVector(channel->mPositionKeys[k].mValue) - rest).norm() > tolerance) return true;
     }
   }
   return false;
@@ -381,13 +393,12 @@ bool TranslationMoves(const aiScene& scene, const aiNode& node, const Eigen::Vec
 
 absl::StatusOr<RestSkeleton> FindSkeleton(const aiScene& scene, const Quat& to_y_up,
                                           std::vector<std::string>& warnings) {
-  const absl::flat_hash_set<std::string> animated = AnimatedNodeNames(scene);
+  const ChannelIndex animated = IndexChannels(scene);
   const aiNode* root = nullptr;
-  for (const std::string& name : animated) {
-    const aiNode* node = scene.mRootNode->FindNode(name.c_str());
-    if (node == nullptr) continue;
-    root = root == nullptr ? node : LowestCommonAncestor(root, node);
-  }
+  VisitNodes(*scene.mRootNode, [&](const aiNode& node) {
+    if (!animated.contains(node.mName.C_Str())) return;
+    root = root == nullptr ? &node : LowestCommonAncestor(root, &node);
+  });
   if (root == nullptr) {
     return absl::InvalidArgumentError(
         "no skeletal animation: the file's animations move no node of its scene");
@@ -432,7 +443,8 @@ absl::StatusOr<RestSkeleton> FindSkeleton(const aiScene& scene, const Quat& to_y
     const double parent_scale = parent < 0 ? rest.above_scale : rest.world_scale[parent];
     rest.world_scale.push_back(parent_scale * rest.local[j].scale.mean());
     rest.translation_animated.push_back(
-        parent >= 0 && TranslationMoves(scene, *rest.nodes[j].node, rest.local[j].translation));
+        parent >= 0 &&
+        TranslationMoves(ChannelsOf(animated, *rest.nodes[j].node), rest.local[j].translation));
   }
   if (unequal) warnings.push_back("joints scale their axes unequally; their mean was kept");
   return rest;
