@@ -3,13 +3,21 @@
 // library. Run by run_browser_tests.sh (ctest Web.BrowserTests), which says how it is invoked.
 // Screenshots go to $MOTIONDB_WEB_TEST_OUT.
 import assert from "node:assert/strict";
-import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { execFileSync } from "node:child_process";
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { createServer } from "node:http";
 import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { dirname, join } from "node:path";
+import { fileURLToPath } from "node:url";
 import { after, before, test } from "node:test";
 import { Browser } from "../../testing/web/browser.mjs";
-import { ASSIMP_BVH, cli, cliOffline, loadDemoLibrary } from "../../testing/web/library.mjs";
+import {
+  ASSIMP_BVH,
+  cli,
+  cliJson,
+  cliOffline,
+  loadDemoLibrary,
+} from "../../testing/web/library.mjs";
 import { ServerProcess, freePort } from "../../testing/web/server.mjs";
 
 const SERVER = process.env.MOTIONDB_SERVER_BIN;
@@ -23,6 +31,10 @@ let browser;
 let clips;
 let work;
 let queryFile;
+let glbFile;
+/** Made by Debian's Blender from queryFile; null without Blender. */
+let fbxFile = null;
+let twoTakeFbx = null;
 
 before(async () => {
   assert.ok(
@@ -46,8 +58,44 @@ before(async () => {
     "--to",
     "340",
   );
+  // The same range as glTF, written by the server's exporter, and as FBX, written by Blender.
+  glbFile = join(work, "hit_01_03.glb");
+  cli(CLI, server, "export", clips["01_03"].clip_id, "--from", "100", "--to", "340", "-o", glbFile);
+  if (existsSync(BLENDER)) {
+    fbxFile = blenderFbx("query_01_03", queryFile);
+    twoTakeFbx = blenderFbx("two_takes", queryFile, queryFile);
+  }
   browser = await Browser.launch();
 });
+
+const BLENDER = "/usr/bin/blender";
+const BVH_TO_SCENE = join(
+  dirname(fileURLToPath(import.meta.url)),
+  "..",
+  "scene",
+  "bvh_to_scene.py",
+);
+
+/** An FBX file of the BVH files' takes, written by Blender as a studio's tools would. */
+function blenderFbx(base, ...bvhFiles) {
+  const out = join(work, base);
+  execFileSync(
+    BLENDER,
+    [
+      "-b",
+      "--factory-startup",
+      "--python",
+      BVH_TO_SCENE,
+      "--",
+      out,
+      ...bvhFiles,
+      "--formats",
+      "fbx",
+    ],
+    { stdio: ["ignore", "pipe", "pipe"] },
+  );
+  return `${out}.fbx`;
+}
 
 after(async () => {
   await browser?.close();
@@ -198,7 +246,7 @@ test("a hit plays beside its query, in step", async () => {
 
 test("an uploaded BVH file searches, chosen or dropped", async () => {
   const page = await openPage();
-  await page.setInputFiles("[data-testid=bvh-input]", queryFile);
+  await page.setInputFiles("[data-testid=query-input]", queryFile);
   await page.waitForSelector("[data-testid=hit]", WAIT);
   assert.match(await page.textContent("[data-testid=search-summary]"), /^\d+ hits/);
   assert.match(await page.textContent("[data-testid=hits]"), /01_03/);
@@ -486,6 +534,106 @@ test("a name rebound to the server's address (DNS rebinding) is refused", async 
     await expectListed(page, ["01_01", "01_03", "Boxing_Toes"]);
   } finally {
     await own.close();
+  }
+});
+
+/** Searches with `file` and opens hit 1: the file's own figure plays beside it. */
+async function searchWithFile(page, file, source) {
+  await page.evaluate(() => document.querySelector("[data-testid=hits]").replaceChildren());
+  await page.setInputFiles("[data-testid=query-input]", file);
+  await page.waitForSelector("[data-testid=hit]", WAIT);
+  const first = await page.locator("[data-testid=hit] >> nth=0").textContent();
+  assert.match(first, source, `${file}'s first hit is its source`);
+  assert.match(await page.textContent("[data-testid=query]"), /uploaded .*\.(glb|fbx)/);
+  await page.click("[data-testid=hit] >> nth=0");
+  await page.waitForFunction(
+    (name) => document.querySelector("[data-testid=pane-query] .title")?.textContent.includes(name),
+    file.split("/").pop(),
+    WAIT,
+  );
+  // The take's own length and rate, read from the file by three.js: frames 100-340 at 120 fps.
+  assert.match(
+    await page.textContent("[data-testid=pane-query] .title"),
+    /not stored · 2\.0 s · 120 fps/,
+  );
+  await expectAdvances(page, "pane-query", await frameOf(page, "pane-query"));
+}
+
+test("an uploaded glTF file searches, and plays beside its hit", async () => {
+  const page = await openPage("/?space=demo");
+  await searchWithFile(page, glbFile, /01_03/);
+  await page.screenshot({ path: join(OUT, "gltf-search.png") });
+  await page.close();
+});
+
+test("a file of several takes, or of no motion format, is refused as a query on the page", async (t) => {
+  const page = await openPage("/?space=demo");
+  const notes = join(work, "notes.txt");
+  writeFileSync(notes, "not motion\n");
+  await page.setInputFiles("[data-testid=query-input]", notes);
+  await page.waitForSelector(".status.error", WAIT);
+  assert.equal(await page.textContent("#status"), "notes.txt is not a BVH, FBX or glTF file");
+  if (!twoTakeFbx) {
+    t.diagnostic(`${BLENDER} is missing: the two-take FBX file is not tried`);
+  } else {
+    await page.setInputFiles("[data-testid=query-input]", twoTakeFbx);
+    await page.waitForFunction(
+      () => document.querySelector("#status")?.textContent.includes("2 takes"),
+      null,
+      WAIT,
+    );
+    assert.match(
+      await page.textContent("#status"),
+      /two_takes\.fbx holds 2 takes; a search asks with one/,
+    );
+  }
+  await page.close();
+});
+
+const DEMO_CLIPS = ["01_01", "01_03", "Boxing_Toes"];
+
+test("files dropped on the library are added to it, each take a clip; an FBX searches its rig", async (t) => {
+  const page = await openPage("/?space=demo");
+  const files = [glbFile, twoTakeFbx].filter(Boolean);
+  await page.setInputFiles("[data-testid=add-input]", files);
+  await page.waitForFunction(
+    () => document.querySelector("#status")?.textContent.startsWith("added "),
+    null,
+    WAIT,
+  );
+  const status = await page.textContent("#status");
+  assert.match(status, /^added hit_01_03/);
+  assert.match(status, /\(glb · 1 m a unit · Y up\)$/);
+  const expected = twoTakeFbx ? ["hit_01_03", "two_takes/", "two_takes/"] : ["hit_01_03"];
+  const added = (await listedNames(page)).filter((n) => !DEMO_CLIPS.includes(n));
+  assert.equal(added.length, expected.length, `listed: ${added}`);
+  expected.forEach((prefix, i) => assert.ok(added[i].startsWith(prefix), added[i]));
+  // The first added clip is open on the stage.
+  await page.waitForSelector("[data-testid=pane-query] .title:has-text('hit_01_03')", WAIT);
+  await page.screenshot({ path: join(OUT, "files-added.png") });
+  await page.close();
+  let spaceMade = false;
+  try {
+    if (!twoTakeFbx) {
+      t.diagnostic(`${BLENDER} is missing: no FBX file is searched with`);
+      return;
+    }
+    // Blender's FBX holds its armature above the BVH's root: a rig of its own, with a space.
+    const fbxClip = cliJson(CLI, server, "clips").clips.find((c) =>
+      c.name.startsWith("two_takes/"),
+    );
+    cli(CLI, server, "space", "create", "fbx", "--skeleton", String(fbxClip.skeleton_id));
+    spaceMade = true;
+    const fbxPage = await openPage("/?space=fbx");
+    await searchWithFile(fbxPage, fbxFile, /two_takes\//);
+    await fbxPage.screenshot({ path: join(OUT, "fbx-search.png") });
+    await fbxPage.close();
+  } finally {
+    // Later tests see the demo library alone.
+    if (spaceMade) cli(CLI, server, "space", "delete", "fbx");
+    for (const clip of cliJson(CLI, server, "clips").clips) {
+      if (!DEMO_CLIPS.includes(clip.name)) cli(CLI, server, "clip", "delete", String(clip.clip_id));
+    }
   }
 });
 

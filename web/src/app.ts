@@ -1,7 +1,8 @@
 // The page: wires the library, the stage (panes, transport, curve plot), search and labels to
 // the state they share: the space, the open clip, the selected range, the last search.
 import { api, type FrameRange } from "./api/routes";
-import type { Clip, SearchResult, Space } from "./api/types";
+import { bytesToBase64 } from "./api/packed";
+import type { Clip, IngestClipResponse, SearchResult, Space } from "./api/types";
 import { isLive, watchJob } from "./controller/job_watch";
 import { describe, fileQuery, toSearchQuery, type Query } from "./controller/search_query";
 import { loadSide, wholeClip } from "./controller/side_loader";
@@ -32,6 +33,7 @@ export class App {
 
   constructor() {
     this.library.onOpen = (clip) => this.run(this.open(clip));
+    this.library.onAdd = (files) => this.run(this.add(files));
     this.search.onSearch = () => {
       const query = this.selectionQuery() ?? this.query;
       if (query) this.run(this.runSearch(query));
@@ -54,6 +56,7 @@ export class App {
     this.spaces = spaces;
     // What the token cannot do is not offered (the server refuses it all the same).
     this.labels.setWritable(info.scope !== "read");
+    this.library.setWritable(info.scope !== "read");
     fill(
       this.spaceSelect,
       ...spaces.map((s) => h("option", { value: s.name }, `${s.name} · skeleton ${s.skeleton_id}`)),
@@ -140,6 +143,32 @@ export class App {
         ? `${clip.name}: drag on the timeline to select a range`
         : `${clip.name}: no curve in space ${this.space?.name ?? "(none)"}`,
     );
+  }
+
+  /**
+   * Adds files to the library one after another (the server reads FBX and glTF in a child
+   * process of its own), then opens the first clip added. A file the server refuses stops the
+   * rest; the ones before it stay added.
+   */
+  private async add(files: File[]): Promise<void> {
+    const added: IngestClipResponse[] = [];
+    try {
+      for (const [i, file] of files.entries()) {
+        this.status.info(`Adding ${file.name} (${i + 1} of ${files.length})…`);
+        const bytes = new Uint8Array(await file.arrayBuffer());
+        const answer = await api.ingest(file.name, bytesToBase64(bytes));
+        added.push(answer, ...(answer.more_takes ?? []));
+      }
+    } finally {
+      if (added.length) {
+        this.library.showSkeletons(await api.skeletons());
+        await this.library.reload();
+      }
+    }
+    const first = added[0];
+    if (!first) return;
+    await this.open(first.clip);
+    this.status.info(`added ${added.map((a) => a.clip.name).join(", ")}${facts(first)}`);
   }
 
   private select(range: FrameRange | null): void {
@@ -275,4 +304,14 @@ export class App {
   private run(action: Promise<unknown>): void {
     action.catch((error) => this.status.error(error));
   }
+}
+
+/** What an added file said of itself: " (fbx · 0.01 m · Z up, stored Y up)". */
+function facts(answer: IngestClipResponse): string {
+  const file = answer.file;
+  if (!file || file.format === "bvh") return "";
+  const parts = [file.format];
+  if (file.unit_m) parts.push(`${file.unit_m} m a unit`);
+  if (file.up_axis) parts.push(file.up_axis === "Y" ? "Y up" : `${file.up_axis} up, stored Y up`);
+  return ` (${parts.join(" · ")})`;
 }

@@ -3,6 +3,7 @@ import { call } from "./http";
 import type {
   Clip,
   ClipLabels,
+  IngestClipResponse,
   ClipPosesJson,
   CurveJson,
   Job,
@@ -28,8 +29,8 @@ export interface FrameRange {
   last: number;
 }
 
-/** A search's query: a stored clip range or an uploaded BVH file (base64). */
-export type SearchQuery = { range: FrameRange } | { bvhBase64: string; fileName: string };
+/** A search's query: a stored clip range or an uploaded BVH, FBX or glTF file (base64). */
+export type SearchQuery = { range: FrameRange } | { fileBase64: string; fileName: string };
 
 // The server's largest page (fewer when its answer limit is below 2 MiB; the pages then follow).
 const LABEL_PAGE_SIZE = 1000;
@@ -43,6 +44,12 @@ export const api = {
     }),
 
   clip: (id: string) => call<Clip>("GET", `/v1/clips/${id}`),
+
+  /** Adds a BVH, FBX or glTF file to the library: a clip a take. */
+  ingest: (fileName: string, fileBase64: string) =>
+    call<IngestClipResponse>("POST", "/v1/clips", {
+      body: { file_name: fileName, bvh: fileBase64 },
+    }),
 
   skeletons: async () => (await call<{ skeletons: Skeleton[] }>("GET", "/v1/skeletons")).skeletons,
 
@@ -67,7 +74,7 @@ export const api = {
       });
     const first = await page("");
     const labels = [...first.labels];
-    for (let token = first.next_page_token; token; ) {
+    for (let token = first.next_page_token; token;) {
       const next = await page(token);
       labels.push(...next.labels);
       token = next.next_page_token;
@@ -89,7 +96,7 @@ export const api = {
                 last_frame: query.range.last,
               },
             }
-          : { bvh: { bvh: query.bvhBase64 } }),
+          : { bvh: { bvh: query.fileBase64 } }),
       },
     }),
 

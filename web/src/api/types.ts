@@ -16,6 +16,16 @@ export interface Clip {
   joint_count: number;
 }
 
+export interface IngestClipResponse {
+  clip: Clip;
+  warnings?: string[];
+  /** "INGEST_RESULT_STORED", "INGEST_RESULT_SKIPPED", ... */
+  result: string;
+  /** A file's second and later takes, each as the first. */
+  more_takes?: IngestClipResponse[];
+  file?: { format: string; unit_m?: number; up_axis?: string; generator?: string };
+}
+
 export interface ListClipsResponse {
   clips: Clip[];
   next_page_token: string;

@@ -1,15 +1,17 @@
 // The library: clips filtered by name, tag, skeleton and label, sorted and paged, each with its
-// duration, rate and tags. Choosing a clip opens it.
+// duration, rate and tags. Choosing a clip opens it; files dropped on it are added to it.
 import { api, type ClipFilter } from "../api/routes";
 import type { Clip, Skeleton } from "../api/types";
 import { duration, rate } from "../model/format";
 import { h, fill } from "./dom";
+import { dropZone, MOTION_FILES } from "./drop_zone";
 import type { StatusLine } from "./status_line";
 
 const PAGE_SIZE = 50;
 
 export class LibraryPanel {
   onOpen: (clip: Clip) => void = () => {};
+  onAdd: (files: File[]) => void = () => {};
   private readonly name = h("input", {
     type: "search",
     placeholder: "name contains",
@@ -40,6 +42,14 @@ export class LibraryPanel {
   private readonly count = h("span", { class: "count", "data-testid": "clip-count" });
   private readonly previous = h("button", { class: "ghost", title: "Previous page" }, "‹");
   private readonly next = h("button", { class: "ghost", title: "Next page" }, "›");
+  private readonly add = dropZone({
+    text: "Add BVH, FBX or glTF files: drop them here",
+    accept: MOTION_FILES,
+    multiple: true,
+    testId: "add-drop",
+    inputTestId: "add-input",
+    onFiles: (files) => this.onAdd(files),
+  });
   /** The token of each page shown so far; the last is the current page's. */
   private tokens: string[] = [""];
   private nextToken = "";
@@ -55,6 +65,7 @@ export class LibraryPanel {
       h("div", { class: "filters" }, this.name, this.tag, this.label, this.skeleton, this.sort),
       this.list,
       h("div", { class: "pager" }, this.previous, this.count, this.next),
+      this.add,
     );
     let typing = 0;
     for (const input of [this.name, this.tag, this.label]) {
@@ -67,6 +78,11 @@ export class LibraryPanel {
       select.addEventListener("change", () => this.reload());
     this.previous.addEventListener("click", () => this.turn(-1));
     this.next.addEventListener("click", () => this.turn(1));
+  }
+
+  /** Whether the token may add files (the server refuses them all the same). */
+  setWritable(writable: boolean): void {
+    this.add.hidden = !writable;
   }
 
   showSkeletons(skeletons: Skeleton[]): void {

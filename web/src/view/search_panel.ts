@@ -1,9 +1,10 @@
-// Search: the query (the selected range of the open clip, or a dropped BVH file), the search
-// button, and the ranked hits with score and time range. Choosing a hit opens it beside its
-// query.
+// Search: the query (the selected range of the open clip, or a dropped BVH, FBX or glTF file),
+// the search button, and the ranked hits with score and time range. Choosing a hit opens it
+// beside its query.
 import type { SearchResult } from "../api/types";
 import { score, seconds } from "../model/format";
 import { h, fill } from "./dom";
+import { dropZone, MOTION_FILES } from "./drop_zone";
 
 export class SearchPanel {
   onSearch: () => void = () => {};
@@ -11,41 +12,20 @@ export class SearchPanel {
   onOpenHit: (index: number) => void = () => {};
   private readonly query = h("div", { class: "query", "data-testid": "query" });
   private readonly button = h("button", { class: "primary", "data-testid": "search" }, "Search");
-  private readonly input = h("input", {
-    type: "file",
-    accept: ".bvh",
-    hidden: true,
-    "data-testid": "bvh-input",
-  });
   private readonly summary = h("div", { class: "summary", "data-testid": "search-summary" });
   private readonly hits = h("ol", { class: "hits", "data-testid": "hits" });
 
   constructor(element: HTMLElement) {
-    const drop = h(
-      "label",
-      { class: "drop", "data-testid": "drop" },
-      "Drop a BVH file here, or ",
-      h("u", {}, "choose one"),
-      this.input,
-    );
+    const drop = dropZone({
+      text: "Search with a BVH, FBX or glTF file: drop it here",
+      accept: MOTION_FILES,
+      multiple: false,
+      testId: "drop",
+      inputTestId: "query-input",
+      onFiles: ([file]) => this.onFile(file),
+    });
     fill(element, h("h2", {}, "Search"), this.query, this.button, drop, this.summary, this.hits);
     this.button.addEventListener("click", () => this.onSearch());
-    this.input.addEventListener("change", () => {
-      const file = this.input.files?.[0];
-      if (file) this.onFile(file);
-      this.input.value = "";
-    });
-    drop.addEventListener("dragover", (event) => {
-      event.preventDefault();
-      drop.classList.add("over");
-    });
-    drop.addEventListener("dragleave", () => drop.classList.remove("over"));
-    drop.addEventListener("drop", (event) => {
-      event.preventDefault();
-      drop.classList.remove("over");
-      const file = event.dataTransfer?.files[0];
-      if (file) this.onFile(file);
-    });
     this.setQuery(null);
   }
 
