@@ -268,22 +268,6 @@ struct Half {
   bool mirrored = false;
 };
 
-// The work of `more` added to `stats`: counts and times; the points stay `stats`'.
-void AddWork(const SearchStats& more, SearchStats* stats) {
-  stats->seeds += more.seeds;
-  stats->clusters += more.clusters;
-  stats->warps += more.warps;
-  stats->cells += more.cells;
-  stats->pruned_blocks += more.pruned_blocks;
-  stats->characteristic_ms += more.characteristic_ms;
-  stats->seeds_ms += more.seeds_ms;
-  stats->clusters_ms += more.clusters_ms;
-  stats->warps_ms += more.warps_ms;
-  stats->refine_ms += more.refine_ms;
-  stats->ranking_ms += more.ranking_ms;
-  stats->total_ms += more.total_ms;
-}
-
 // Runs the search of each half and makes their results hits: one half's as they come, two
 // halves' ranked together (RankedIndices) under the first's max_results and max_overlap. The
 // stats are the first half's, with the second's work added.
@@ -302,7 +286,8 @@ absl::StatusOr<std::vector<SearchHit>> Hits(const SpaceSnapshot& snapshot,
     if (h == 0) {
       *stats = found.stats;
     } else {
-      AddWork(found.stats, stats);
+      AddStageStats(found.stats, *stats);
+      stats->total_ms += found.stats.total_ms;
     }
     for (SearchResult& result : found.results) {
       candidates.push_back(std::move(result));

@@ -71,6 +71,43 @@ class SearchTest : public ::testing::Test {
   std::vector<Planted> planted_;
 };
 
+TEST(SearchStatsTest, AddStageStatsAddsCountsAndStageTimesButNotThreadsOrTotal) {
+  SearchStats total;
+  total.threads = 2;
+  total.total_ms = 7;
+  total.seeds = 1;
+  total.warps_ms = 0.5;
+  SearchStats part;
+  part.threads = 4;
+  part.total_ms = 100;
+  part.seeds = 10;
+  part.clusters = 3;
+  part.warps = 5;
+  part.cells = 40;
+  part.pruned_blocks = 6;
+  part.characteristic_ms = 0.25;
+  part.seeds_ms = 1;
+  part.clusters_ms = 2;
+  part.warps_ms = 3;
+  part.refine_ms = 4;
+  part.ranking_ms = 5;
+  AddStageStats(part, total);
+  AddStageStats(part, total);
+  EXPECT_EQ(total.seeds, 21);
+  EXPECT_EQ(total.clusters, 6);
+  EXPECT_EQ(total.warps, 10);
+  EXPECT_EQ(total.cells, 80);
+  EXPECT_EQ(total.pruned_blocks, 12);
+  EXPECT_DOUBLE_EQ(total.characteristic_ms, 0.5);
+  EXPECT_DOUBLE_EQ(total.seeds_ms, 2);
+  EXPECT_DOUBLE_EQ(total.clusters_ms, 4);
+  EXPECT_DOUBLE_EQ(total.warps_ms, 6.5);
+  EXPECT_DOUBLE_EQ(total.refine_ms, 8);
+  EXPECT_DOUBLE_EQ(total.ranking_ms, 10);
+  EXPECT_EQ(total.threads, 2);
+  EXPECT_DOUBLE_EQ(total.total_ms, 7);
+}
+
 TEST_F(SearchTest, LibraryMapsGlobalFramesToClips) {
   EXPECT_EQ(library_->total_frames(), 3600);
   EXPECT_EQ(library_->Locate(0), std::make_pair(0, int64_t{0}));

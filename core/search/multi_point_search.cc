@@ -280,19 +280,6 @@ SearchResult ChainResult(const std::vector<std::vector<SearchResult>>& matches,
   return result;
 }
 
-void AddStageStats(const SearchStats& part, SearchStats& total) {
-  total.seeds += part.seeds;
-  total.clusters += part.clusters;
-  total.warps += part.warps;
-  total.threads = part.threads;
-  total.characteristic_ms += part.characteristic_ms;
-  total.seeds_ms += part.seeds_ms;
-  total.clusters_ms += part.clusters_ms;
-  total.warps_ms += part.warps_ms;
-  total.refine_ms += part.refine_ms;
-  total.ranking_ms += part.ranking_ms;
-}
-
 }  // namespace
 
 absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, CoordinateView query,
@@ -323,6 +310,7 @@ absl::StatusOr<SearchResponse> MultiPointSearch(const LibraryIndex& library, Coo
             ? PoseSearch(library, part_query, filter, part_params)
             : SinglePointSearch(library, part_query, parts[k].anchor, filter, part_params));
     AddStageStats(part.stats, stats);
+    stats.threads = part.stats.threads;
     matches[k] = std::move(part.results);
     // A part of one frame is a pose query, whose matches are one frame with no path.
     for (SearchResult& match : matches[k]) {

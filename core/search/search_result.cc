@@ -9,6 +9,20 @@
 
 namespace motiondb {
 
+void AddStageStats(const SearchStats& part, SearchStats& total) {
+  total.seeds += part.seeds;
+  total.clusters += part.clusters;
+  total.warps += part.warps;
+  total.cells += part.cells;
+  total.pruned_blocks += part.pruned_blocks;
+  total.characteristic_ms += part.characteristic_ms;
+  total.seeds_ms += part.seeds_ms;
+  total.clusters_ms += part.clusters_ms;
+  total.warps_ms += part.warps_ms;
+  total.refine_ms += part.refine_ms;
+  total.ranking_ms += part.ranking_ms;
+}
+
 bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap) {
   if (a.clip_index != b.clip_index) return false;
   const int64_t overlap =

@@ -53,6 +53,11 @@ struct SearchStats {
   double total_ms = 0;  // the whole search, checking the query included: at least the stages' sum
 };
 
+// Adds `part`'s counts and stage times to `total`, for a search made of several searches (the
+// parts of a several-point query, the halves of a mirrored one). `threads` and `total_ms` are
+// the caller's: the parts ran one after another.
+void AddStageStats(const SearchStats& part, SearchStats& total);
+
 struct SearchResponse {
   std::vector<SearchResult> results;
   SearchStats stats;
