@@ -9,12 +9,18 @@
 //  - each search's request time (SearchOutcome::request_ms), mirror against plain, as the
 //    median and p90 over every query and round, and the search proper's (SearchStats::total_ms,
 //    both halves'): the rest is the query's preparation (the mirror: reading, mirroring and
-//    projecting the range).
+//    projecting the range);
+//  - beside it, the window-vector baseline (bench/window_vector_baseline.h) over the same
+//    space's index, searched with the query and with its mirror (mirrored and projected as the
+//    server does): the same precisions, and its search time for both.
+// `--takes first-half|second-half` loads half of each content's takes (testing::Takes): the
+// second half is held out from the defaults chosen since issue 39.
 //
-// usage: mirrored_search [--folder DIR] [--rounds N]
+// usage: mirrored_search [--folder DIR] [--rounds N] [--takes all|first-half|second-half]
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -25,24 +31,20 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "core/bvh/bvh_reader.h"
+#include "bench/window_vector_baseline.h"
+#include "core/motion/clip_mirror.h"
+#include "core/space/search_coordinates.h"
 #include "server/catalog.h"
 #include "server/index_registry.h"
 #include "server/search_runner.h"
+#include "server/skeleton_map.h"
 #include "storage/database.h"
 #include "testing/corpus_paths.h"
+#include "testing/labelled_index.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
 namespace {
-
-// "wave-left-hand" of "dataset-2_wave-left-hand_normal_012".
-std::string ContentOf(const std::string& stem) {
-  const size_t first = stem.find('_');
-  const size_t last = stem.find("_normal_");
-  if (first == std::string::npos || last == std::string::npos || last <= first) return stem;
-  return stem.substr(first + 1, last - first - 1);
-}
 
 double Percentile(std::vector<double> values, double share) {
   if (values.empty()) return 0;
@@ -57,7 +59,21 @@ struct Precision {
   double value() const { return counted > 0 ? static_cast<double>(hits) / counted : 0; }
 };
 
-absl::Status Run(const std::filesystem::path& folder, int rounds) {
+// The first five clips of a baseline search's results, each counted as `want`'s or not.
+void CountFirstFive(const LibraryIndex& library, const std::vector<SearchResult>& results,
+                    const std::map<int64_t, std::string>& content, const std::string& want,
+                    Precision& precision) {
+  for (size_t i = 0; i < std::min<size_t>(5, results.size()); ++i) {
+    precision.Add(content.at(library.clip(results[i].clip_index).clip_id) == want);
+  }
+}
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+absl::Status Run(const std::filesystem::path& folder, int rounds, testing::Takes takes) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / absl::StrCat("mirrored_search_", ::getpid());
   std::filesystem::create_directories(dir);
@@ -65,31 +81,35 @@ absl::Status Run(const std::filesystem::path& folder, int rounds) {
                             storage::Database::Open((dir / "bench.sqlite").string()));
   server::IndexRegistry registry;
   server::Catalog catalog(*database, registry);
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    if (entry.path().extension() == ".bvh") files.push_back(entry.path());
-  }
-  std::sort(files.begin(), files.end());
+  std::vector<std::string> labels;
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<TrainingClip> files,
+                            testing::ReadLabelledFolder(folder, &labels, takes));
   std::map<int64_t, std::string> content;  // by clip id
-  for (const std::filesystem::path& file : files) {
-    MOTIONDB_ASSIGN_OR_RETURN(const BvhReadResult read, ReadBvhFile(file.string()));
+  std::map<int64_t, const Clip*> clips;    // by clip id
+  for (size_t i = 0; i < files.size(); ++i) {
     storage::ClipRecord record;
-    record.name = file.stem().string();
-    record.source_file = file.filename().string();
+    record.name = std::filesystem::path(files[i].source).stem().string();
+    record.source_file = files[i].source;
     MOTIONDB_ASSIGN_OR_RETURN(const server::IngestedClip stored,
-                              catalog.IngestClip(record, read.clip));
-    content[stored.record.clip_id] = ContentOf(record.name);
+                              catalog.IngestClip(record, files[i].clip));
+    content[stored.record.clip_id] = labels[i];
+    clips[stored.record.clip_id] = &files[i].clip;
   }
   server::SpaceRequest space;
   space.name = "bandai";
   MOTIONDB_RETURN_IF_ERROR(catalog.CreateSpace(space, {}).status());
   const server::SearchRunner runner(registry, *database, {});
-  absl::PrintF("%d clips of %s in one space\n", files.size(), folder.string());
+  const std::shared_ptr<const server::SpaceSnapshot> snapshot = registry.Find("bandai");
+  const LibraryIndex& library = *snapshot->index;
+  MOTIONDB_ASSIGN_OR_RETURN(const std::unique_ptr<bench::WindowVectorBaseline> baseline,
+                            bench::WindowVectorBaseline::Build(library, {}));
+  absl::PrintF("%d clips of %s in one space; window baseline %.1f MiB\n", files.size(),
+               folder.string(), baseline->memory_bytes() / 1048576.0);
 
   const std::map<std::string, std::string> other = {{"wave-left-hand", "wave-right-hand"},
                                                     {"wave-right-hand", "wave-left-hand"}};
-  std::map<std::string, Precision> mirrored, same, plain_other;
-  std::vector<double> plain_ms, mirror_ms, plain_search_ms, mirror_search_ms;
+  std::map<std::string, Precision> mirrored, same, plain_other, window_mirrored, window_other;
+  std::vector<double> plain_ms, mirror_ms, plain_search_ms, mirror_search_ms, window_ms;
   int queries = 0;
   for (int round = 0; round < rounds; ++round) {
     for (const auto& [clip_id, label] : content) {
@@ -101,6 +121,28 @@ absl::Status Run(const std::filesystem::path& folder, int rounds) {
       query.clip_id = clip_id;
       request.query = query;
       request.params.max_results = 20;
+      // The baseline: its index searched with the query, then with its mirror.
+      const int own = library.FindClip(clip_id);
+      std::vector<bool> allowed(library.clip_count(), true);
+      allowed[own] = false;
+      const Clip& clip = *clips.at(clip_id);
+      MOTIONDB_ASSIGN_OR_RETURN(
+          const SkeletonMirror mirror_map,
+          server::MirrorOfSkeleton(*database, snapshot->record.skeleton_id, clip.skeleton(),
+                                   snapshot->space->data().references));
+      MOTIONDB_ASSIGN_OR_RETURN(const Clip mirrored_clip, MirrorClip(clip, mirror_map));
+      MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXf mirrored_rows,
+                                SearchCoordinates(*snapshot->space, mirrored_clip));
+      const auto window_start = std::chrono::steady_clock::now();
+      const std::vector<SearchResult> window_plain =
+          baseline->Search(library.clip_coordinates(own), 20, allowed);
+      const std::vector<SearchResult> window_mirror =
+          baseline->Search(CoordinateView::Of(mirrored_rows), 20, allowed);
+      window_ms.push_back(MillisecondsSince(window_start));
+      if (round == 0) {
+        CountFirstFive(library, window_plain, content, other.at(label), window_other[label]);
+        CountFirstFive(library, window_mirror, content, other.at(label), window_mirrored[label]);
+      }
       for (const bool mirror : {false, true}) {
         request.mirror = mirror;
         MOTIONDB_ASSIGN_OR_RETURN(const server::SearchOutcome found, runner.Run(request, {}));
@@ -120,12 +162,15 @@ absl::Status Run(const std::filesystem::path& folder, int rounds) {
     }
   }
   absl::PrintF("%d queries, %d rounds\n", queries, rounds);
-  absl::PrintF("%-16s %28s %26s %28s\n", "query", "mirrored hits: other hand",
-               "plain hits: same hand", "plain search: other hand");
+  absl::PrintF("%-16s %28s %26s %28s %28s %28s\n", "query", "mirrored hits: other hand",
+               "plain hits: same hand", "plain search: other hand", "window, mirror: other hand",
+               "window, plain: other hand");
   for (const auto& [label, precision] : mirrored) {
-    absl::PrintF("%-16s %20.3f (%3d) %18.3f (%3d) %20.3f (%3d)\n", label, precision.value(),
-                 precision.counted, same[label].value(), same[label].counted,
-                 plain_other[label].value(), plain_other[label].counted);
+    absl::PrintF("%-16s %20.3f (%3d) %18.3f (%3d) %20.3f (%3d) %20.3f (%3d) %20.3f (%3d)\n", label,
+                 precision.value(), precision.counted, same[label].value(), same[label].counted,
+                 plain_other[label].value(), plain_other[label].counted,
+                 window_mirrored[label].value(), window_mirrored[label].counted,
+                 window_other[label].value(), window_other[label].counted);
   }
   absl::PrintF("request ms: plain p50 %.2f p90 %.2f; mirror p50 %.2f p90 %.2f (x%.2f at p50)\n",
                Percentile(plain_ms, 0.5), Percentile(plain_ms, 0.9), Percentile(mirror_ms, 0.5),
@@ -133,6 +178,8 @@ absl::Status Run(const std::filesystem::path& folder, int rounds) {
   absl::PrintF(
       "search proper (both halves' SearchStats::total_ms): plain p50 %.2f, mirror p50 %.2f\n",
       Percentile(plain_search_ms, 0.5), Percentile(mirror_search_ms, 0.5));
+  absl::PrintF("window baseline, query and mirror searched: p50 %.2f ms, p90 %.2f ms\n",
+               Percentile(window_ms, 0.5), Percentile(window_ms, 0.9));
   std::filesystem::remove_all(dir);
   return absl::OkStatus();
 }
@@ -143,14 +190,23 @@ absl::Status Run(const std::filesystem::path& folder, int rounds) {
 int main(int argc, char** argv) {
   std::filesystem::path folder;
   int rounds = 3;
+  motiondb::testing::Takes takes = motiondb::testing::Takes::kAll;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     if (flag == "--folder") {
       folder = argv[i + 1];
     } else if (flag == "--rounds") {
       rounds = std::max(1, std::atoi(argv[i + 1]));
+    } else if (flag == "--takes" && std::string(argv[i + 1]) == "all") {
+      takes = motiondb::testing::Takes::kAll;
+    } else if (flag == "--takes" && std::string(argv[i + 1]) == "first-half") {
+      takes = motiondb::testing::Takes::kFirstHalf;
+    } else if (flag == "--takes" && std::string(argv[i + 1]) == "second-half") {
+      takes = motiondb::testing::Takes::kSecondHalf;
     } else {
-      std::fprintf(stderr, "usage: mirrored_search [--folder DIR] [--rounds N]\n");
+      std::fprintf(stderr,
+                   "usage: mirrored_search [--folder DIR] [--rounds N] "
+                   "[--takes all|first-half|second-half]\n");
       return 2;
     }
   }
@@ -162,7 +218,7 @@ int main(int argc, char** argv) {
     }
     folder = *mocap / "bandai2-normal";
   }
-  const absl::Status status = motiondb::Run(folder, rounds);
+  const absl::Status status = motiondb::Run(folder, rounds, takes);
   if (!status.ok()) {
     std::fprintf(stderr, "%s\n", std::string(status.message()).c_str());
     return 1;
