@@ -46,7 +46,10 @@ export class Browser {
   async page() {
     const page = await this.context.newPage();
     page.on("console", (message) => {
-      if (message.type() === "error") this.errors.push(`console: ${message.text()}`);
+      if (message.type() === "error") {
+        const where = message.location().url;
+        this.errors.push(`console: ${message.text()}${where ? ` (${where})` : ""}`);
+      }
     });
     page.on("pageerror", (error) => this.errors.push(`page: ${error.message}`));
     return page;

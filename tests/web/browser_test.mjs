@@ -198,6 +198,32 @@ test("a clip opens with its figure, labels and curve, and plays", async () => {
   await page.close();
 });
 
+test("an open clip's skeleton shows its humanoid map and mirror pairs", async () => {
+  const page = await openPage();
+  await page.click(".clip-row:has-text('01_01')");
+  await page.waitForSelector("[data-testid=skeleton-summary]:has-text('01_01')", WAIT);
+  assert.equal(
+    await page.textContent("[data-testid=skeleton-summary]"),
+    "Hips (01_01) · 31 joints · humanoid map complete",
+  );
+  await page.click("[data-testid=skeleton-map] summary");
+  // CMU calls the upper arm "LeftArm" and the lower back plays the spine.
+  const slot = (name) => page.textContent(`[data-testid=skeleton-map] tr[data-slot=${name}]`);
+  assert.equal(await slot("LeftUpperArm"), "LeftUpperArmLeftArm");
+  assert.equal(await slot("Spine"), "SpineLowerBack");
+  assert.match(await page.textContent("[data-testid=skeleton-map]"), /21 slots, 12 mirror pairs/);
+  assert.match(await page.textContent("[data-testid=skeleton-map]"), /LeftHand\/RightHand/);
+  // Another rig's clip shows its own skeleton.
+  await page.click(".clip-row:has-text('Boxing_Toes')");
+  await page.waitForSelector("[data-testid=skeleton-summary]:has-text('Boxing_Toes')", WAIT);
+  assert.equal(
+    await page.getAttribute("[data-testid=skeleton]", "data-skeleton-id"),
+    String(clips["Boxing_Toes"].skeleton_id),
+  );
+  await page.screenshot({ path: join(OUT, "skeleton-map.png") });
+  await page.close();
+});
+
 test("a deep link opens its search and shows the ranked hits", async () => {
   const id = clips["01_01"].clip_id;
   const page = await openPage(`/?space=demo&clip=${id}&from=40&to=124`);

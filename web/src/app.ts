@@ -5,7 +5,7 @@ import { bytesToBase64 } from "./api/packed";
 import type { Clip, IngestClipResponse, SearchResult, Space } from "./api/types";
 import { isLive, watchJob } from "./controller/job_watch";
 import { describe, fileQuery, toSearchQuery, type Query } from "./controller/search_query";
-import { loadSide, wholeClip } from "./controller/side_loader";
+import { holds, loadSide, wholeClip } from "./controller/side_loader";
 import { readDeepLink, showDeepLink, formatDeepLink, type DeepLink } from "./model/deep_link";
 import { straightFrames, warpedFrames } from "./model/frame_map";
 import type { Side } from "./player/stage_player";
@@ -14,6 +14,7 @@ import { byId, fill, h } from "./view/dom";
 import { LabelPanel } from "./view/label_panel";
 import { LibraryPanel } from "./view/library_panel";
 import { SearchPanel } from "./view/search_panel";
+import { SkeletonPanel } from "./view/skeleton_panel";
 import { StatusLine } from "./view/status_line";
 
 const MAX_RESULTS = 20;
@@ -23,6 +24,7 @@ export class App {
   private readonly library = new LibraryPanel(byId("library"), this.status);
   private readonly search = new SearchPanel(byId("search"));
   private readonly labels = new LabelPanel(byId("labels"));
+  private readonly skeleton = new SkeletonPanel(byId("skeleton"));
   private readonly spaceSelect = byId<HTMLSelectElement>("space");
   private stageLoad: Promise<Stage> | null = null;
   private spaces: Space[] = [];
@@ -118,22 +120,26 @@ export class App {
 
   /** Opens a clip alone on the stage; picks a space of its skeleton when the current one is not. */
   private async open(clip: Clip, pickSpace = true): Promise<void> {
-    if (pickSpace && this.space?.skeleton_id !== clip.skeleton_id) {
-      const fitting = this.spaces.find((s) => s.skeleton_id === clip.skeleton_id);
+    if (pickSpace && !holds(this.space, clip)) {
+      const fitting = this.spaces.find((s) => holds(s, clip));
       if (fitting) this.spaceSelect.value = fitting.name;
     }
     this.status.info(`Opening ${clip.name}…`);
     const range = wholeClip(clip);
-    const side = await loadSide(
-      {
-        clip,
-        range,
-        frames: straightFrames(range.first, range.last, clip.fps),
-        highlight: null,
-        role: "clip",
-      },
-      this.space?.name ?? null,
-    );
+    const [side, skeleton] = await Promise.all([
+      loadSide(
+        {
+          clip,
+          range,
+          frames: straightFrames(range.first, range.last, clip.fps),
+          highlight: null,
+          role: "clip",
+        },
+        this.space,
+      ),
+      api.skeleton(clip.skeleton_id),
+    ]);
+    this.skeleton.show(skeleton);
     this.openClip = clip;
     this.select(null);
     this.library.highlight(clip.clip_id);
@@ -229,7 +235,7 @@ export class App {
     const hitClip = await api.clip(hit.clip_id);
     const span = { first: hit.start_frame, last: hit.end_frame };
     const [query, hitSide] = await Promise.all([
-      this.querySide(this.query, space.name),
+      this.querySide(this.query, space),
       loadSide(
         {
           clip: hitClip,
@@ -238,7 +244,7 @@ export class App {
           highlight: span,
           role: `hit ${index + 1}`,
         },
-        space.name,
+        space,
       ),
     ]);
     (await this.stage()).player.play([query, hitSide], true);
@@ -247,7 +253,7 @@ export class App {
   }
 
   /** The query's side: a stored range from the server, an uploaded file from the file. */
-  private querySide(query: Query, space: string): Promise<Side> {
+  private querySide(query: Query, space: Space): Promise<Side> {
     const { clip } = query;
     if (query.kind === "file") {
       const last = clip.frame_count - 1;

@@ -12,6 +12,7 @@ import type {
   SearchResponse,
   ServerInfo,
   Skeleton,
+  SkeletonDetail,
   Space,
 } from "./types";
 
@@ -50,6 +51,8 @@ export const api = {
     call<IngestClipResponse>("POST", "/v1/clips", {
       body: { file_name: fileName, bvh: fileBase64 },
     }),
+
+  skeleton: (id: string) => call<SkeletonDetail>("GET", `/v1/skeletons/${id}`),
 
   skeletons: async () => (await call<{ skeletons: Skeleton[] }>("GET", "/v1/skeletons")).skeletons,
 

@@ -39,6 +39,25 @@ export interface Skeleton {
   clip_count: Int64;
 }
 
+export interface HumanoidSlot {
+  slot: string;
+  joint: number;
+  joint_name: string;
+  overridden?: boolean;
+  required?: boolean;
+}
+
+export interface SkeletonDetail {
+  skeleton: Skeleton;
+  joints: { name: string; parent: number }[];
+  humanoid_map: {
+    slots?: HumanoidSlot[];
+    missing_slots?: string[];
+    complete?: boolean;
+    mirror_pairs?: { left_name: string; right_name: string }[];
+  };
+}
+
 export interface Space {
   space_id: Int64;
   name: string;

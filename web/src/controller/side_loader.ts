@@ -1,8 +1,8 @@
 // Fetches what one side of the stage shows: the clip, its poses over the range, its labels and
-// its motion curve in the space (in parallel). A curve the space cannot give (another skeleton)
-// leaves the side without one rather than failing it.
+// its motion curve in the space (in parallel). A clip of a skeleton the space does not hold has
+// no curve there: the side shows none, and the page does not ask for one.
 import { api, type FrameRange } from "../api/routes";
-import type { Clip } from "../api/types";
+import type { Clip, Space } from "../api/types";
 import { Curve } from "../model/curve";
 import type { FrameMap } from "../model/frame_map";
 import { decodePoses } from "../model/poses";
@@ -22,11 +22,18 @@ export interface SideRequest {
   role: string;
 }
 
-export async function loadSide(request: SideRequest, space: string | null): Promise<Side> {
+/** Whether `space` holds clips of `clip`'s skeleton. */
+export function holds(space: Space | null, clip: Clip): space is Space {
+  return space !== null && space.skeleton_id === clip.skeleton_id;
+}
+
+export async function loadSide(request: SideRequest, space: Space | null): Promise<Side> {
   const [poses, labels, curve] = await Promise.all([
     api.poses(request.range, POSE_RATE),
     api.clipLabels(request.range.clipId),
-    space ? api.curve(space, request.range, CURVE_DIMS).catch(() => null) : Promise.resolve(null),
+    holds(space, request.clip)
+      ? api.curve(space.name, request.range, CURVE_DIMS)
+      : Promise.resolve(null),
   ]);
   return {
     ...request,
