@@ -161,6 +161,8 @@ def render(path, armatures):
     scene.display.shading.color_type = "OBJECT"
     scene.render.resolution_x, scene.render.resolution_y = 480, 270
     scene.render.filepath = path
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.compression = 100  # small enough to commit (docs/)
     colors = ((0.25, 0.5, 0.9, 1.0), (0.95, 0.55, 0.2, 1.0))
     points = []
     for armature, color in zip(armatures, colors):
