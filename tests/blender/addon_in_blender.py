@@ -1,21 +1,25 @@
 """The add-on's checks, run inside Blender by blender_addon_test.py:
 
     blender -b --factory-startup --python-exit-code 1 --python addon_in_blender.py -- \
-        ZIP SERVER_URL TOKEN_FILE TAKE_BVH DEAD_URL OUT_PNG
+        ZIP SERVER_URL TOKEN_FILE TLS_CA TAKE_BVH DEAD_URL OUT_PNG
 
 Installs the add-on from ZIP and enables it; checks that its panels are registered in the 3-D
-viewport's and the dope sheet's sidebars (-b cannot draw them); connects with the token file;
-loads TAKE_BVH (frames 0-479 of clip 1) through the add-on's importer; searches with the
-preview range 100-300 and expects hit 1 to be that range of clip 1; imports hit 1 at frame 500
-onto the take's armature and checks its frame count and four joints' rotations at three frames
-against the hit's BVH as the server exports it; imports the whole clip while a one-bone armature
-is active and expects a new armature; labels frames 520-600, finds the label through the API at
-the clip's frames; propagates it and follows the job to its end; ingests the active action; a
-typed bad token and a dead server give readable errors; renders the armatures with the workbench
-engine to OUT_PNG. Any failed check raises, which --python-exit-code turns into exit 1.
+viewport's and the dope sheet's sidebars (-b cannot draw them); connects over HTTPS with the
+token file and the CA; loads TAKE_BVH (frames 0-479 of clip 1) through the add-on's importer;
+searches with the preview range 100-300, with Mirror (some hits mirrored), then without, and
+expects hit 1 to be that range of clip 1; imports hit 1 at frame 500 onto the take's armature
+and checks its frame count and four joints' rotations at three frames against the hit's BVH as
+the server exports it; imports the whole clip while a one-bone armature is active and expects a
+new armature; labels frames 520-600, finds the label through the API at the clip's frames and
+in the hits; propagates it and follows the job to its end; ingests the active action; a typed
+bad token, a missing token file, no CA for the server's certificate, plain HTTP to its HTTPS
+port, a dead server and a URL without a scheme give readable errors; renders the armatures with
+the workbench engine to OUT_PNG. Any failed check raises, which --python-exit-code turns into
+exit 1.
 """
 import json
 import math
+import ssl
 import sys
 import time
 import urllib.request
@@ -25,7 +29,8 @@ import bpy
 from bpy_extras.io_utils import axis_conversion
 from mathutils import Matrix
 
-zip_path, url, token_file, take_path, dead_url, out_png = sys.argv[sys.argv.index("--") + 1:]
+zip_path, url, token_file, tls_ca, take_path, dead_url, out_png = \
+    sys.argv[sys.argv.index("--") + 1:]
 TOKEN = open(token_file).read().strip()
 JOINTS = ("Hips", "LeftUpLeg", "RightForeArm", "Head")
 
@@ -39,7 +44,8 @@ def check(condition, what):
 def api(path):
     """GET a route of the server's API (independently of the add-on's client)."""
     request = urllib.request.Request(url + path, headers={"Authorization": f"Bearer {TOKEN}"})
-    with urllib.request.urlopen(request, timeout=60) as answer:
+    with urllib.request.urlopen(request, timeout=60,
+                                context=ssl.create_default_context(cafile=tls_ca)) as answer:
         return answer.read()
 
 
@@ -205,6 +211,7 @@ check(spaces == {"VIEW_3D", "DOPESHEET_EDITOR"} and
 prefs = bpy.context.preferences.addons["motiondb_blender"].preferences
 prefs.server_url = url
 prefs.token_file = token_file
+prefs.tls_ca = tls_ca
 bpy.ops.motiondb.connect()
 state = bpy.context.window_manager.motiondb
 check([space.name for space in state.spaces] == ["body"], "Connect lists the server's space")
@@ -299,6 +306,18 @@ prefs.token = "not-the-token"
 message = operator_error(bpy.ops.motiondb.search)
 check("refused the token (401)" in message and "Traceback" not in message,
       f"a bad token: {message.strip()}")
+prefs.token_file = token_file + ".missing"
+message = operator_error(bpy.ops.motiondb.connect)
+check(f"cannot read the token file {token_file}.missing" in message,
+      f"a missing token file: {message.strip()}")
+prefs.token_file, prefs.tls_ca = token_file, ""
+message = operator_error(bpy.ops.motiondb.connect)
+check("TLS: CERTIFICATE_VERIFY_FAILED" in message,
+      f"without the CA, the server's certificate: {message.strip()}")
+prefs.server_url = url.replace("https://", "http://")
+message = operator_error(bpy.ops.motiondb.connect)
+check(f"the connection to {prefs.server_url} failed" in message and
+      "(is it an https:// server?)" in message, f"plain HTTP to the HTTPS port: {message.strip()}")
 prefs.server_url = dead_url
 message = operator_error(bpy.ops.motiondb.connect)
 check(f"cannot reach the motiondb server at {dead_url}: Connection refused" in message,

@@ -4,19 +4,20 @@ headless against a real server.
 
     blender_addon_test.py SERVER_BINARY CLI_BINARY REPO OUT_DIR
 
-Starts motiondb-server with a token file on free loopback ports (gRPC and HTTP), ingests two of
-assimp-testmodels' CMU takes with the CLI and builds a space on them, writes the first 480
+Starts motiondb-server with a token file and TLS (a self-signed certificate for 127.0.0.1 made
+with openssl) on free loopback ports (gRPC and HTTPS), ingests two of assimp-testmodels' CMU takes with the CLI and builds a space on them, writes the first 480
 frames of the first take as the BVH take Blender loads, builds the zip with
 scripts/blender-addon.sh, then runs `blender -b --factory-startup` on addon_in_blender.py, which
 installs the zip and checks the add-on (its docstring says what). OUT_DIR receives the rendered
-picture, blender_addon.png. Exits 77 (ctest's skip) with a message when blender or the takes
-are missing.
+picture, blender_addon.png. Exits 77 (ctest's skip) with a message when blender, openssl or the
+takes are missing.
 """
 import os
 import pathlib
 import shutil
 import signal
 import socket
+import ssl
 import subprocess
 import sys
 import tempfile
@@ -41,6 +42,8 @@ def main():
     blender = shutil.which("blender")
     if blender is None:
         return skip("blender is not installed")
+    if shutil.which("openssl") is None:
+        return skip("openssl is not installed (it makes the server's certificate)")
     missing = [str(take) for take in TAKES if not take.is_file()]
     if missing:
         return skip(f"{', '.join(missing)} missing (package assimp-testmodels)")
@@ -49,11 +52,18 @@ def main():
         work = pathlib.Path(work)
         token_file = work / "token"
         token_file.write_text(TOKEN + "\n")
+        cert, key = work / "cert.pem", work / "key.pem"
+        # As tests/python/package_test.py makes its certificate: for the name the client dials.
+        subprocess.run(
+            ["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1",
+             "-subj", "/CN=localhost", "-addext", "subjectAltName=DNS:localhost,IP:127.0.0.1",
+             "-keyout", str(key), "-out", str(cert)], check=True, capture_output=True)
         log = work / "server.log"
         with open(log, "w") as log_file:
             server = subprocess.Popen(
                 [server_binary, "--db", str(work / "test.sqlite"), "--listen", "127.0.0.1:0",
-                 "--http", "127.0.0.1:0", "--auth-token-file", str(token_file)],
+                 "--http", "127.0.0.1:0", "--auth-token-file", str(token_file),
+                 "--tls-cert", str(cert), "--tls-key", str(key)],
                 stdout=subprocess.DEVNULL, stderr=log_file)
         # A socket bound and never listening: a server address that refuses every connection,
         # held for the whole test so that no other process can take its port.
@@ -61,8 +71,9 @@ def main():
         dead.bind(("127.0.0.1", 0))
         try:
             port = logged_port(log, server)
-            url = f"http://127.0.0.1:{logged_port(log, server, face='http port')}"
-            command = [cli, "--server", f"127.0.0.1:{port}", "--token-file", str(token_file)]
+            url = f"https://127.0.0.1:{logged_port(log, server, face='http port')}"
+            command = [cli, "--server", f"127.0.0.1:{port}", "--token-file", str(token_file),
+                       "--tls-ca", str(cert)]
             subprocess.run(command + ["ingest", "--tag", "cmu"] + [str(t) for t in TAKES],
                            check=True)
             subprocess.run(command + ["space", "create", "body", "--skeleton", "1", "--rate",
@@ -70,7 +81,8 @@ def main():
             take = work / "take_01_01.bvh"
             request = urllib.request.Request(f"{url}/v1/clips/1/bvh?from=0&to=479",
                                              headers={"Authorization": f"Bearer {TOKEN}"})
-            with urllib.request.urlopen(request, timeout=60) as answer:
+            with urllib.request.urlopen(request, timeout=60,
+                                        context=ssl.create_default_context(cafile=cert)) as answer:
                 take.write_bytes(answer.read())
             addon_zip = work / "motiondb_blender.zip"
             subprocess.run([str(repo / "scripts" / "blender-addon.sh"), str(addon_zip)],
@@ -81,7 +93,7 @@ def main():
             script = pathlib.Path(__file__).resolve().parent / "addon_in_blender.py"
             result = subprocess.run(
                 [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                 str(script), "--", str(addon_zip), url, str(token_file), str(take),
+                 str(script), "--", str(addon_zip), url, str(token_file), str(cert), str(take),
                  f"http://127.0.0.1:{dead.getsockname()[1]}", str(out_dir / "blender_addon.png")],
                 env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                 timeout=300)

@@ -5,6 +5,7 @@ message fit for Blender's report area: the server's own message for an HTTP erro
 wrong for a server that cannot be reached.
 """
 import base64
+import http.client
 import json
 import socket
 import ssl
@@ -70,8 +71,11 @@ class Client:
         except (socket.timeout, TimeoutError):
             raise ApiError(f"the motiondb server at {self.url} did not answer {method} {path} "
                            f"within {self.timeout} s") from None
-        except (OSError, ssl.SSLError) as error:
-            raise ApiError(f"the connection to {self.url} failed: {error}") from None
+        except (OSError, http.client.HTTPException) as error:
+            # A TLS server answers plain HTTP by dropping the connection or with a TLS alert.
+            hint = " (is it an https:// server?)" if self._context is None else ""
+            raise ApiError(f"the connection to {self.url} failed: {error or type(error).__name__}"
+                           f"{hint}") from None
         if raw:
             return payload
         try:
