@@ -10,12 +10,12 @@ searches with the preview range 100-300, with Mirror (some hits mirrored), then 
 expects hit 1 to be that range of clip 1; imports hit 1 at frame 500 onto the take's armature
 and checks its frame count and four joints' rotations at three frames against the hit's BVH as
 the server exports it; imports the whole clip while a one-bone armature is active and expects a
-new armature; labels frames 520-600, finds the label through the API at the clip's frames and
-in the hits; propagates it and follows the job to its end; ingests the active action; a typed
-bad token, a missing token file, no CA for the server's certificate, plain HTTP to its HTTPS
-port, a dead server and a URL without a scheme give readable errors; renders the armatures with
-the workbench engine to OUT_PNG. Any failed check raises, which --python-exit-code turns into
-exit 1.
+new armature; labels the selected keys, frames 520-600, finds the label through the API at the
+clip's frames and in the hits; propagates it and follows the job to its end; ingests the active
+action and the take's file; a typed bad token, a missing token file, no CA for the server's
+certificate, plain HTTP to its HTTPS port, a dead server, a URL without a scheme and no selected
+keys give readable errors; renders the armatures with the workbench engine to OUT_PNG. Any
+failed check raises, which --python-exit-code turns into exit 1.
 """
 import json
 import math
@@ -265,11 +265,21 @@ check(clip_armature not in (other, take) and clip_armature.type == "ARMATURE" an
       "the whole clip (2752 frames) comes in on a new armature when the skeletons differ")
 bpy.data.objects.remove(other)
 
-# -- Label frames 520-600 of hit 1 (clip frames first+20 to first+100) and find it.
+# -- Label the selected keys, frames 520-600 of hit 1 (clip frames first+20 to first+100), and
+# find it (the preview range, still 100-300, is not the range).
 bpy.context.view_layer.objects.active = take
-scene.frame_preview_start, scene.frame_preview_end = 520, 600
+scene.motiondb.range_source = "SELECTED_KEYS"
 scene.motiondb.space = "body"
 scene.motiondb.descriptor, scene.motiondb.value = "blender-kick", 0.75
+for curve in action.fcurves:
+    for point in curve.keyframe_points:
+        point.select_control_point = False
+message = operator_error(bpy.ops.motiondb.label)
+check(f"no keyframe of action '{action.name}' is selected" in message,
+      f"no keys selected: {message.strip()}")
+for curve in action.fcurves:
+    for point in curve.keyframe_points:
+        point.select_control_point = 520 <= point.co.x <= 600
 bpy.ops.motiondb.label()
 found = json.loads(api("/v1/labels:find?descriptor=blender-kick"))["labels"]
 check(len(found) == 1 and found[0]["clip_id"] == "1" and
@@ -299,6 +309,10 @@ clip_id = action[operators.CLIP_ID]
 clip = json.loads(api(f"/v1/clips/{clip_id}"))
 check(clip_id > 2 and clip["frame_count"] == frames and "blender" in clip["tags"],
       f"the action is ingested as clip {clip_id} ({clip['frame_count']} frames, tag blender)")
+bpy.ops.motiondb.ingest_file(filepath=take_path)
+taken = json.loads(api("/v1/clips?name_contains=take_01_01"))["clips"]
+check(len(taken) == 1 and taken[0]["frame_count"] == 480,
+      f"the take's file is ingested as clip {taken[0]['clip_id']} ('{taken[0]['name']}')")
 
 # -- Errors are readable reports, not tracebacks.
 prefs.token_file = ""
