@@ -32,7 +32,7 @@ TOKEN = "blender-test-token"
 
 
 def skip(why):
-    print(f"SKIPPED: {why} (scripts/install-deps.sh --dev installs it)")
+    print(f"SKIPPED: {why} (scripts/install-deps.sh installs it)")
     return 77
 
 
