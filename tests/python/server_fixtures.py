@@ -1,7 +1,8 @@
 """What the Python tests share: a BVH written here and the port a started server logs.
 
 Imported by client_test.py and package_test.py from their own folder (a script's folder is the
-first entry of sys.path), so it must not import the motiondb package or its stubs.
+first entry of sys.path), and by tests/blender/blender_addon_test.py, so it must not import the
+motiondb package or its stubs.
 """
 import math
 import pathlib
@@ -9,17 +10,18 @@ import re
 import time
 
 
-def logged_port(log_path, server, timeout=60):
-    """The port the server picked for --listen 127.0.0.1:0, read from its log."""
+def logged_port(log_path, server, timeout=60, face="port"):
+    """The port the server picked for --listen 127.0.0.1:0 (face "http port": for --http
+    127.0.0.1:0), read from its log."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        match = re.search(r"\(port ([0-9]+)\)", pathlib.Path(log_path).read_text())
+        match = re.search(rf"\({face} ([0-9]+)\)", pathlib.Path(log_path).read_text())
         if match:
             return int(match.group(1))
         if server.poll() is not None:
             raise RuntimeError(f"motiondb-server exited with {server.returncode}")
         time.sleep(0.02)
-    raise RuntimeError("motiondb-server did not report its port")
+    raise RuntimeError(f"motiondb-server did not report its {face}")
 
 
 def arm_raise_bvh(frames=90, lift=1.0, phase=0.0):

@@ -6,10 +6,15 @@ Writes OUT_BASE.fbx and/or OUT_BASE.glb: the first BVH's skeleton and motion at 
 frame rate; each further BVH (same skeleton) another take of the FBX. --up Z writes a Z-up FBX.
 Without a BVH: a cube and no animation, a file without a skeleton.
 """
-import builtins
+import pathlib
 import sys
 
 import bpy
+
+# The Blender add-on's importer, which works around Debian's Blender 3.4 BVH importer on Python
+# 3.11 (client/blender/motiondb_blender/bvh_io.py).
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "client" / "blender"))
+from motiondb_blender.bvh_io import import_bvh as import_bvh_file  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 up = "Y"
@@ -24,22 +29,8 @@ if "--formats" in args:
     del args[i:i + 2]
 out_base, sources = args[0], args[1:]
 
-# Debian's Blender 3.4 runs on Python 3.11, which refuses open()'s mode 'rU' that its BVH
-# importer passes.
-_open = builtins.open
-
-
-def _open_without_u(file, mode="r", *rest, **options):
-    return _open(file, mode.replace("U", ""), *rest, **options)
-
-
 def import_bvh(path):
-    builtins.open = _open_without_u
-    try:
-        bpy.ops.import_anim.bvh(filepath=path, update_scene_fps=True, update_scene_duration=True)
-    finally:
-        builtins.open = _open
-    return bpy.context.view_layer.objects.active
+    return import_bvh_file(path, update_scene_fps=True, update_scene_duration=True)
 
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
