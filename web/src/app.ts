@@ -5,7 +5,7 @@ import { bytesToBase64 } from "./api/packed";
 import type { Clip, IngestClipResponse, SearchResult, Space } from "./api/types";
 import { isLive, watchJob } from "./controller/job_watch";
 import { describe, fileQuery, toSearchQuery, type Query } from "./controller/search_query";
-import { holds, loadSide, wholeClip } from "./controller/side_loader";
+import { holds, loadSide, skeletonsOf, wholeClip } from "./controller/side_loader";
 import { readDeepLink, showDeepLink, formatDeepLink, type DeepLink } from "./model/deep_link";
 import { straightFrames, warpedFrames } from "./model/frame_map";
 import type { Side } from "./player/stage_player";
@@ -61,7 +61,11 @@ export class App {
     this.library.setWritable(info.scope !== "read");
     fill(
       this.spaceSelect,
-      ...spaces.map((s) => h("option", { value: s.name }, `${s.name} · skeleton ${s.skeleton_id}`)),
+      ...spaces.map((s) => {
+        const skeletons = skeletonsOf(s);
+        const which = `skeleton${skeletons.length > 1 ? "s" : ""} ${skeletons.join(", ")}`;
+        return h("option", { value: s.name }, `${s.name} · ${which}`);
+      }),
     );
     if (!spaces.length) fill(this.spaceSelect, h("option", { value: "" }, "no space"));
     this.library.showSkeletons(skeletons);

@@ -62,6 +62,8 @@ export interface Space {
   space_id: Int64;
   name: string;
   skeleton_id: Int64;
+  /** A space over several skeletons: all of them, skeleton_id first; absent for one. */
+  skeleton_ids?: Int64[];
   report?: { dims: number; sample_rate: number };
   index?: { clips: Int64; frames: Int64; dims: number };
 }

@@ -2,7 +2,7 @@
 // its motion curve in the space (in parallel). A clip of a skeleton the space does not hold has
 // no curve there: the side shows none, and the page does not ask for one.
 import { api, type FrameRange } from "../api/routes";
-import type { Clip, Space } from "../api/types";
+import type { Clip, Int64, Space } from "../api/types";
 import { Curve } from "../model/curve";
 import type { FrameMap } from "../model/frame_map";
 import { decodePoses } from "../model/poses";
@@ -22,9 +22,14 @@ export interface SideRequest {
   role: string;
 }
 
+/** The skeletons whose clips `space` holds. */
+export function skeletonsOf(space: Space): Int64[] {
+  return space.skeleton_ids?.length ? space.skeleton_ids : [space.skeleton_id];
+}
+
 /** Whether `space` holds clips of `clip`'s skeleton. */
 export function holds(space: Space | null, clip: Clip): space is Space {
-  return space !== null && space.skeleton_id === clip.skeleton_id;
+  return space !== null && skeletonsOf(space).includes(clip.skeleton_id);
 }
 
 export async function loadSide(request: SideRequest, space: Space | null): Promise<Side> {
