@@ -424,6 +424,14 @@ absl::StatusOr<MotionSpace> MotionSpace::WithSearchTransform(RowMatrixXd transfo
   return FromData(std::move(data));
 }
 
+int MotionSpace::part_count() const {
+  return canonical() ? kCanonicalBoneCount : skeleton().joint_count();
+}
+
+std::string MotionSpace::part_name(int part) const {
+  return canonical() ? std::string(CanonicalBoneName(part)) : skeleton().joint(part).name;
+}
+
 Eigen::VectorXd MotionSpace::ExplainedVariance() const {
   return data_.eigenvalues / data_.eigenvalues.sum();
 }

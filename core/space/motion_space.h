@@ -165,6 +165,10 @@ class MotionSpace {
   const Skeleton& skeleton() const { return *data_.skeleton; }
   SpaceRepresentation representation() const { return data_.representation; }
   bool canonical() const { return data_.representation == SpaceRepresentation::kCanonicalBones; }
+  // What the pose vectors' first numbers describe, 3 numbers each, with a weight each: the
+  // skeleton's joints, or a canonical space's bones (named by CanonicalBoneName).
+  int part_count() const;
+  std::string part_name(int part) const;
   double sample_rate() const { return data_.sample_rate; }
   int dims() const { return static_cast<int>(data_.mean.size()); }
   // The weight of each pose-vector number: joint weights repeated 3 times, then the yaw rate's.
