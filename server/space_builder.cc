@@ -240,7 +240,14 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
 
   result.record.name = request.name;
   result.record.skeleton_id = skeleton_id;
-  result.record.skeleton_ids = request.skeleton_ids;
+  if (several) {
+    // The space's own skeleton is its first training clip's (MotionSpace::skeleton), listed first.
+    result.record.skeleton_id = records.front().skeleton_id;
+    result.record.skeleton_ids = {result.record.skeleton_id};
+    for (const int64_t id : request.skeleton_ids) {
+      if (id != result.record.skeleton_id) result.record.skeleton_ids.push_back(id);
+    }
+  }
   result.record.version = 1;
   result.record.created_unix_ms = absl::ToUnixMillis(absl::Now());
   result.record.build_report_json = ReportToJson(report);

@@ -75,7 +75,7 @@ struct SpaceOptions {
   SpaceRepresentation representation = SpaceRepresentation::kJointRotations;
   // kCanonicalBones only: each training clip's skeleton's map; unset, MapHumanoid without
   // overrides.
-  HumanoidMapper map_of;
+  HumanoidMapper map_of = {};
 };
 
 // A clip, or a range of its frames, for training or for the error report.
