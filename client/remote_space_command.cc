@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "client/clip_range_arg.h"
 #include "client/commands.h"
 #include "client/server_connection.h"
@@ -24,6 +25,7 @@ struct CreateFlags {
   std::string name;
   std::vector<std::string> train;  // CLIP_ID[:FROM-TO]
   std::optional<int64_t> skeleton;
+  std::vector<int64_t> skeletons;  // a space over several
   SpaceFlags space;
   bool learned_metric = false;
   std::optional<double> learned_metric_shrink;
@@ -40,6 +42,7 @@ absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
   if (space.yaw_rate_weight) request.set_yaw_rate_weight(*space.yaw_rate_weight);
   if (space.root_velocity_weight) request.set_root_velocity_weight(*space.root_velocity_weight);
   if (flags.skeleton) request.set_skeleton_id(*flags.skeleton);
+  for (const int64_t id : flags.skeletons) request.add_skeleton_ids(id);
   request.set_keep_heading(space.keep_heading);
   if (!IsWeightPreset(space.weights)) {
     MOTIONDB_ASSIGN_OR_RETURN(*request.mutable_weights_json(),
@@ -59,7 +62,8 @@ absl::StatusOr<v1::CreateSpaceRequest> CreateRequest(const CreateFlags& flags) {
 
 // The flags that set CreateSpaceRequest's fields, for the server's errors.
 FlagNames CreateFlagNames(const CreateFlags& flags) {
-  FlagNames names = {{"skeleton_id", "--skeleton"},
+  FlagNames names = {{"skeleton_ids", "--skeletons"},
+                     {"skeleton_id", "--skeleton"},
                      {"sample_rate", "--rate"},
                      {"yaw_rate_weight", "--yaw-rate-weight"},
                      {"root_velocity_weight", "--root-velocity-weight"},
@@ -88,6 +92,9 @@ nlohmann::json SpaceJson(const v1::Space& space) {
       {"name", space.name()},
       {"space_id", space.space_id()},
       {"skeleton_id", space.skeleton_id()},
+      {"representation", space.representation()},
+      {"skeleton_ids",
+       std::vector<int64_t>(space.skeleton_ids().begin(), space.skeleton_ids().end())},
       {"dims", report.dims()},
       {"sample_rate", report.sample_rate()},
       {"heading_removed", report.heading_removed()},
@@ -115,6 +122,10 @@ void PrintSpace(const v1::Space& space) {
                space.name(), space.space_id(), space.skeleton_id(), report.dims(),
                report.sample_rate(), report.heading_removed() ? "removed" : "kept",
                report.pelvis());
+  if (space.skeleton_ids_size() > 0) {
+    absl::PrintF("  over skeletons %s (%s)\n", absl::StrJoin(space.skeleton_ids(), ", "),
+                 space.representation());
+  }
   absl::PrintF("  trained on %d ranges (%d frames); %d clips projected when built\n",
                report.training_size(), report.training_frames(), report.projected_clips());
   absl::PrintF("  index: %d clips, %d frames\n", space.index().clips(), space.index().frames());
@@ -212,6 +223,13 @@ void AddRemoteSpace(Commands& commands, CLI::App* space) {
   create_command->add_option("--skeleton", create->skeleton, "the skeleton (default: --train's)")
       ->type_name("ID")
       ->check(WholeAtLeast(1));
+  create_command
+      ->add_option("--skeletons", create->skeletons,
+                   "a space over several skeletons, in canonical bone directions: their ids")
+      ->type_name("ID,ID,...")
+      ->delimiter(',')
+      ->check(WholeAtLeast(1))
+      ->excludes("--skeleton");
   AddSpaceFlags(create_command, &create->space);
   create_command->add_flag(
       "--learned-metric", create->learned_metric,

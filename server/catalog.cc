@@ -2,6 +2,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/space/search_coordinates.h"
+#include "server/skeleton_map.h"
 #include "storage/content_hash.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -134,8 +135,14 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
   std::vector<std::shared_ptr<const SpaceSnapshot>> spaces;
   if (skeleton_id >= 0) spaces = registry_.OfSkeleton(skeleton_id);
   std::vector<std::pair<int64_t, storage::Projection>> projections;
+  std::optional<HumanoidMap> map;  // for the spaces over several skeletons
   for (const auto& space : spaces) {
-    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space->space, clip));
+    if (space->space->canonical() && !map) {
+      MOTIONDB_ASSIGN_OR_RETURN(map, CanonicalMapOfSkeleton(database_, skeleton_id));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(
+        RowMatrixXf coordinates,
+        SearchCoordinates(*space->space, clip, -1, space->space->canonical() ? &*map : nullptr));
     projections.push_back({space->record.space_id, storage::Projection{0, std::move(coordinates)}});
   }
   storage::InsertClipOptions options;

@@ -127,7 +127,11 @@ std::vector<std::shared_ptr<const SpaceSnapshot>> IndexRegistry::All() const {
 std::vector<std::shared_ptr<const SpaceSnapshot>> IndexRegistry::OfSkeleton(
     int64_t skeleton_id) const {
   std::vector<std::shared_ptr<const SpaceSnapshot>> spaces = All();
-  std::erase_if(spaces, [&](const auto& s) { return s->record.skeleton_id != skeleton_id; });
+  std::erase_if(spaces, [&](const auto& s) {
+    return s->record.skeleton_id != skeleton_id &&
+           std::find(s->record.skeleton_ids.begin(), s->record.skeleton_ids.end(), skeleton_id) ==
+               s->record.skeleton_ids.end();
+  });
   return spaces;
 }
 

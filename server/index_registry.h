@@ -81,6 +81,7 @@ class IndexRegistry {
   std::shared_ptr<const SpaceSnapshot> Find(const std::string& name) const;
   // Every space, in space id order.
   std::vector<std::shared_ptr<const SpaceSnapshot>> All() const;
+  // Over this skeleton alone, or over several among them.
   std::vector<std::shared_ptr<const SpaceSnapshot>> OfSkeleton(int64_t skeleton_id) const;
   // Adds the snapshot, or replaces the one of the same name.
   void Put(std::shared_ptr<const SpaceSnapshot> snapshot);

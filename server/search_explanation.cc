@@ -8,12 +8,11 @@
 namespace motiondb::server {
 namespace {
 
-// The name of pose-vector number `k`'s group: its joint, or the extra dimensions'.
+// The name of pose-vector number `k`'s group: its joint (its bone in a space over several
+// skeletons), or the extra dimensions'.
 std::vector<std::string> GroupNames(const MotionSpace& space) {
   std::vector<std::string> names;
-  for (int j = 0; j < space.skeleton().joint_count(); ++j) {
-    names.push_back(space.skeleton().joint(j).name);
-  }
+  for (int j = 0; j < space.part_count(); ++j) names.push_back(space.part_name(j));
   if (space.data().pose.remove_heading) names.push_back("yaw rate");
   if (space.data().pose.remove_heading && space.data().pose.root_velocity) {
     names.push_back("root velocity");
@@ -57,7 +56,7 @@ absl::StatusOr<SearchExplanation> ExplainHit(const MotionSpace& space, Coordinat
     return absl::InternalError(absl::StrCat("coordinates of ", dims, " dimensions in a space of ",
                                             space.dims(), " with a learned metric"));
   }
-  const int joints = space.skeleton().joint_count();
+  const int joints = space.part_count();
   const std::vector<std::string> names = GroupNames(space);
   std::vector<double> squared(names.size(), 0.0);
   double total_squared = 0, distance_sum = 0;

@@ -110,9 +110,10 @@ absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapsho
 // `clip` projected whole, as a stored clip is, as the query of the frames `range` (numbered from
 // `frame_offset`, the query clip's frame that is `clip`'s first).
 absl::StatusOr<Query> ProjectedQuery(const Clip& clip, FrameRange range, int frame_offset,
-                                     const SpaceSnapshot& snapshot) {
+                                     const SpaceSnapshot& snapshot,
+                                     const HumanoidMap* map = nullptr) {
   Query query;
-  MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip));
+  MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip, -1, map));
   query.frames = FrameConversion(clip.fps(), clip.frame_count(), snapshot.space->sample_rate(),
                                  query.uploaded->rows());
   query.range = range;
@@ -122,9 +123,24 @@ absl::StatusOr<Query> ProjectedQuery(const Clip& clip, FrameRange range, int fra
 }
 
 // `clip`, an uploaded file's, as the query of its frames `upload` asks for.
+// The humanoid map of an uploaded query's skeleton in a space over several skeletons: a stored
+// skeleton's with its overrides, any other's as MapHumanoid makes it; FAILED_PRECONDITION naming
+// the slots it lacks.
+absl::StatusOr<HumanoidMap> UploadMap(const Clip& clip, storage::Database& database) {
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database.FindSkeleton(clip.skeleton()));
+  if (skeleton_id >= 0) return CanonicalMapOfSkeleton(database, skeleton_id);
+  MOTIONDB_ASSIGN_OR_RETURN(HumanoidMap map, MapHumanoid(clip.skeleton()));
+  MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(map, "of the query"));
+  return map;
+}
+
 absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& clip,
-                                    const SpaceSnapshot& snapshot, int max_rows) {
-  if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
+                                    const SpaceSnapshot& snapshot, storage::Database& database,
+                                    int max_rows) {
+  std::optional<HumanoidMap> map;
+  if (snapshot.space->canonical()) {
+    MOTIONDB_ASSIGN_OR_RETURN(map, UploadMap(clip, database));
+  } else if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
     return absl::FailedPreconditionError(absl::StrCat(
         "bvh: the query's skeleton (", clip.skeleton().joint_count(), " joints, root '",
         clip.skeleton().joint(0).name, "') is not the skeleton of space '", snapshot.record.name,
@@ -143,7 +159,7 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& cli
       absl::StrCat("the file's ", clip.frame_count(), " frames at its ", clip.fps(),
                    " fps; a range of it is searched after the whole file is projected"),
       max_rows));
-  return ProjectedQuery(clip, range, /*frame_offset=*/0, snapshot);
+  return ProjectedQuery(clip, range, /*frame_offset=*/0, snapshot, map ? &*map : nullptr);
 }
 
 // The mirror of `query` (of `uploaded`, an uploaded file's clip, or else of a stored clip's
@@ -151,6 +167,11 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& cli
 absl::StatusOr<Query> MirroredQuery(const Query& query, const std::optional<Clip>& uploaded,
                                     const SearchRequest& request, const SpaceSnapshot& snapshot,
                                     storage::Database& database) {
+  if (snapshot.space->canonical()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "mirror: space '", snapshot.record.name,
+        "' is over several skeletons; a mirrored search runs in a space over one skeleton"));
+  }
   std::optional<Clip> stored;
   if (!uploaded) {
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -364,8 +385,8 @@ absl::StatusOr<SearchOutcome> SearchRunner::Run(const SearchRequest& request,
                        " takes; a query is one (ingest the file and query a take by its clip)"));
     }
     uploaded = std::move(read.takes[0].clip);
-    MOTIONDB_ASSIGN_OR_RETURN(query,
-                              QueryOfUpload(*upload, *uploaded, *snapshot, max_query_frames_));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        query, QueryOfUpload(*upload, *uploaded, *snapshot, database_, max_query_frames_));
   } else {
     return absl::InvalidArgumentError("query: give a stored clip (clip) or a BVH file (bvh)");
   }

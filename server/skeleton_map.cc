@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/space/canonical_pose.h"
 #include "util/status_macros.h"
 
 namespace motiondb::server {
@@ -57,6 +58,15 @@ absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t
       storage::SkeletonRecord record,
       database.UpdateSlotOverrides(skeleton_id, change, {.should_stop = should_stop}));
   return View(std::move(record));
+}
+
+absl::StatusOr<HumanoidMap> CanonicalMapOfSkeleton(storage::Database& database,
+                                                   int64_t skeleton_id) {
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::SkeletonRecord record,
+                            database.GetSkeleton(skeleton_id));
+  MOTIONDB_ASSIGN_OR_RETURN(HumanoidMap map, MapHumanoid(*record.skeleton, record.slot_overrides));
+  MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(map, absl::StrCat(skeleton_id)));
+  return map;
 }
 
 absl::StatusOr<SkeletonMirror> MirrorOfSkeleton(storage::Database& database, int64_t skeleton_id,

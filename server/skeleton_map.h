@@ -34,6 +34,12 @@ absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t
                                             const AnswerLimit& answers,
                                             const std::function<bool()>& should_stop);
 
+// The map of skeleton `skeleton_id`, its stored overrides applied, for its clips' canonical poses
+// (core/space/canonical_pose.h) in a space over several skeletons; FAILED_PRECONDITION naming the
+// slots it lacks when it cannot join one. NOT_FOUND for an unknown skeleton.
+absl::StatusOr<HumanoidMap> CanonicalMapOfSkeleton(storage::Database& database,
+                                                   int64_t skeleton_id);
+
 // The mirror (core/motion/clip_mirror.h) of a clip of skeleton `skeleton_id` whose own joints
 // are `skeleton` (offsets differ between a skeleton's clips), by the skeleton's map as
 // ShowSkeleton shows it: about the rest pose when that is symmetric, else about `mean_pose`

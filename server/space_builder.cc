@@ -1,6 +1,8 @@
 #include "server/space_builder.h"
 
+#include <algorithm>
 #include <chrono>
+#include <map>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -10,6 +12,7 @@
 #include "server/frame_conversion.h"
 #include "server/learned_metric_fit.h"
 #include "server/listing.h"
+#include "server/skeleton_map.h"
 #include "server/space_report.h"
 #include "util/name_text.h"
 #include "util/status_macros.h"
@@ -73,6 +76,36 @@ absl::StatusOr<int64_t> ResolveSkeleton(storage::Database& database, const Space
   return page.clips.front().skeleton_id;
 }
 
+// A space over several skeletons: each listed once and mapped completely (by id), the training
+// clips of them.
+absl::StatusOr<std::map<int64_t, HumanoidMap>> ResolveSkeletons(storage::Database& database,
+                                                                const SpaceRequest& request) {
+  if (request.skeleton_id) {
+    return absl::InvalidArgumentError("give skeleton_id or skeleton_ids, not both");
+  }
+  if (request.learned_metric) {
+    return absl::FailedPreconditionError(
+        "a learned metric is fitted in a space over one skeleton only: leave out skeleton_ids");
+  }
+  std::map<int64_t, HumanoidMap> maps;
+  for (const int64_t id : request.skeleton_ids) {
+    if (maps.contains(id)) {
+      return absl::InvalidArgumentError(absl::StrCat("skeleton_ids lists skeleton ", id, " twice"));
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(maps[id], CanonicalMapOfSkeleton(database, id));
+  }
+  for (size_t i = 0; i < request.training.size(); ++i) {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord record,
+                              TrainingRecord(database, i, request.training[i].clip_id));
+    if (!maps.contains(record.skeleton_id)) {
+      return absl::FailedPreconditionError(absl::StrCat("training[", i, "]: clip ", record.clip_id,
+                                                        " is on skeleton ", record.skeleton_id,
+                                                        ", which skeleton_ids does not list"));
+    }
+  }
+  return maps;
+}
+
 }  // namespace
 
 absl::Status ValidateSpaceName(const std::string& name) {
@@ -99,11 +132,36 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
     }
     return absl::OkStatus();
   };
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, ResolveSkeleton(database, request));
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> clip_ids,
-                            database.ClipsOfSkeleton(skeleton_id));
-  if (clip_ids.empty()) {
-    return absl::NotFoundError(absl::StrCat("skeleton ", skeleton_id, " has no clips"));
+  const bool several = !request.skeleton_ids.empty();
+  std::map<int64_t, HumanoidMap> maps;  // of a space over several skeletons, by skeleton
+  if (several) {
+    MOTIONDB_ASSIGN_OR_RETURN(maps, ResolveSkeletons(database, request));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, several
+                                                           ? request.skeleton_ids.front()
+                                                           : ResolveSkeleton(database, request));
+  std::vector<int64_t> clip_ids;
+  for (const int64_t id : several ? request.skeleton_ids : std::vector<int64_t>{skeleton_id}) {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> of_skeleton, database.ClipsOfSkeleton(id));
+    if (of_skeleton.empty()) {
+      return absl::NotFoundError(absl::StrCat("skeleton ", id, " has no clips"));
+    }
+    clip_ids.insert(clip_ids.end(), of_skeleton.begin(), of_skeleton.end());
+  }
+  std::sort(clip_ids.begin(), clip_ids.end());
+  SpaceOptions options = request.options;
+  if (several) {
+    options.representation = SpaceRepresentation::kCanonicalBones;
+    // Each training clip's skeleton is one of the listed: found by its topology.
+    options.map_of = [&](const Skeleton& skeleton) -> absl::StatusOr<HumanoidMap> {
+      MOTIONDB_ASSIGN_OR_RETURN(const int64_t id, database.FindSkeleton(skeleton));
+      const auto found = maps.find(id);
+      if (found == maps.end()) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("a training clip's skeleton is not one of skeleton_ids"));
+      }
+      return found->second;
+    };
   }
 
   // The training clips are read from the database as each pass needs them (two to train, one to
@@ -135,16 +193,16 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
                                return TrainingClip{last->record.name, last->clip, used[i].frames};
                              }};
 
-  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built,
-                            MotionSpace::Build(training, request.options, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(MotionSpace built, MotionSpace::Build(training, options, should_stop));
   // Counted once Build has checked the sample rate (a rate of 1e295 overflowed the count).
   int64_t training_frames = 0;
   for (size_t i = 0; i < used.size(); ++i) {
     training_frames +=
         ResampledFrameCount(used[i].frames.size(), records[i].frame_time, built.sample_rate());
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<ReconstructionError> errors,
-                            built.RepresentationalError(training, kErrorReportDims, should_stop));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const std::vector<ReconstructionError> errors,
+      built.RepresentationalError(training, kErrorReportDims, should_stop, options.map_of));
   last.reset();
   std::optional<FittedMetric> fitted;
   if (request.learned_metric) {
@@ -158,7 +216,10 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
   for (const int64_t id : clip_ids) {
     MOTIONDB_RETURN_IF_ERROR(check_stop());
     MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, database.GetClip(id));
-    MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, SearchCoordinates(*space, stored.clip));
+    MOTIONDB_ASSIGN_OR_RETURN(
+        RowMatrixXf coordinates,
+        SearchCoordinates(*space, stored.clip, -1,
+                          several ? &maps.at(stored.record.skeleton_id) : nullptr));
     result.clips.push_back({{id, stored.record.name, stored.record.tags, std::move(coordinates)},
                             ClipTiming::Of(stored.record)});
   }
@@ -179,6 +240,14 @@ absl::StatusOr<BuiltSpace> BuildSpace(storage::Database& database, const SpaceRe
 
   result.record.name = request.name;
   result.record.skeleton_id = skeleton_id;
+  if (several) {
+    // The space's own skeleton is its first training clip's (MotionSpace::skeleton), listed first.
+    result.record.skeleton_id = records.front().skeleton_id;
+    result.record.skeleton_ids = {result.record.skeleton_id};
+    for (const int64_t id : request.skeleton_ids) {
+      if (id != result.record.skeleton_id) result.record.skeleton_ids.push_back(id);
+    }
+  }
   result.record.version = 1;
   result.record.created_unix_ms = absl::ToUnixMillis(absl::Now());
   result.record.build_report_json = ReportToJson(report);

@@ -24,6 +24,10 @@ struct SpaceRequest {
   std::string name;
   // The skeleton; optional when `training` is given or the database holds one skeleton.
   std::optional<int64_t> skeleton_id;
+  // Set instead of skeleton_id: a space over several skeletons, in canonical bone directions
+  // (core/space/canonical_pose.h), holding the clips of each; `training` may then be of any of
+  // them. Each must map completely, with its stored overrides.
+  std::vector<int64_t> skeleton_ids;
   // Empty: every clip of the skeleton, whole.
   std::vector<ClipSelection> training;
   SpaceOptions options;
@@ -35,7 +39,7 @@ struct SpaceRequest {
 struct BuiltSpace {
   storage::SpaceRecord record;  // without space_id; the report as JSON
   std::shared_ptr<const MotionSpace> space;
-  std::vector<IndexedClip> clips;  // every clip of the skeleton, projected
+  std::vector<IndexedClip> clips;  // every clip of the skeleton (or skeletons), projected
 };
 
 // Letters, digits, '.', '_' and '-', 1 to 128 of them: safe in URLs, file names and logs.

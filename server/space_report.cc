@@ -124,15 +124,15 @@ SpaceReport DescribeSpace(const MotionSpace& space) {
   const SpaceData& data = space.data();
   SpaceReport report;
   report.dims = space.dims();
-  report.joint_count = space.skeleton().joint_count();
+  report.joint_count = space.part_count();
   report.pelvis = space.skeleton().joint(FindPelvis(space.skeleton())).name;
   report.sample_rate = space.sample_rate();
   report.heading_removed = data.pose.remove_heading;
   report.yaw_rate_weight = data.pose.remove_heading ? data.yaw_rate_weight : 0.0;
   report.root_velocity_weight = data.root_velocity_weight;
   report.metric = data.metric;
-  for (int j = 0; j < space.skeleton().joint_count(); ++j) {
-    report.joint_weights.push_back({space.skeleton().joint(j).name, data.joint_weights[j]});
+  for (int j = 0; j < space.part_count(); ++j) {
+    report.joint_weights.push_back({space.part_name(j), data.joint_weights[j]});
   }
   const Eigen::VectorXd explained = space.ExplainedVariance();
   report.explained_variance.assign(explained.data(), explained.data() + explained.size());

@@ -131,6 +131,9 @@ struct SpaceRecord {
   int version = 1;                // rebuilding a space under the same name makes a new version
   int64_t created_unix_ms = 0;    // 0 on insert: the time of the insert
   std::string build_report_json;  // dims, explained variance, reconstruction errors, options
+  // A space over several skeletons (a canonical-bones space): all of them, skeleton_id first;
+  // their clips are the space's. Empty for a space over one skeleton.
+  std::vector<int64_t> skeleton_ids;
 };
 
 // The rows of a listing's page: Page::page_size 0 means kDefaultPageSize, and more than
@@ -256,7 +259,8 @@ class Database {
   // Deletes the clip, its projections and labels. NOT_FOUND when absent.
   absl::Status DeleteClip(int64_t clip_id, const WriteOptions& write = {});
 
-  // Stores a space built on `skeleton_id` with the projections of every clip of that skeleton,
+  // Stores a space built on `skeleton_id` with the projections of every clip of that skeleton
+  // (of every skeleton of `skeleton_ids` when it lists them; the first must be the space's),
   // in one transaction. ALREADY_EXISTS when a space of that name exists; NOT_FOUND for an
   // unknown skeleton or clip; FAILED_PRECONDITION when the space's topology is not the
   // skeleton's, or `projections` misses a clip of the skeleton or names one of another.
@@ -270,7 +274,8 @@ class Database {
   absl::Status DeleteSpace(const std::string& name, const WriteOptions& write = {});
   // Every cached projection of a space, in clip id order (loaded at start, not recomputed).
   absl::StatusOr<std::vector<Projection>> LoadProjections(int64_t space_id);
-  // Ids of the clips of a skeleton, in id order.
+  // Ids of the clips of a skeleton, in id order (a space over several skeletons holds the clips
+  // of each of its SpaceRecord::skeleton_ids).
   absl::StatusOr<std::vector<int64_t>> ClipsOfSkeleton(int64_t skeleton_id);
 
   // Labels (storage/label_record.h). AddLabels stores the batch in one transaction, all or

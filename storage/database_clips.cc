@@ -191,14 +191,16 @@ absl::StatusOr<std::vector<std::string>> CheckClipUpdate(const ClipUpdate& updat
   return add_tags;
 }
 
-// Inserts the new clip's projections, which must be one into every space of its skeleton.
+// Inserts the new clip's projections, which must be one into every space of its skeleton (its
+// own, or one over several that lists it).
 absl::Status InsertProjectionsOfClip(
     SqliteConnection& db, int64_t clip_id, int64_t skeleton_id,
     const std::vector<std::pair<int64_t, Projection>>& projections) {
   // The spaces of this skeleton, each of which must receive the clip's projection.
   MOTIONDB_ASSIGN_OR_RETURN(
       SqliteStatement spaces,
-      db.Prepare("SELECT space_id, name, dims FROM spaces WHERE skeleton_id = ?"));
+      db.Prepare("SELECT space_id, name, dims FROM spaces WHERE skeleton_id = ?1 OR space_id IN "
+                 "(SELECT space_id FROM space_skeletons WHERE skeleton_id = ?1)"));
   spaces.BindInt64(1, skeleton_id);
   absl::flat_hash_map<int64_t, std::pair<std::string, int>> needed;
   while (true) {

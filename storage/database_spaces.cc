@@ -33,18 +33,42 @@ absl::StatusOr<int64_t> SkeletonOfSpace(SqliteConnection& db, int64_t skeleton_i
   return skeleton_id;
 }
 
-// Inserts the new space's projections, which must be those of every clip of its skeleton.
-absl::Status InsertProjectionsOfSpace(SqliteConnection& db, int64_t space_id, int64_t skeleton_id,
+// Records the skeletons of a space over several: each must exist, the first be the space's own.
+absl::Status InsertSkeletonsOfSpace(SqliteConnection& db, int64_t space_id, int64_t skeleton_id,
+                                    const std::vector<int64_t>& skeleton_ids) {
+  if (skeleton_ids.front() != skeleton_id) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the space's skeleton is ", skeleton_id, ", not the first listed, ", skeleton_ids.front()));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement insert,
+      db.Prepare("INSERT INTO space_skeletons (space_id, skeleton_id) VALUES (?, ?)"));
+  for (const int64_t id : skeleton_ids) {
+    MOTIONDB_ASSIGN_OR_RETURN(const bool exists,
+                              Exists(db, "SELECT 1 FROM skeletons WHERE skeleton_id = ?", id));
+    if (!exists) return absl::NotFoundError(absl::StrCat("skeleton ", id, " not found"));
+    insert.Reset();
+    MOTIONDB_RETURN_IF_ERROR(insert.BindInt64(1, space_id).BindInt64(2, id).Run());
+  }
+  return absl::OkStatus();
+}
+
+// Inserts the new space's projections, which must be those of every clip of its skeletons.
+absl::Status InsertProjectionsOfSpace(SqliteConnection& db, int64_t space_id,
+                                      const std::vector<int64_t>& skeleton_ids,
                                       const std::vector<Projection>& projections) {
-  // The clips of this skeleton, each of which must come with its projection.
+  // The clips of these skeletons, each of which must come with its projection.
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement clips,
                             db.Prepare("SELECT clip_id FROM clips WHERE skeleton_id = ?"));
-  clips.BindInt64(1, skeleton_id);
   absl::flat_hash_set<int64_t> needed;
-  while (true) {
-    MOTIONDB_ASSIGN_OR_RETURN(const bool row, clips.Step());
-    if (!row) break;
-    needed.insert(clips.ColumnInt64(0));
+  for (const int64_t skeleton_id : skeleton_ids) {
+    clips.Reset();
+    clips.BindInt64(1, skeleton_id);
+    while (true) {
+      MOTIONDB_ASSIGN_OR_RETURN(const bool row, clips.Step());
+      if (!row) break;
+      needed.insert(clips.ColumnInt64(0));
+    }
   }
   MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement insert_projection, PrepareProjectionInsert(db));
   for (const Projection& projection : projections) {
@@ -67,6 +91,20 @@ absl::Status InsertProjectionsOfSpace(SqliteConnection& db, int64_t space_id, in
         " of the space's skeleton; a space is stored with the projections of all its clips"));
   }
   return absl::OkStatus();
+}
+
+// Fills record->skeleton_ids: the space's own skeleton first, then the others in id order.
+absl::Status ReadSkeletonsOfSpace(SqliteConnection& db, SpaceRecord* record) {
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement query,
+                            db.Prepare("SELECT skeleton_id FROM space_skeletons WHERE space_id = ? "
+                                       "ORDER BY skeleton_id != ?, skeleton_id"));
+  query.BindInt64(1, record->space_id).BindInt64(2, record->skeleton_id);
+  record->skeleton_ids.clear();
+  while (true) {
+    MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
+    if (!row) return absl::OkStatus();
+    record->skeleton_ids.push_back(query.ColumnInt64(0));
+  }
 }
 
 }  // namespace
@@ -111,7 +149,12 @@ absl::StatusOr<int64_t> Database::InsertSpace(const SpaceRecord& record, const M
                                  .BindText(7, record.build_report_json)
                                  .Run());
     space_id = db.last_insert_rowid();
-    return InsertProjectionsOfSpace(db, space_id, skeleton_id, projections);
+    if (record.skeleton_ids.empty()) {
+      return InsertProjectionsOfSpace(db, space_id, {skeleton_id}, projections);
+    }
+    MOTIONDB_RETURN_IF_ERROR(
+        InsertSkeletonsOfSpace(db, space_id, skeleton_id, record.skeleton_ids));
+    return InsertProjectionsOfSpace(db, space_id, record.skeleton_ids, projections);
   }));
   return space_id;
 }
@@ -125,7 +168,7 @@ absl::StatusOr<SpaceRecord> Database::GetSpaceRecord(const std::string& name) {
     MOTIONDB_ASSIGN_OR_RETURN(const bool found, query.BindText(1, name).Step());
     if (!found) return absl::NotFoundError(absl::StrCat("space '", name, "' not found"));
     record = ReadSpaceRecord(query);
-    return absl::OkStatus();
+    return ReadSkeletonsOfSpace(db, &record);
   }));
   return record;
 }
@@ -157,9 +200,11 @@ absl::StatusOr<std::vector<SpaceRecord>> Database::ListSpaces() {
         db.Prepare(absl::StrCat("SELECT ", kSpaceRecordColumns, " FROM spaces ORDER BY space_id")));
     while (true) {
       MOTIONDB_ASSIGN_OR_RETURN(const bool row, query.Step());
-      if (!row) return absl::OkStatus();
+      if (!row) break;
       records.push_back(ReadSpaceRecord(query));
     }
+    for (SpaceRecord& record : records) MOTIONDB_RETURN_IF_ERROR(ReadSkeletonsOfSpace(db, &record));
+    return absl::OkStatus();
   }));
   return records;
 }

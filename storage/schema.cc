@@ -249,6 +249,17 @@ CREATE TABLE clip_sources (
 );
 )sql";
 
+// The skeletons of a space over several (issue 40 item 3), its spaces.skeleton_id among them: a
+// clip of any of them is projected into the space. A space over one skeleton has no rows here.
+constexpr const char* kMigration9 = R"sql(
+CREATE TABLE space_skeletons (
+  space_id INTEGER NOT NULL REFERENCES spaces (space_id) ON DELETE CASCADE,
+  skeleton_id INTEGER NOT NULL REFERENCES skeletons (skeleton_id),
+  PRIMARY KEY (space_id, skeleton_id)
+) WITHOUT ROWID;
+CREATE INDEX space_skeletons_by_skeleton ON space_skeletons (skeleton_id, space_id);
+)sql";
+
 // Hashes the clips stored before migration 2. SQLite has no SHA-256, so this is C++; one clip's
 // blobs are in memory at a time.
 absl::Status BackfillContentHashes(SqliteConnection& connection) {
@@ -301,6 +312,7 @@ constexpr std::array kMigrations = {
     Migration{kMigration6},
     Migration{kMigration7},
     Migration{kMigration8},
+    Migration{kMigration9},
 };
 // clang-format on
 

@@ -179,15 +179,15 @@ TEST(LabelStorage, MigrationSixIndexesWhatIdentifiesALabel) {
     ASSERT_TRUE((*db)->AddLabels({label}).ok());
   }
   {
-    // The file as version 5 left it: migration 6's index as it was, migrations 7 and 8's tables
-    // gone.
+    // The file as version 5 left it: migration 6's index as it was, migrations 7, 8 and 9's
+    // tables gone.
     auto raw =
         storage::SqliteConnection::Open(path, storage::SqliteConnection::Mode::kReadWrite, 1000);
     ASSERT_TRUE(raw.ok()) << raw.status();
     ASSERT_TRUE((*raw)
                     ->Execute("DROP INDEX labels_by_clip; CREATE INDEX labels_by_clip ON labels "
                               "(clip_id, first_frame); DROP TABLE skeleton_slot_overrides; "
-                              "DROP TABLE clip_sources; "
+                              "DROP TABLE clip_sources; DROP TABLE space_skeletons; "
                               "PRAGMA user_version = 5")
                     .ok());
   }

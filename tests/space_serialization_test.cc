@@ -154,9 +154,9 @@ TEST_F(SpaceSerializationTest, RejectsBadMagicVersionAndChecksum) {
   EXPECT_THAT(ParseSpace("BVH HIERARCHY").status().message(), HasSubstr("bad magic"));
 
   std::string version = bytes_;
-  version[8] = 4;
+  version[8] = 5;  // the first version this build does not read
   EXPECT_EQ(ParseSpace(version).status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 4 is not supported"));
+  EXPECT_THAT(ParseSpace(version).status().message(), HasSubstr("version 5 is not supported"));
 
   for (const size_t at : {kHeaderSize, bytes_.size() / 2, bytes_.size() - 5, bytes_.size() - 1}) {
     std::string flipped = bytes_;

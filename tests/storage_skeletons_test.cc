@@ -93,6 +93,7 @@ TEST_F(StorageTest, ASchemaSixFileGainsTheOverridesTable) {
   // The file as version 6 left it.
   ASSERT_TRUE(Raw()
                   ->Execute("DROP TABLE skeleton_slot_overrides; DROP TABLE clip_sources; "
+                            "DROP TABLE space_skeletons; "
                             "PRAGMA user_version = 6")
                   .ok());
   const absl::StatusOr<SkeletonRecord> record = Db().GetSkeleton(skeleton_id);

@@ -32,6 +32,11 @@ std::vector<int> AbovePelvis(const Skeleton& skeleton) {
 
 absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip,
                                        const std::function<bool()>& should_stop) {
+  if (space.canonical()) {
+    return absl::FailedPreconditionError(
+        "the space is over several skeletons (canonical bone directions): the operators edit "
+        "joint rotations, which its points do not hold; use a space over the clip's skeleton");
+  }
   if (!clip.skeleton().SameTopology(space.skeleton())) {
     return absl::InvalidArgumentError(
         "the clip's skeleton differs from the space's: joint names or parents do not match");

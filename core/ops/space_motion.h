@@ -39,8 +39,9 @@ struct SpaceMotion {
 };
 
 // The clip resampled to the space rate and projected, with its placement. INVALID_ARGUMENT
-// when its skeleton is not the space's. `should_stop` is asked while the clip is resampled and
-// between the steps after: CANCELLED once it says stop.
+// when its skeleton is not the space's; FAILED_PRECONDITION in a space over several skeletons.
+// `should_stop` is asked while the clip is resampled and between the steps after: CANCELLED once it
+// says stop.
 absl::StatusOr<SpaceMotion> EnterSpace(const MotionSpace& space, const Clip& clip,
                                        const std::function<bool()>& should_stop = {});
 

@@ -75,17 +75,37 @@ absl::Status CheckShape(absl::string_view what, Eigen::Index rows, Eigen::Index 
   return absl::OkStatus();
 }
 
+bool IsCanonical(const SpaceData& data) {
+  return data.representation == SpaceRepresentation::kCanonicalBones;
+}
+
+// The numbers a pose vector of the space holds.
+int DimsOf(const SpaceData& data) {
+  return IsCanonical(data) ? CanonicalPoseDims(data.pose)
+                           : PoseDims(data.skeleton->joint_count(), data.pose);
+}
+
+absl::Status CheckCanonicalOptions(const PoseOptions& pose) {
+  if (!pose.remove_heading) {
+    return absl::InvalidArgumentError(
+        "a canonical-bones space removes the facing: its directions are told in the heading frame");
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckData(const SpaceData& data) {
   if (data.skeleton == nullptr) return absl::InvalidArgumentError("space has no skeleton");
   MOTIONDB_RETURN_IF_ERROR(CheckSampleRate(data.sample_rate, kMaxResampleRate));
   MOTIONDB_RETURN_IF_ERROR(ValidatePoseOptions(data.pose));
+  if (IsCanonical(data)) MOTIONDB_RETURN_IF_ERROR(CheckCanonicalOptions(data.pose));
   MOTIONDB_RETURN_IF_ERROR(
       CheckExtraWeights(data.pose, data.yaw_rate_weight, data.root_velocity_weight));
-  const int joints = data.skeleton->joint_count();
-  const int dims = PoseDims(joints, data.pose);
+  // Rotations have a weight and a reference per joint, bones a weight each and no reference.
+  const int joints = IsCanonical(data) ? kCanonicalBoneCount : data.skeleton->joint_count();
+  const int dims = DimsOf(data);
   MOTIONDB_RETURN_IF_ERROR(CheckShape("joint weights", data.joint_weights.size(), 1, joints, 1));
-  MOTIONDB_RETURN_IF_ERROR(
-      CheckShape("references", data.references.rows(), data.references.cols(), joints, 4));
+  MOTIONDB_RETURN_IF_ERROR(CheckShape("references", data.references.rows(), data.references.cols(),
+                                      IsCanonical(data) ? 0 : joints, 4));
   MOTIONDB_RETURN_IF_ERROR(CheckShape("mean", data.mean.size(), 1, dims, 1));
   MOTIONDB_RETURN_IF_ERROR(CheckShape("basis", data.basis.rows(), data.basis.cols(), dims, dims));
   MOTIONDB_RETURN_IF_ERROR(CheckShape("eigenvalues", data.eigenvalues.size(), 1, dims, 1));
@@ -152,6 +172,45 @@ struct TrainingPoses {
   }
 };
 
+// The canonical poses of a set of training clips of any mapped skeletons, a clip at a time.
+struct CanonicalTrainingPoses {
+  const TrainingSet& training;
+  const HumanoidMapper& map_of;  // unset: MapHumanoid without overrides
+  double rate;
+  const PoseOptions& pose;
+  const std::function<bool()>& should_stop;
+
+  absl::Status ForEach(
+      const std::function<absl::Status(const TrainingClip&, const RowMatrixXd&)>& use) const {
+    for (size_t i = 0; i < training.count; ++i) {
+      MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
+      MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip range, training.fetch(i));
+      absl::StatusOr<HumanoidMap> map =
+          map_of ? map_of(range.clip.skeleton()) : MapHumanoid(range.clip.skeleton());
+      if (!map.ok()) return Prefixed(range.source, map.status());
+      MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(*map, absl::StrCat("of ", range.source)));
+      MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
+      MOTIONDB_RETURN_IF_ERROR(use(range, CanonicalPoses(sampled, *map, pose)));
+    }
+    return absl::OkStatus();
+  }
+};
+
+// Adds the angle between each bone's direction (frames x 3 * bones, unit or zero rows) and its
+// rebuilt one to the level's sum (mean_rad until divided) and maximum.
+void AddDirectionErrors(const RowMatrixXd& original, const RowMatrixXd& rebuilt,
+                        ReconstructionError* level) {
+  for (Eigen::Index f = 0; f < original.rows(); ++f) {
+    for (Eigen::Index c = 0; c < 3 * kCanonicalBoneCount; c += 3) {
+      const Eigen::Vector3d a = original.block<1, 3>(f, c).transpose();
+      const Eigen::Vector3d b = rebuilt.block<1, 3>(f, c).transpose();
+      const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+      level->mean_rad += angle;
+      level->max_rad = std::max(level->max_rad, angle);
+    }
+  }
+}
+
 // Adds the angle between each joint's original and rebuilt rotation (frames x 4 * joints, w, x,
 // y, z) to the level's sum (mean_rad until divided) and maximum.
 void AddAngleErrors(const RowMatrixXd& original, const RowMatrixXd& rebuilt,
@@ -216,11 +275,22 @@ void SolveBasis(const Eigen::MatrixXd& covariance, SpaceData* data) {
   }
 }
 
+// The mean and basis of the weighted training poses.
+absl::Status SolveMoments(const PoseMoments& moments, SpaceData* data) {
+  data->mean = moments.Mean();
+  SolveBasis(moments.Covariance(), data);
+  if (data->eigenvalues.sum() <= 0.0) {
+    return absl::InvalidArgumentError(
+        "the training poses do not vary: a space needs at least two different poses");
+  }
+  return absl::OkStatus();
+}
+
 // The weight of each pose-vector number: each joint's three, then the yaw rate's and the root
 // velocity's.
 Eigen::VectorXd PoseWeights(const SpaceData& data) {
   const Eigen::Index joints = data.joint_weights.size();
-  Eigen::VectorXd weights(PoseDims(static_cast<int>(joints), data.pose));
+  Eigen::VectorXd weights(DimsOf(data));
   for (Eigen::Index j = 0; j < joints; ++j) {
     weights.segment<3>(3 * j).setConstant(data.joint_weights[j]);
   }
@@ -269,6 +339,9 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const TrainingSet& training,
   data.yaw_rate_weight = options.yaw_rate_weight;
   data.root_velocity_weight = data.pose.root_velocity ? options.root_velocity_weight : 0.0;
   data.metric = options.metric;
+  if (options.representation == SpaceRepresentation::kCanonicalBones) {
+    return BuildCanonical(training, options, should_stop, std::move(data));
+  }
   MOTIONDB_ASSIGN_OR_RETURN(data.joint_weights,
                             ComputeJointWeights(*data.skeleton, options.weights));
   const TrainingPoses poses{training,
@@ -303,12 +376,30 @@ absl::StatusOr<MotionSpace> MotionSpace::Build(const TrainingSet& training,
     moments.Add(EncodePoses(pose, data.references) * pose_weights.asDiagonal());
     return absl::OkStatus();
   }));
-  data.mean = moments.Mean();
-  SolveBasis(moments.Covariance(), &data);
-  if (data.eigenvalues.sum() <= 0.0) {
-    return absl::InvalidArgumentError(
-        "the training poses do not vary: a space needs at least two different poses");
-  }
+  MOTIONDB_RETURN_IF_ERROR(SolveMoments(moments, &data));
+  return MotionSpace(std::move(data));
+}
+
+absl::StatusOr<MotionSpace> MotionSpace::BuildCanonical(const TrainingSet& training,
+                                                        const SpaceOptions& options,
+                                                        const std::function<bool()>& should_stop,
+                                                        SpaceData data) {
+  MOTIONDB_RETURN_IF_ERROR(CheckCanonicalOptions(data.pose));
+  data.representation = SpaceRepresentation::kCanonicalBones;
+  data.joint_weights = Eigen::VectorXd::Ones(kCanonicalBoneCount);
+  data.references.resize(0, 4);
+  const Eigen::VectorXd pose_weights = PoseWeights(data);
+  PoseMoments moments(pose_weights.size());
+  // One pass: bones need no references.
+  const CanonicalTrainingPoses poses{training, options.map_of, data.sample_rate, data.pose,
+                                     should_stop};
+  MOTIONDB_RETURN_IF_ERROR(poses.ForEach([&](const TrainingClip& range, const RowMatrixXd& pose) {
+    moments.Add(pose * pose_weights.asDiagonal());
+    const FrameRange all{0, range.clip.frame_count() - 1};
+    data.training.push_back({range.source, range.frames.value_or(all)});
+    return absl::OkStatus();
+  }));
+  MOTIONDB_RETURN_IF_ERROR(SolveMoments(moments, &data));
   return MotionSpace(std::move(data));
 }
 
@@ -331,6 +422,14 @@ absl::StatusOr<MotionSpace> MotionSpace::WithSearchTransform(RowMatrixXd transfo
   SpaceData data = data_;
   data.search_transform = std::move(transform);
   return FromData(std::move(data));
+}
+
+int MotionSpace::part_count() const {
+  return canonical() ? kCanonicalBoneCount : skeleton().joint_count();
+}
+
+std::string MotionSpace::part_name(int part) const {
+  return canonical() ? std::string(CanonicalBoneName(part)) : skeleton().joint(part).name;
 }
 
 Eigen::VectorXd MotionSpace::ExplainedVariance() const {
@@ -357,7 +456,18 @@ absl::StatusOr<RowMatrixXd> MotionSpace::Unproject(
   return poses;
 }
 
-absl::StatusOr<RowMatrixXd> MotionSpace::EncodeClip(const Clip& clip) const {
+absl::StatusOr<RowMatrixXd> MotionSpace::EncodeClip(const Clip& clip,
+                                                    const HumanoidMap* map) const {
+  if (canonical()) {
+    std::optional<HumanoidMap> own;
+    if (map == nullptr) {
+      MOTIONDB_ASSIGN_OR_RETURN(own, MapHumanoid(clip.skeleton()));
+      map = &*own;
+    }
+    MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(*map, "of the clip"));
+    MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, Resample(clip, data_.sample_rate));
+    return CanonicalPoses(sampled, *map, data_.pose);
+  }
   if (!clip.skeleton().SameTopology(skeleton())) {
     return absl::InvalidArgumentError(
         "the clip's skeleton differs from the space's: joint names or parents do not match");
@@ -366,14 +476,20 @@ absl::StatusOr<RowMatrixXd> MotionSpace::EncodeClip(const Clip& clip) const {
   return EncodePoses(ComputePoseRotations(sampled, data_.pose), data_.references);
 }
 
-absl::StatusOr<RowMatrixXd> MotionSpace::ProjectClip(const Clip& clip, int dims) const {
-  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd poses, EncodeClip(clip));
+absl::StatusOr<RowMatrixXd> MotionSpace::ProjectClip(const Clip& clip, int dims,
+                                                     const HumanoidMap* map) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd poses, EncodeClip(clip, map));
   return Project(poses, dims);
 }
 
 absl::StatusOr<RowMatrixXd> MotionSpace::Reconstruct(
     const Eigen::Ref<const RowMatrixXd>& coordinates,
     const std::function<bool()>& should_stop) const {
+  if (canonical()) {
+    return absl::FailedPreconditionError(
+        "the space is over several skeletons (canonical bone directions): its points hold no "
+        "joint rotations to rebuild a pose from");
+  }
   MOTIONDB_ASSIGN_OR_RETURN(const int n, CoordinateDims(coordinates.cols()));
   RowMatrixXd rotations(coordinates.rows(), 4 * skeleton().joint_count());
   // A block of rows at a time, each row on its own (the same rotations, block by block).
@@ -412,8 +528,8 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
 }
 
 absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalError(
-    const TrainingSet& clips, absl::Span<const int> dims,
-    const std::function<bool()>& should_stop) const {
+    const TrainingSet& clips, absl::Span<const int> dims, const std::function<bool()>& should_stop,
+    const HumanoidMapper& map_of) const {
   std::vector<int> levels;
   for (const int n : dims) {
     if (n < 1) {
@@ -429,21 +545,36 @@ absl::StatusOr<std::vector<ReconstructionError>> MotionSpace::RepresentationalEr
   std::vector<ReconstructionError> report;
   for (const int n : levels) report.push_back({n, 0.0, 0.0});
   double angles = 0.0;
-  const int joints = skeleton().joint_count();
-  const TrainingPoses poses{clips,      skeleton(), "the space's", data_.sample_rate,
-                            data_.pose, should_stop};
-  MOTIONDB_RETURN_IF_ERROR(
-      poses.ForEach([&](const TrainingClip&, const PoseRotations& pose) -> absl::Status {
-        MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates,
-                                  Project(EncodePoses(pose, data_.references)));
-        for (ReconstructionError& level : report) {
-          MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
-                                    Reconstruct(coordinates.leftCols(level.dims)));
-          AddAngleErrors(pose.rotations, rebuilt, &level);
-        }
-        angles += static_cast<double>(pose.rotations.rows()) * joints;
-        return absl::OkStatus();
-      }));
+  if (canonical()) {
+    const CanonicalTrainingPoses poses{clips, map_of, data_.sample_rate, data_.pose, should_stop};
+    MOTIONDB_RETURN_IF_ERROR(
+        poses.ForEach([&](const TrainingClip&, const RowMatrixXd& pose) -> absl::Status {
+          MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates, Project(pose));
+          for (ReconstructionError& level : report) {
+            MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
+                                      Unproject(coordinates.leftCols(level.dims)));
+            AddDirectionErrors(pose, rebuilt, &level);
+          }
+          angles += static_cast<double>(pose.rows()) * kCanonicalBoneCount;
+          return absl::OkStatus();
+        }));
+  } else {
+    const int joints = skeleton().joint_count();
+    const TrainingPoses poses{clips,      skeleton(), "the space's", data_.sample_rate,
+                              data_.pose, should_stop};
+    MOTIONDB_RETURN_IF_ERROR(
+        poses.ForEach([&](const TrainingClip&, const PoseRotations& pose) -> absl::Status {
+          MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd coordinates,
+                                    Project(EncodePoses(pose, data_.references)));
+          for (ReconstructionError& level : report) {
+            MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXd rebuilt,
+                                      Reconstruct(coordinates.leftCols(level.dims)));
+            AddAngleErrors(pose.rotations, rebuilt, &level);
+          }
+          angles += static_cast<double>(pose.rotations.rows()) * joints;
+          return absl::OkStatus();
+        }));
+  }
   if (angles == 0.0) return absl::InvalidArgumentError("no clips to reconstruct");
   for (ReconstructionError& level : report) level.mean_rad /= angles;
   return report;

@@ -25,6 +25,7 @@
 #include "absl/types/span.h"
 #include "core/motion/clip.h"
 #include "core/motion/matrix.h"
+#include "core/space/canonical_pose.h"
 #include "core/space/joint_weights.h"
 #include "core/space/pose_encoder.h"
 
@@ -68,6 +69,13 @@ struct SpaceOptions {
   double root_velocity_weight = 0.5;
   // The metric the space's distances use.
   SpaceMetric metric = SpaceMetric::kUnit;
+  // What the pose vectors hold. kCanonicalBones (canonical_pose.h) lets the training clips be of
+  // several skeletons, each mapped by `map_of`; its bones weigh 1 each (`weights` is for joint
+  // rotations only) and it needs the facing removed.
+  SpaceRepresentation representation = SpaceRepresentation::kJointRotations;
+  // kCanonicalBones only: each training clip's skeleton's map; unset, MapHumanoid without
+  // overrides.
+  HumanoidMapper map_of = {};
 };
 
 // A clip, or a range of its frames, for training or for the error report.
@@ -99,18 +107,21 @@ struct TrainingSource {
 
 // Everything a space is made of: what serialisation stores.
 struct SpaceData {
+  // With kCanonicalBones, the first training clip's: the space's own skeleton for what needs one
+  // (listings, exports), not a constraint on its clips.
   std::shared_ptr<const Skeleton> skeleton;
+  SpaceRepresentation representation = SpaceRepresentation::kJointRotations;
   // As built, from SpaceOptions (no defaults here: a space has them all set).
   double sample_rate = 0.0;
   PoseOptions pose = {};
   double yaw_rate_weight = 0.0;
   double root_velocity_weight = 0.0;  // 0 without the root velocity
   SpaceMetric metric = SpaceMetric::kUnit;
-  Eigen::VectorXd joint_weights;  // one per joint, positive
-  RowMatrixXd references;         // joints x 4: each joint's mean orientation, w, x, y, z
-  Eigen::VectorXd mean;           // dims: mean weighted training pose vector
-  RowMatrixXd basis;              // dims x dims, orthonormal; column i is dimension i
-  Eigen::VectorXd eigenvalues;    // dims, decreasing: the weighted variance along each column
+  Eigen::VectorXd joint_weights;  // one per joint (per canonical bone), positive
+  RowMatrixXd references;  // joints x 4: each joint's mean orientation, w, x, y, z; 0 x 4 for bones
+  Eigen::VectorXd mean;    // dims: mean weighted training pose vector
+  RowMatrixXd basis;       // dims x dims, orthonormal; column i is dimension i
+  Eigen::VectorXd eigenvalues;  // dims, decreasing: the weighted variance along each column
   std::vector<TrainingSource> training;
   // dims x dims, invertible, or empty: a learned metric (core/space/learned_metric.h) that search
   // coordinates are multiplied by (core/space/search_coordinates.h).
@@ -118,7 +129,8 @@ struct SpaceData {
 };
 
 // Joint-angle error (radians, over every joint of every frame) of a reconstruction from the
-// first `dims` dimensions.
+// first `dims` dimensions; in a kCanonicalBones space, the angle between each bone's direction
+// and its rebuilt one.
 struct ReconstructionError {
   int dims = 0;
   double mean_rad = 0.0;
@@ -151,6 +163,12 @@ class MotionSpace {
 
   const SpaceData& data() const { return data_; }
   const Skeleton& skeleton() const { return *data_.skeleton; }
+  SpaceRepresentation representation() const { return data_.representation; }
+  bool canonical() const { return data_.representation == SpaceRepresentation::kCanonicalBones; }
+  // What the pose vectors' first numbers describe, 3 numbers each, with a weight each: the
+  // skeleton's joints, or a canonical space's bones (named by CanonicalBoneName).
+  int part_count() const;
+  std::string part_name(int part) const;
   double sample_rate() const { return data_.sample_rate; }
   int dims() const { return static_cast<int>(data_.mean.size()); }
   // The weight of each pose-vector number: joint weights repeated 3 times, then the yaw rate's.
@@ -167,14 +185,17 @@ class MotionSpace {
   // Coordinates in the first k <= dims() dimensions (n x k) to pose vectors (n x dims()); the
   // dimensions beyond k are taken at the training mean.
   absl::StatusOr<RowMatrixXd> Unproject(const Eigen::Ref<const RowMatrixXd>& coordinates) const;
-  // A clip of the space's skeleton, sampled at the space rate, as pose vectors (n x dims()).
-  absl::StatusOr<RowMatrixXd> EncodeClip(const Clip& clip) const;
+  // A clip of the space's skeleton, sampled at the space rate, as pose vectors (n x dims()). In a
+  // kCanonicalBones space a clip of any skeleton whose map passes CheckCanonicalMap: `map` when
+  // given (the skeleton's, with its stored overrides), else MapHumanoid's without overrides.
+  absl::StatusOr<RowMatrixXd> EncodeClip(const Clip& clip, const HumanoidMap* map = nullptr) const;
   // The same, projected to its first `dims` coordinates (-1 for all): the clip's motion curve.
-  absl::StatusOr<RowMatrixXd> ProjectClip(const Clip& clip, int dims = -1) const;
+  absl::StatusOr<RowMatrixXd> ProjectClip(const Clip& clip, int dims = -1,
+                                          const HumanoidMap* map = nullptr) const;
   // Joint rotations (n x 4 * joints) of the poses at `coordinates` (n x k, k <= dims()), as
   // the pose describes them: facing-free when the space removes the facing. `should_stop` is
   // asked about every millisecond of work (a long curve takes seconds): CANCELLED once it says
-  // stop.
+  // stop. FAILED_PRECONDITION in a kCanonicalBones space: bone directions hold no rotations.
   absl::StatusOr<RowMatrixXd> Reconstruct(const Eigen::Ref<const RowMatrixXd>& coordinates,
                                           const std::function<bool()>& should_stop = {}) const;
 
@@ -190,12 +211,18 @@ class MotionSpace {
   absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
       const std::vector<TrainingClip>& clips, absl::Span<const int> dims = kErrorReportDims,
       const std::function<bool()>& should_stop = {}) const;
+  // `map_of` maps the clips' skeletons in a kCanonicalBones space (unset: without overrides).
   absl::StatusOr<std::vector<ReconstructionError>> RepresentationalError(
       const TrainingSet& clips, absl::Span<const int> dims = kErrorReportDims,
-      const std::function<bool()>& should_stop = {}) const;
+      const std::function<bool()>& should_stop = {}, const HumanoidMapper& map_of = {}) const;
 
  private:
   explicit MotionSpace(SpaceData data);
+  // Build's second half for kCanonicalBones: `data` has the options set.
+  static absl::StatusOr<MotionSpace> BuildCanonical(const TrainingSet& training,
+                                                    const SpaceOptions& options,
+                                                    const std::function<bool()>& should_stop,
+                                                    SpaceData data);
   // `dims` checked against the space, -1 meaning all.
   absl::StatusOr<int> ResolveDims(int dims) const;
   // The dimensions of points with `columns` coordinates, at most dims().

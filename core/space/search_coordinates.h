@@ -12,9 +12,10 @@
 
 namespace motiondb {
 
-// `dims` -1 means all of the space's dimensions.
+// `dims` -1 means all of the space's dimensions; `map` is the clip's skeleton's humanoid map in a
+// canonical-bones space (MotionSpace::EncodeClip).
 absl::StatusOr<RowMatrixXf> SearchCoordinates(const MotionSpace& space, const Clip& clip,
-                                              int dims = -1);
+                                              int dims = -1, const HumanoidMap* map = nullptr);
 
 }  // namespace motiondb
 

@@ -17,11 +17,14 @@
 //             that many u8 channels (Channel enum values), u8 has End Site, [3 f64 End Site]
 //   f64 sample rate, u8 remove heading, i32 yaw-rate window, f64 yaw-rate weight, u8 metric,
 //   [version 2 on: u8 root velocity, f64 root-velocity weight]
-//   joints f64 joint weights, joints x 4 f64 references (w, x, y, z)
+//   [version 4 on: u8 representation (SpaceRepresentation)]
+//   joints f64 joint weights, joints x 4 f64 references (w, x, y, z); with canonical bones,
+//   kCanonicalBoneCount f64 bone weights and no references
 //   u32 dims, dims f64 mean, dims f64 eigenvalues, dims x dims f64 basis (row-major)
 //   u32 training ranges; per range: str source, i32 first frame, i32 last frame
 //   [version 3 on: u8 search transform, [dims x dims f64 search transform (row-major)]]; a space
-//   without a search transform is written as version 2
+//   without a search transform is written as version 2, one with joint rotations as version 3:
+//   only a canonical-bones space needs 4
 
 namespace motiondb {
 namespace {
@@ -52,16 +55,27 @@ absl::StatusOr<SpaceData> ReadPayload(ByteReader& in, uint32_t version) {
     MOTIONDB_ASSIGN_OR_RETURN(data.root_velocity_weight, in.F64("root-velocity weight"));
   }
 
-  const Eigen::Index joints = data.skeleton->joint_count();
+  if (version >= 4) {
+    MOTIONDB_ASSIGN_OR_RETURN(const uint8_t representation, in.U8("representation"));
+    if (representation > static_cast<uint8_t>(SpaceRepresentation::kCanonicalBones)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("space has unknown representation ", representation));
+    }
+    data.representation = static_cast<SpaceRepresentation>(representation);
+  }
+  const bool canonical = data.representation == SpaceRepresentation::kCanonicalBones;
+  const Eigen::Index joints = canonical ? kCanonicalBoneCount : data.skeleton->joint_count();
   data.joint_weights.resize(joints);
   MOTIONDB_RETURN_IF_ERROR(in.F64s("joint weights", data.joint_weights.data(), joints));
-  data.references.resize(joints, 4);
-  MOTIONDB_RETURN_IF_ERROR(in.F64s("references", data.references.data(), 4 * joints));
+  const Eigen::Index references = canonical ? 0 : joints;
+  data.references.resize(references, 4);
+  MOTIONDB_RETURN_IF_ERROR(in.F64s("references", data.references.data(), 4 * references));
+  const int expected_dims =
+      canonical ? CanonicalPoseDims(data.pose) : PoseDims(static_cast<int>(joints), data.pose);
   MOTIONDB_ASSIGN_OR_RETURN(const uint32_t dims, in.Count("dimension count", 8 * 2));
-  if (dims != static_cast<uint32_t>(PoseDims(static_cast<int>(joints), data.pose))) {
-    return absl::InvalidArgumentError(absl::StrCat("space has ", dims,
-                                                   " dimensions, its skeleton and options make ",
-                                                   PoseDims(static_cast<int>(joints), data.pose)));
+  if (dims != static_cast<uint32_t>(expected_dims)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "space has ", dims, " dimensions, its skeleton and options make ", expected_dims));
   }
   data.mean.resize(dims);
   MOTIONDB_RETURN_IF_ERROR(in.F64s("mean", data.mean.data(), dims));
@@ -102,6 +116,8 @@ std::string SerializeSpace(const MotionSpace& space) {
   payload.U8(static_cast<uint8_t>(data.metric));
   payload.U8(data.pose.root_velocity ? 1 : 0);
   payload.F64(data.root_velocity_weight);
+  const bool canonical = data.representation == SpaceRepresentation::kCanonicalBones;
+  if (canonical) payload.U8(static_cast<uint8_t>(data.representation));
   payload.F64s(data.joint_weights.data(), data.joint_weights.size());
   payload.F64s(data.references.data(), data.references.size());
   payload.U32(static_cast<uint32_t>(data.mean.size()));
@@ -114,16 +130,16 @@ std::string SerializeSpace(const MotionSpace& space) {
     payload.I32(source.frames.first);
     payload.I32(source.frames.last);
   }
-  // A space without a transform is written as version 2, which builds before 3 still read.
+  // A space without a transform is written as version 2, which builds before 3 still read, and
+  // only one over canonical bones as 4.
   const bool transformed = data.search_transform.size() > 0;
-  if (transformed) {
-    payload.U8(1);
-    payload.F64s(data.search_transform.data(), data.search_transform.size());
-  }
+  if (transformed || canonical) payload.U8(transformed ? 1 : 0);
+  if (transformed) payload.F64s(data.search_transform.data(), data.search_transform.size());
+  const uint32_t version = canonical ? kSpaceFormatVersion : transformed ? 3 : 2;
 
   ByteWriter file;
   file.bytes().append(kMagic.data(), kMagic.size());
-  file.U32(transformed ? kSpaceFormatVersion : 2);
+  file.U32(version);
   file.U64(payload.bytes().size());
   file.bytes() += payload.bytes();
   file.U32(Crc32(file.bytes()));

@@ -24,8 +24,10 @@ namespace motiondb {
 
 // 2 added the root velocity (flag and weight after the metric); 1 is read as without it. 3 added
 // the search transform (a learned metric, after the training ranges); 1 and 2 are read as without,
-// and a space without one is still written as 2, so that earlier builds read it.
-inline constexpr uint32_t kSpaceFormatVersion = 3;
+// and a space without one is still written as 2, so that earlier builds read it. 4 added the
+// representation (after the root velocity); 1-3 are read as joint rotations, and only a
+// canonical-bones space is written as 4.
+inline constexpr uint32_t kSpaceFormatVersion = 4;
 
 std::string SerializeSpace(const MotionSpace& space);
 // Errors are DATA_LOSS for damaged bytes (magic, checksum, truncation) and INVALID_ARGUMENT for

@@ -53,6 +53,7 @@ absl::StatusOr<SpaceRequest> FromProto(const v1::CreateSpaceRequest& request) {
   SpaceRequest out;
   out.name = request.name();
   if (request.has_skeleton_id()) out.skeleton_id = request.skeleton_id();
+  out.skeleton_ids.assign(request.skeleton_ids().begin(), request.skeleton_ids().end());
   for (const v1::ClipRange& range : request.training()) out.training.push_back(FromProto(range));
   SpaceOptions& options = out.options;
   if (request.has_sample_rate()) options.sample_rate = request.sample_rate();
@@ -145,6 +146,8 @@ void ToProto(const SpaceSnapshot& snapshot, v1::Space* space) {
   space->set_space_id(record.space_id);
   space->set_name(record.name);
   space->set_skeleton_id(record.skeleton_id);
+  for (const int64_t id : record.skeleton_ids) space->add_skeleton_ids(id);
+  space->set_representation(std::string(SpaceRepresentationName(snapshot.space->representation())));
   space->set_version(record.version);
   space->set_created_unix_ms(record.created_unix_ms);
   ToProto(ReportFromJson(record.build_report_json, *snapshot.space), space->mutable_report());

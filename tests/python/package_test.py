@@ -136,6 +136,26 @@ class PackageTest(unittest.TestCase):
         self.assertEqual(raised.exception.code, "FAILED_PRECONDITION")
         self.assertIn("cannot be mirrored", raised.exception.message)
 
+    def test_1c_a_space_over_several_skeletons(self):
+        client = self.client
+        arm = client.clip("raise_0").skeleton_id  # Hips, Shoulder, Elbow: no legs, no hands
+        cmu_file = pathlib.Path("/usr/share/assimp/models/BVH/01_01.bvh")
+        skeletons = [arm] + ([client.clip("01_01").skeleton_id] if cmu_file.exists() else [])
+        with self.assertRaises(motiondb.Error) as raised:
+            client.create_space("rigs", skeleton_ids=skeletons)
+        self.assertEqual(raised.exception.code, "FAILED_PRECONDITION")
+        self.assertIn(f"skeleton {arm}", raised.exception.message)
+        self.assertIn("LeftUpperLeg", raised.exception.message)
+        if not cmu_file.exists():
+            return
+        space = client.create_space("rigs", skeleton_ids=skeletons[1:])
+        self.assertEqual((list(space.skeleton_ids), space.representation),
+                         (skeletons[1:], "canonical-bones"))
+        self.assertIn("LeftThigh", [w.joint for w in space.report.joint_weights])
+        results = client.search("rigs", clip="01_01", first=200, last=440, max_results=3)
+        self.assertGreater(len(results), 0)
+        client.delete_space("rigs")
+
     def test_1b_skeletons_and_their_humanoid_maps(self):
         client = self.client
         skeleton = client.clip("raise_0").skeleton_id  # Hips, Shoulder, Elbow

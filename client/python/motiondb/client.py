@@ -270,12 +270,14 @@ class Client:
     @_rpc
     def create_space(self, name: str, skeleton_id: Optional[int] = None,
                      training: Iterable[Union[ClipRef, Tuple[ClipRef, int, int]]] = (),
-                     **params: Any) -> Space:
+                     skeleton_ids: Iterable[int] = (), **params: Any) -> Space:
         """Builds a space (CreateSpace). training: clips, or (clip, first, last) ranges; empty
-        trains on every clip of the skeleton. params: the other CreateSpaceRequest fields
-        (sample_rate, weight_preset, keep_heading, ...)."""
+        trains on every clip of the skeleton. skeleton_ids, instead of skeleton_id: a space over
+        several skeletons (canonical bone directions), holding the clips of each. params: the
+        other CreateSpaceRequest fields (sample_rate, weight_preset, keep_heading, ...)."""
         ranges = [self._range(*(item if isinstance(item, tuple) else (item,))) for item in training]
-        request = space_service_pb2.CreateSpaceRequest(name=name, training=ranges, **params)
+        request = space_service_pb2.CreateSpaceRequest(name=name, training=ranges,
+                                                       skeleton_ids=list(skeleton_ids), **params)
         if skeleton_id is not None:
             request.skeleton_id = skeleton_id
         return self._call(self._spaces.CreateSpace, request)
