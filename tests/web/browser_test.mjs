@@ -663,6 +663,35 @@ test("files dropped on the library are added to it, each take a clip; an FBX sea
   }
 });
 
+test("in a space over two skeletons a hit of the other rig plays beside its query", async () => {
+  const cmu = clips["01_01"];
+  const boxing = clips["Boxing_Toes"];
+  const skeletons = `${cmu.skeleton_id},${boxing.skeleton_id}`;
+  cli(CLI, server, "space", "create", "rigs", "--skeletons", skeletons);
+  try {
+    const page = await openPage(`/?space=rigs&clip=${cmu.clip_id}&from=100&to=340`);
+    assert.match(
+      await page.textContent("[data-testid=space] option[value=rigs]"),
+      new RegExp(`rigs · skeletons ${cmu.skeleton_id}, ${boxing.skeleton_id}`),
+    );
+    await page.waitForSelector("[data-testid=hit]", WAIT);
+    const other = page.locator("[data-testid=hit]", { hasText: "Boxing_Toes" }).first();
+    await other.click();
+    await page.waitForSelector(
+      "[data-testid=pane-hit]:not([hidden]) .title:has-text('Boxing_Toes')",
+      WAIT,
+    );
+    assert.match(await page.textContent("[data-testid=pane-query] .title"), /01_01/);
+    await expectAdvances(page, "pane-hit", await frameOf(page, "pane-hit"));
+    // Both clips have their curve in the space: two skeletons, one plot.
+    assert.equal(await page.locator("[data-testid=curves] canvas").count(), 1);
+    await page.screenshot({ path: join(OUT, "other-rig-hit.png") });
+    await page.close();
+  } finally {
+    cli(CLI, server, "space", "delete", "rigs");
+  }
+});
+
 test("no page logged an error", () => {
   assert.deepEqual(browser.errors, []);
 });
