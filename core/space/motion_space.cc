@@ -145,6 +145,19 @@ absl::Status CheckData(const SpaceData& data) {
   return absl::OkStatus();
 }
 
+// Calls `visit` with each of `training`'s clips, fetched a clip at a time, until it fails or
+// `should_stop` says so.
+absl::Status ForEachTrainingClip(const TrainingSet& training,
+                                 const std::function<bool()>& should_stop,
+                                 const std::function<absl::Status(const TrainingClip&)>& visit) {
+  for (size_t i = 0; i < training.count; ++i) {
+    MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
+    MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip range, training.fetch(i));
+    MOTIONDB_RETURN_IF_ERROR(visit(range));
+  }
+  return absl::OkStatus();
+}
+
 // The poses of a set of training clips, a clip at a time: each is fetched, checked against the
 // skeleton, cut to its range, sampled at the rate and turned into pose rotations.
 struct TrainingPoses {
@@ -157,18 +170,16 @@ struct TrainingPoses {
 
   absl::Status ForEach(
       const std::function<absl::Status(const TrainingClip&, const PoseRotations&)>& use) const {
-    for (size_t i = 0; i < training.count; ++i) {
-      MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
-      MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip range, training.fetch(i));
-      if (!range.clip.skeleton().SameTopology(skeleton)) {
-        return absl::InvalidArgumentError(absl::StrCat(range.source, ": skeleton differs from ",
-                                                       skeleton_owner,
-                                                       ": joint names or parents do not match"));
-      }
-      MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
-      MOTIONDB_RETURN_IF_ERROR(use(range, ComputePoseRotations(sampled, pose)));
-    }
-    return absl::OkStatus();
+    return ForEachTrainingClip(
+        training, should_stop, [&](const TrainingClip& range) -> absl::Status {
+          if (!range.clip.skeleton().SameTopology(skeleton)) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(range.source, ": skeleton differs from ", skeleton_owner,
+                             ": joint names or parents do not match"));
+          }
+          MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
+          return use(range, ComputePoseRotations(sampled, pose));
+        });
   }
 };
 
@@ -182,17 +193,15 @@ struct CanonicalTrainingPoses {
 
   absl::Status ForEach(
       const std::function<absl::Status(const TrainingClip&, const RowMatrixXd&)>& use) const {
-    for (size_t i = 0; i < training.count; ++i) {
-      MOTIONDB_RETURN_IF_ERROR(CheckStop(should_stop));
-      MOTIONDB_ASSIGN_OR_RETURN(const TrainingClip range, training.fetch(i));
-      absl::StatusOr<HumanoidMap> map =
-          map_of ? map_of(range.clip.skeleton()) : MapHumanoid(range.clip.skeleton());
-      if (!map.ok()) return Prefixed(range.source, map.status());
-      MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(*map, absl::StrCat("of ", range.source)));
-      MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
-      MOTIONDB_RETURN_IF_ERROR(use(range, CanonicalPoses(sampled, *map, pose)));
-    }
-    return absl::OkStatus();
+    return ForEachTrainingClip(
+        training, should_stop, [&](const TrainingClip& range) -> absl::Status {
+          absl::StatusOr<HumanoidMap> map =
+              map_of ? map_of(range.clip.skeleton()) : MapHumanoid(range.clip.skeleton());
+          if (!map.ok()) return Prefixed(range.source, map.status());
+          MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(*map, absl::StrCat("of ", range.source)));
+          MOTIONDB_ASSIGN_OR_RETURN(const Clip sampled, SampleRange(range, rate));
+          return use(range, CanonicalPoses(sampled, *map, pose));
+        });
   }
 };
 

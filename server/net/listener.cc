@@ -223,8 +223,10 @@ void Listener::AcceptReady(int listening) {
 }
 
 void Listener::Refuse(SocketFd socket, absl::string_view reason) {
-  ++refused_;
+  // The refuser has its word before the count moves, so that whoever sees the count sees it
+  // told (a test that read the count first saw the refuser not yet called).
   if (refuse_) refuse_(socket.get(), reason);
+  ++refused_;
   ++refusals_unlogged_;
   last_refusal_ = std::string(reason);
   LogRefusals(/*force=*/false);
