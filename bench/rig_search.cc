@@ -315,6 +315,11 @@ absl::Status ReriggedTakes(const fs::path& mocap) {
     }
     MOTIONDB_ASSIGN_OR_RETURN(outcome, rigs->Search("both", copy, {}, {}, "", 1));
     copy_first.Add(!outcome.hits.empty() && outcome.hits[0].clip_id == original);
+    if (!outcome.hits.empty() && outcome.hits[0].clip_id != original && misses++ < 10) {
+      absl::PrintF("   a miss: %s's copy found %s frames %d-%d (score %.4f)\n", names[original],
+                   outcome.hits[0].clip_name, outcome.hits[0].start_frame,
+                   outcome.hits[0].end_frame, outcome.hits[0].score);
+    }
     // The exhaustive search: what the representation gives, whatever the fast search's seeds.
     MOTIONDB_ASSIGN_OR_RETURN(outcome, rigs->Search("both", original, {}, {}, "", 1, true));
     exact_own_first.Add(!outcome.hits.empty() && outcome.hits[0].clip_id == copy);

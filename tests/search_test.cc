@@ -125,38 +125,49 @@ const float* FrameRow(const LibraryIndex& library, int64_t frame) {
 }
 
 // The k nearest frames over the tree's dims, nearest first, by brute force, and as the index
-// finds them (kd-tree, kd-tree with a filter: its frames only, the multiples of tree_every();
+// finds them (kd-tree, kd-tree with a selector: its frames only, the multiples of tree_every();
 // linear scan: every frame).
 void ExpectNearestAgreesWithBruteForce(const LibraryIndex& library, int clips) {
   const int dims = library.ann_dims();
   std::mt19937 rng(3);
   for (int trial = 0; trial < 20; ++trial) {
-    const float* point = FrameRow(library, rng() % library.total_frames());
-    // Filters: none, all but one clip (kd-tree and post-filter), and one clip (linear scan).
+    const int64_t at = rng() % library.total_frames();
+    const float* point = FrameRow(library, at);
+    // Selectors: none, all but one clip (kd-tree, tested inside), one clip (linear scan), and
+    // each of those but the 200 frames around the point's own (a stored query's range).
     std::vector<bool> all_but_one(clips, true), one(clips, false);
     all_but_one[1] = false;
     one[1] = true;
-    const std::vector<bool> filters[] = {std::vector<bool>(), all_but_one, one};
-    for (const std::vector<bool>& allowed : filters) {
+    const auto [own_clip, own_frame] = library.Locate(at);
+    std::vector<FrameSelector> selectors;
+    for (const std::vector<bool>& allowed : {std::vector<bool>(), all_but_one, one}) {
+      selectors.push_back(FrameSelector::OfClips(allowed));
+      selectors.push_back({.allowed = allowed,
+                           .excluded_clip = own_clip,
+                           .excluded_first = own_frame - 100,
+                           .excluded_last = own_frame + 100});
+    }
+    for (const FrameSelector& selector : selectors) {
+      SCOPED_TRACE(::testing::Message() << "selector " << &selector - selectors.data());
       // One clip of three is answered by a scan, the others by the tree.
-      const int every = &allowed == &filters[2] ? 1 : library.tree_every();
+      const int every = selector.allowed == one ? 1 : library.tree_every();
       std::vector<float> expected;
       for (int64_t f = 0; f < library.total_frames(); f += every) {
-        if (allowed.empty() || allowed[library.Locate(f).first]) {
+        const auto [clip, frame] = library.Locate(f);
+        if (selector.Admits(clip, frame)) {
           expected.push_back(Distance(point, FrameRow(library, f), dims));
         }
       }
       std::sort(expected.begin(), expected.end());
-      const std::vector<Neighbour> found = library.Nearest(point, dims, 50, 0.0f, allowed);
+      const std::vector<Neighbour> found = library.Nearest(point, dims, 50, 0.0f, selector);
       ASSERT_EQ(found.size(), 50u);
       for (size_t i = 0; i < found.size(); ++i) {
         EXPECT_EQ(found[i].frame % every, 0) << i;
         EXPECT_NEAR(found[i].distance, expected[i], 1e-4) << i;
         EXPECT_NEAR(found[i].distance, Distance(point, FrameRow(library, found[i].frame), dims),
                     1e-4);
-        if (!allowed.empty()) {
-          EXPECT_TRUE(allowed[library.Locate(found[i].frame).first]);
-        }
+        const auto [clip, frame] = library.Locate(found[i].frame);
+        EXPECT_TRUE(selector.Admits(clip, frame));
       }
     }
     // Other dimensions than the tree's are answered by a scan of every frame.
@@ -536,6 +547,69 @@ TEST_F(SearchTest, AnExcludedRangeIsLeftOutAndTheResultsStillFill) {
   }
   params.excluded = ExcludedRange{100, own.first + 5, own.first + 3};
   EXPECT_EQ(Search(*library_, query(), params).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Takes of one motion, as a stored take's range searches them: the take (id 1), its exact copy
+// (id 2) and 14 near copies, each with a little noise of its own.
+std::unique_ptr<LibraryIndex> TakesAndACopy(int take_frames) {
+  const RowMatrixXf take = testing::Pattern(take_frames, kDims);
+  std::vector<LibraryClip> clips = {{1, "take", {}, take}, {2, "copy", {}, take}};
+  for (int k = 0; k < 14; ++k) {
+    RowMatrixXf near = testing::Pattern(take_frames + k % 3, kDims);
+    near += 0.05f * testing::SmoothNoise(near.rows(), kDims, 300 + k);
+    clips.push_back({3 + k, "near", {}, std::move(near)});
+  }
+  return *LibraryIndex::Build(std::move(clips), 30.0, {});
+}
+
+// A whole take searched with itself excluded finds its exact copy first, scored 0, whether the
+// copy starts an even or an odd number of frames after it. The kd-tree holds every other frame
+// at 30 Hz, and the warps run on every other frame from their seed: a copy an odd number of
+// frames along had seeds one frame off the query's, was warped a frame out of step at every
+// sample, and ranked below a pool of near copies that refinement never looked past
+// (bench/notes/2026-12-07-copy-miss.md).
+TEST(SearchExcludedQuery, FindsTheTakesExactCopyFirstWhateverItsPhase) {
+  for (const int take_frames : {50, 51, 52, 53}) {
+    SCOPED_TRACE(take_frames);
+    const std::unique_ptr<LibraryIndex> library = TakesAndACopy(take_frames);
+    const CoordinateView take = library->clip_coordinates(0);
+    SearchParams params;
+    params.max_results = 1;
+    params.excluded = ExcludedRange{1, 0, take_frames - 1};
+    for (const bool exact : {false, true}) {
+      SCOPED_TRACE(exact ? "exact" : "fast");
+      const absl::StatusOr<SearchResponse> found =
+          exact ? ExactSearch(*library, take, params) : Search(*library, take, params);
+      ASSERT_TRUE(found.ok()) << found.status();
+      ASSERT_EQ(found->results.size(), 1u);
+      EXPECT_EQ(found->results[0].clip_id, 2);
+      EXPECT_NEAR(found->results[0].score, 0.0, 1e-6);
+    }
+  }
+}
+
+// Every take of such libraries searched whole, itself excluded: the fast search's best is the
+// exact search's, each take's copy or near copies alike (which
+// ExactSearch.MatchesAnExhaustiveReferenceOnSmallLibraries checks against brute force).
+TEST(SearchExcludedQuery, EveryTakesBestIsTheExactSearchsBest) {
+  for (const int take_frames : {51, 52}) {
+    const std::unique_ptr<LibraryIndex> library = TakesAndACopy(take_frames);
+    for (int c = 0; c < library->clip_count(); ++c) {
+      SCOPED_TRACE(::testing::Message() << take_frames << " frames, clip " << c);
+      const CoordinateView query = library->clip_coordinates(c);
+      SearchParams params;
+      params.max_results = 1;  // the smallest pool of candidates refined (12)
+      params.excluded = ExcludedRange{library->clip(c).clip_id, 0, query.rows - 1};
+      const absl::StatusOr<SearchResponse> fast = Search(*library, query, params);
+      const absl::StatusOr<SearchResponse> exact = ExactSearch(*library, query, params);
+      ASSERT_TRUE(fast.ok()) << fast.status();
+      ASSERT_TRUE(exact.ok()) << exact.status();
+      ASSERT_FALSE(fast->results.empty());
+      ASSERT_FALSE(exact->results.empty());
+      EXPECT_EQ(fast->results[0].clip_id, exact->results[0].clip_id);
+      EXPECT_NEAR(fast->results[0].score, exact->results[0].score, 1e-5);
+    }
+  }
 }
 
 // A one-frame query: the nearest distinct places, one frame each, scored by the pose distance.

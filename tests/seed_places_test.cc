@@ -121,8 +121,8 @@ TEST(NearestPlaces, AreTheBottomsOfTheWellsFirstAsBruteForceFindsThem) {
     for (int k : {1, 7, wells}) {
       const std::vector<int64_t> expected =
           BruteForcePlaces(*library, centre.data(), dims, k, separation, allowed);
-      const std::vector<Neighbour> found =
-          library->NearestPlaces(centre.data(), dims, k, separation, 0.0f, allowed);
+      const std::vector<Neighbour> found = library->NearestPlaces(
+          centre.data(), dims, k, separation, 0.0f, FrameSelector::OfClips(allowed));
       EXPECT_EQ(Frames(found), expected) << "dims " << dims << ", k " << k;
       for (const Neighbour& n : found) {
         EXPECT_NE(std::find(bottoms.begin(), bottoms.end(), n.frame), bottoms.end());
@@ -130,8 +130,8 @@ TEST(NearestPlaces, AreTheBottomsOfTheWellsFirstAsBruteForceFindsThem) {
       }
     }
     // Beyond, slopes give places too, after every bottom.
-    const std::vector<Neighbour> found =
-        library->NearestPlaces(centre.data(), dims, 1000, separation, 0.0f, allowed);
+    const std::vector<Neighbour> found = library->NearestPlaces(
+        centre.data(), dims, 1000, separation, 0.0f, FrameSelector::OfClips(allowed));
     EXPECT_GT(static_cast<int>(found.size()), wells);
     const std::vector<int64_t> frames = Frames(found);
     for (int64_t bottom : bottoms) {

@@ -81,8 +81,8 @@ void ExpectWindowsAgreeWithBruteForce(const LibraryIndex& library) {
         const std::vector<float> expected =
             BruteForceWindows(library, query, frame, kTreeDims, allowed, every);
         for (const int k : {1, 40}) {
-          const std::vector<Neighbour> found =
-              library.NearestWindows(query, frame, kTreeDims, k, 0.0f, allowed);
+          const std::vector<Neighbour> found = library.NearestWindows(
+              query, frame, kTreeDims, k, 0.0f, FrameSelector::OfClips(allowed));
           ASSERT_EQ(found.size(), static_cast<size_t>(k));
           for (int i = 0; i < k; ++i) {
             EXPECT_EQ(found[i].frame % every, 0) << i;
@@ -136,7 +136,7 @@ TEST(NearestWindows, OverOtherDimensionsScan) {
   const int64_t unbuilt_bytes = (*library)->tree_bytes();
   ASSERT_EQ((*library)
                 ->NearestWindows((*library)->clip_coordinates(2), 100, kTreeDims, 10, 0.0f,
-                                 {false, false, true})
+                                 FrameSelector::OfClips({false, false, true}))
                 .size(),
             10u);
   const CoordinateView query = (*library)->clip_coordinates(2);
@@ -208,8 +208,9 @@ TEST(NearestWindows, ConcurrentFirstSearchesAgree) {
 }
 
 // Clips at 120 Hz, six holding the query's peak pose for 4 s: 500 seed windows pile into the
-// holds, too few places to fill 20 results; the default count takes them again, twice as many,
-// until they fill them; a count the search is given is kept.
+// holds, fewer places than two a result for 20 results; the default count takes them again, twice
+// as many, until they reach that; a count the search is given is kept. (Since each seed moves to
+// the full-rate frame nearest its warp's pinned pose, the given 500 fill the 20 results too.)
 TEST(DefaultSeeds, AreTakenAgainWhileTooFewPlacesToFillTheResults) {
   constexpr int kQueryFrames = 240;
   const RowMatrixXf pattern = testing::Pattern(kQueryFrames, kDims);
@@ -222,7 +223,6 @@ TEST(DefaultSeeds, AreTakenAgainWhileTooFewPlacesToFillTheResults) {
   const SearchResponse given = *Search(**library, CoordinateView::Of(pattern), params);
   EXPECT_EQ(given.stats.seeds, 500);
   EXPECT_LT(given.stats.clusters, 2 * params.max_results);
-  EXPECT_LT(given.results.size(), 20u);
   params.neighbours = 0;  // the default, 500 first
   const SearchResponse found = *Search(**library, CoordinateView::Of(pattern), params);
   EXPECT_GT(found.stats.seeds, 500);

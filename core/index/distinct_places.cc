@@ -6,9 +6,10 @@
 
 namespace motiondb {
 
-DistinctPlaces::DistinctPlaces(int k, int64_t separation, absl::FunctionRef<int(int64_t)> clip_of,
-                               const std::vector<bool>& allowed)
-    : k_(k), separation_(std::max<int64_t>(1, separation)), clip_of_(clip_of), allowed_(allowed) {}
+DistinctPlaces::DistinctPlaces(int k, int64_t separation,
+                               absl::FunctionRef<std::pair<int, int64_t>(int64_t)> locate,
+                               const FrameSelector& selector)
+    : k_(k), separation_(std::max<int64_t>(1, separation)), locate_(locate), selector_(selector) {}
 
 float DistinctPlaces::worstDist() const {
   if (!full()) return std::numeric_limits<float>::max();
@@ -23,8 +24,8 @@ void DistinctPlaces::PopRemoved() const {
 void DistinctPlaces::addPoint(float squared, size_t row) {
   if (k_ < 1 || (full() && squared >= worstDist())) return;
   const int64_t frame = first_frame_ + static_cast<int64_t>(row) * every_;
-  const int clip = clip_of_(frame);
-  if (!allowed_.empty() && !allowed_[clip]) return;
+  const auto [clip, clip_frame] = locate_(frame);
+  if (!selector_.Admits(clip, clip_frame)) return;
   // Kept places within `separation` lie in this bucket or the two beside it.
   const int64_t bucket = frame / separation_;
   int farther[3];

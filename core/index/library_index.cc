@@ -17,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/index/coarse_rate.h"
 #include "core/index/internal/distinct_places.h"
+#include "core/index/internal/selected_nearest.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -76,12 +77,12 @@ class LibraryIndex::Tree {
     return result;
   }
 
-  // Every point nearer than `places`' worst, offered to it (numbered from 0: point i is row
+  // Every point nearer than `found`'s worst, offered to it (numbered from 0: point i is row
   // first() + i * every()).
-  void Offer(const float* point, float epsilon, flann::ResultSet<float>& places) const {
+  void Offer(const float* point, float epsilon, flann::ResultSet<float>& found) const {
     flann::SearchParams params;
     params.eps = epsilon;
-    index_.findNeighbors(places, point, params);
+    index_.findNeighbors(found, point, params);
   }
 
   // FLANN's own count (node pool and index permutation) plus its row-pointer table.
@@ -461,7 +462,7 @@ int LibraryIndex::ShapeLengthNearest(int64_t frames) const {
 
 std::vector<ShapeWindow> LibraryIndex::NearestShapes(CoordinateView query, int length, int k,
                                                      float epsilon,
-                                                     const std::vector<bool>& allowed_clips) const {
+                                                     const FrameSelector& selector) const {
   const Shapes& shapes = ShapesOf();
   const ShapeLevel& level = shapes.levels[length];
   const int64_t count = level.rows.rows();
@@ -478,40 +479,32 @@ std::vector<ShapeWindow> LibraryIndex::NearestShapes(CoordinateView query, int l
         std::upper_bound(level.clip_first.begin(), level.clip_first.end(), row) -
         level.clip_first.begin() - 1);
   };
+  const auto admits = [&](int clip, int64_t row) {
+    return selector.AdmitsAny(clip, level.first_frame[row],
+                              level.first_frame[row] + level.frames[row] - 1);
+  };
   int64_t allowed = count;
-  if (!allowed_clips.empty()) {
+  if (!selector.allowed.empty()) {
     allowed = 0;
     for (int c = 0; c < clip_count(); ++c) {
-      if (allowed_clips[c]) allowed += level.clip_first[c + 1] - level.clip_first[c];
+      if (selector.allowed[c]) allowed += level.clip_first[c + 1] - level.clip_first[c];
     }
   }
   std::vector<ShapeWindow> found;
   if (allowed * 2 >= count) {
-    // As FilteredNearest: enough extra windows to cover the filtered-out ones, doubling a few
-    // times, then a scan.
-    int64_t wanted =
-        k + (k * (count - allowed)) / std::max<int64_t>(1, allowed) + (allowed == count ? 0 : 16);
-    for (int attempt = 0; attempt < 4; ++attempt) {
-      wanted = std::min(wanted, count);
-      found.clear();
-      for (const Neighbour& n :
-           level.tree->Nearest(point.data(), dims, static_cast<int>(wanted), epsilon)) {
-        const int clip = clip_of_row(n.frame);
-        if (allowed_clips.empty() || allowed_clips[clip]) {
-          found.push_back(window_of(clip, n.frame, n.distance));
-        }
-      }
-      if (static_cast<int64_t>(found.size()) >= k || wanted == count) {
-        found.resize(std::min<size_t>(found.size(), k));
-        return found;
-      }
-      wanted *= 2;
+    // As FilteredNearest: the selector tested as the tree meets the windows.
+    const auto admits_row = [&](int64_t row) { return admits(clip_of_row(row), row); };
+    SelectedNearest nearest(k, admits_row);
+    level.tree->Offer(point.data(), epsilon, nearest);
+    for (const Neighbour& n : nearest.Take()) {
+      found.push_back(window_of(clip_of_row(n.frame), n.frame, n.distance));
     }
+    return found;
   }
-  found.clear();
   for (int c = 0; c < clip_count(); ++c) {
-    if (!allowed_clips.empty() && !allowed_clips[c]) continue;
+    if (!selector.AdmitsClip(c)) continue;
     for (int64_t row = level.clip_first[c]; row < level.clip_first[c + 1]; ++row) {
+      if (!admits(c, row)) continue;
       found.push_back(window_of(c, row, Distance(point.data(), level.rows.row(row).data(), dims)));
     }
   }
@@ -542,8 +535,22 @@ RowMatrixXf LibraryIndex::CopyClipCoordinates(int index) const {
 }
 
 std::vector<Neighbour> LibraryIndex::TreeNearest(absl::FunctionRef<const Tree*(int block)> tree_of,
-                                                 const float* point, int dims, int k,
-                                                 float epsilon) const {
+                                                 const float* point, int dims, int k, float epsilon,
+                                                 const FrameSelector& selector) const {
+  if (!selector.AdmitsEvery()) {
+    const auto admits = [&](int64_t frame) {
+      const auto [clip, clip_frame] = Locate(frame);
+      return selector.Admits(clip, clip_frame);
+    };
+    SelectedNearest nearest(k, admits);
+    for (int b = 0; b < block_count(); ++b) {
+      const Tree* tree = tree_of(b);
+      if (!tree) continue;
+      nearest.set_rows(blocks_[b]->first_frame + tree->first(), tree->every());
+      tree->Offer(point, epsilon, nearest);
+    }
+    return nearest.Take();
+  }
   const Tree& base = *tree_of(0);  // the first block starts at frame 0, a tree frame
   std::vector<Neighbour> all =
       base.Nearest(point, dims, static_cast<int>(std::min<int64_t>(k, base.points())), epsilon);
@@ -586,38 +593,17 @@ std::pair<int, int64_t> LibraryIndex::Locate(int64_t global_frame) const {
 int LibraryIndex::tree_every() const { return options_.coarse_tree ? CoarseFactor(rate_) : 1; }
 
 std::vector<Neighbour> LibraryIndex::FilteredNearest(
-    int k, const std::vector<bool>& allowed_clips, bool tree_usable,
+    int k, const FrameSelector& selector, bool tree_usable,
     absl::FunctionRef<std::vector<Neighbour>(int k)> tree_nearest,
     absl::FunctionRef<float(int clip, int64_t frame)> distance) const {
   k = static_cast<int>(std::min<int64_t>(k, total_frames()));
-  if (tree_usable) {
-    if (allowed_clips.empty()) return tree_nearest(k);
-    int64_t tree_points = 0;  // the window trees hold the same points as the pose trees
-    for (const auto& block : blocks_) {
-      tree_points += block->pose_tree ? block->pose_tree->points() : 0;
-    }
-    // When the filter keeps most frames, ask the tree for enough extra neighbours to cover the
-    // filtered-out ones (doubling a few times), and scan only if that is not enough.
-    const int64_t allowed_frames = AllowedFrames(allowed_clips);
-    int64_t wanted =
-        k + (k * (total_frames() - allowed_frames)) / std::max<int64_t>(1, allowed_frames) + 16;
-    for (int attempt = 0; allowed_frames * 2 >= total_frames() && attempt < 4; ++attempt) {
-      wanted = std::min(wanted, tree_points);
-      std::vector<Neighbour> found = tree_nearest(static_cast<int>(wanted));
-      std::erase_if(found,
-                    [&](const Neighbour& n) { return !allowed_clips[Locate(n.frame).first]; });
-      if (static_cast<int64_t>(found.size()) >= k || wanted == tree_points) {
-        found.resize(std::min<size_t>(found.size(), k));
-        return found;
-      }
-      wanted *= 2;
-    }
-  }
+  // The tree meets the frames of the clips left out too: worth it while they are few.
+  if (tree_usable && AllowedFrames(selector) * 2 >= total_frames()) return tree_nearest(k);
   std::vector<Neighbour> all;
   for (int c = 0; c < clip_count(); ++c) {
-    if (!allowed_clips.empty() && !allowed_clips[c]) continue;
+    if (!selector.AdmitsClip(c)) continue;
     for (int64_t f = 0; f < clips_[c].frame_count; ++f) {
-      all.push_back({clips_[c].first_frame + f, distance(c, f)});
+      if (selector.Admits(c, f)) all.push_back({clips_[c].first_frame + f, distance(c, f)});
     }
   }
   const size_t keep = std::min<size_t>(k, all.size());
@@ -627,32 +613,44 @@ std::vector<Neighbour> LibraryIndex::FilteredNearest(
 }
 
 std::vector<Neighbour> LibraryIndex::Nearest(const float* point, int dims, int k, float epsilon,
-                                             const std::vector<bool>& allowed_clips) const {
+                                             const FrameSelector& selector) const {
   return FilteredNearest(
-      k, allowed_clips, dims == options_.ann_dims,
+      k, selector, dims == options_.ann_dims,
       [&](int wanted) {
         return TreeNearest([&](int b) { return blocks_[b]->pose_tree.get(); }, point, dims, wanted,
-                           epsilon);
+                           epsilon, selector);
       },
       [&](int clip, int64_t frame) {
         return Distance(point, clip_coordinates(clip).row(frame), dims);
       });
 }
 
+std::pair<int64_t, float> LibraryIndex::NearestFrameAround(const float* point, int dims, int clip,
+                                                           int64_t frame, int64_t reach) const {
+  const CoordinateView coordinates = clip_coordinates(clip);
+  std::pair<int64_t, float> best{frame, std::numeric_limits<float>::infinity()};
+  const int64_t last = std::min(coordinates.rows - 1, frame + reach);
+  for (int64_t f = std::max<int64_t>(0, frame - reach); f <= last; ++f) {
+    const float distance = Distance(point, coordinates.row(f), dims);
+    if (distance < best.second) best = {f, distance};
+  }
+  return best;
+}
+
 std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t frame, int dims,
                                                     int k, float epsilon,
-                                                    const std::vector<bool>& allowed_clips) const {
-  if (window_frames_ == 0) return Nearest(rows.row(frame), dims, k, epsilon, allowed_clips);
+                                                    const FrameSelector& selector) const {
+  if (window_frames_ == 0) return Nearest(rows.row(frame), dims, k, epsilon, selector);
   Eigen::RowVectorXf window(3 * dims);
   WriteWindow(rows, frame, window_frames_, dims, window.data());
   Eigen::RowVectorXf scanned(3 * dims);  // a scanned frame's window
   return FilteredNearest(
-      k, allowed_clips, dims == options_.ann_dims,
+      k, selector, dims == options_.ann_dims,
       [&](int wanted) {
         // Only here, where the trees are asked, are they built.
         const Eigen::RowVectorXf turned = window * WindowsOf(0).basis;
         return TreeNearest([&](int b) { return WindowsOf(b).tree.get(); }, turned.data(), 3 * dims,
-                           wanted, epsilon);
+                           wanted, epsilon, selector);
       },
       [&](int clip, int64_t clip_frame) {
         WriteWindow(clip_coordinates(clip), clip_frame, window_frames_, dims, scanned.data());
@@ -660,21 +658,21 @@ std::vector<Neighbour> LibraryIndex::NearestWindows(CoordinateView rows, int64_t
       });
 }
 
-int64_t LibraryIndex::AllowedFrames(const std::vector<bool>& allowed_clips) const {
-  if (allowed_clips.empty()) return total_frames_;
+int64_t LibraryIndex::AllowedFrames(const FrameSelector& selector) const {
+  if (selector.allowed.empty()) return total_frames_;
   int64_t frames = 0;
   for (int c = 0; c < clip_count(); ++c) {
-    if (allowed_clips[c]) frames += clips_[c].frame_count;
+    if (selector.allowed[c]) frames += clips_[c].frame_count;
   }
   return frames;
 }
 
 std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims, int k,
                                                    int64_t separation, float epsilon,
-                                                   const std::vector<bool>& allowed_clips) const {
-  const auto clip_of = [this](int64_t frame) { return Locate(frame).first; };
-  DistinctPlaces places(k, separation, clip_of, allowed_clips);
-  if (dims == options_.ann_dims && AllowedFrames(allowed_clips) * 2 >= total_frames_) {
+                                                   const FrameSelector& selector) const {
+  const auto locate = [this](int64_t frame) { return Locate(frame); };
+  DistinctPlaces places(k, separation, locate, selector);
+  if (dims == options_.ann_dims && AllowedFrames(selector) * 2 >= total_frames_) {
     for (const auto& block : blocks_) {
       if (!block->pose_tree) continue;
       places.set_rows(block->first_frame + block->pose_tree->first(), block->pose_tree->every());
@@ -683,7 +681,7 @@ std::vector<Neighbour> LibraryIndex::NearestPlaces(const float* point, int dims,
     return places.Take();
   }
   for (int c = 0; c < clip_count(); ++c) {
-    if (!allowed_clips.empty() && !allowed_clips[c]) continue;
+    if (!selector.AdmitsClip(c)) continue;
     const CoordinateView view = clip_coordinates(c);
     places.set_rows(clips_[c].first_frame, 1);
     for (int64_t f = 0; f < view.rows; ++f) {

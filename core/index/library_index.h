@@ -91,6 +91,33 @@ struct ShapeWindow {
   float distance = 0;  // between the shapes: about the RMS pose distance of their samples
 };
 
+// Which library frames a nearest-neighbour search may return (FAISS's IDSelector): those of the
+// allowed clips (by index; empty: every clip) but one range of one clip's frames (clip -1: none),
+// a stored query's own. The index tests the frames as its kd-trees meet them, so that the k
+// nearest are k admitted frames, found in one search.
+struct FrameSelector {
+  std::vector<bool> allowed;
+  int excluded_clip = -1;
+  int64_t excluded_first = 0, excluded_last = -1;
+
+  // The clips `allowed` marks, nothing excluded.
+  static FrameSelector OfClips(std::vector<bool> allowed) {
+    return {.allowed = std::move(allowed),
+            .excluded_clip = -1,
+            .excluded_first = 0,
+            .excluded_last = -1};
+  }
+  bool AdmitsEvery() const { return allowed.empty() && excluded_clip < 0; }
+  bool AdmitsClip(int clip) const { return allowed.empty() || allowed[clip]; }
+  // Whether frame `frame` of the clip of index `clip` may be returned.
+  bool Admits(int clip, int64_t frame) const { return AdmitsAny(clip, frame, frame); }
+  // Whether some frame of first..last of that clip may be.
+  bool AdmitsAny(int clip, int64_t first, int64_t last) const {
+    return AdmitsClip(clip) &&
+           (clip != excluded_clip || first < excluded_first || last > excluded_last);
+  }
+};
+
 struct Neighbour {
   int64_t frame;   // global frame number
   float distance;  // pose distance over the searched dimensions
@@ -143,12 +170,18 @@ class LibraryIndex {
   // A copy of clip_coordinates(index), all dims.
   RowMatrixXf CopyClipCoordinates(int index) const;
 
-  // The k frames nearest to `point` over its first `dims` coordinates, nearest first. Uses the
-  // kd-tree, and so only its frames (every tree_every()-th), when dims == ann_dims() and every
-  // clip is allowed (or nearly); otherwise an exact linear scan over every frame of the allowed
-  // clips (`allowed_clips` empty: all).
+  // The k frames `selector` admits nearest to `point` over its first `dims` coordinates, nearest
+  // first. Uses the kd-tree, and so only its frames (every tree_every()-th), when dims ==
+  // ann_dims() and the allowed clips hold at least half the frames; otherwise an exact linear
+  // scan over every frame of the allowed clips.
   std::vector<Neighbour> Nearest(const float* point, int dims, int k, float epsilon,
-                                 const std::vector<bool>& allowed_clips) const;
+                                 const FrameSelector& selector) const;
+
+  // The frame of clip `clip` within `reach` frames of its frame `frame` nearest to `point` over
+  // its first `dims` coordinates (the earliest of equals), and its distance: a frame the kd-tree
+  // found (one in tree_every()) moved to the nearest at the full rate.
+  std::pair<int64_t, float> NearestFrameAround(const float* point, int dims, int clip,
+                                               int64_t frame, int64_t reach) const;
 
   // The k nearest *places*: frames near `point` (over its first `dims` coordinates) of which
   // no two of one clip lie within `separation` frames, nearest first; a frame is kept unless a
@@ -158,7 +191,7 @@ class LibraryIndex {
   // dims == ann_dims() and the allowed clips hold at least half the frames) and the linear
   // scan may differ where such chains meet.
   std::vector<Neighbour> NearestPlaces(const float* point, int dims, int k, int64_t separation,
-                                       float epsilon, const std::vector<bool>& allowed_clips) const;
+                                       float epsilon, const FrameSelector& selector) const;
 
   // Frames between the poses of a seed window (LibraryIndexOptions::seed_window_s at rate()),
   // 0 when the index has no window tree.
@@ -169,8 +202,7 @@ class LibraryIndex {
   // scan as Nearest() does, over the window tree; window_frames() 0: Nearest() at `frame`.
   // `frame` must be one of `rows`' (0 <= frame < rows.rows), as the search's anchors are.
   std::vector<Neighbour> NearestWindows(CoordinateView rows, int64_t frame, int dims, int k,
-                                        float epsilon,
-                                        const std::vector<bool>& allowed_clips) const;
+                                        float epsilon, const FrameSelector& selector) const;
 
   // The shape windows' lengths in frames, increasing (about sqrt(2) apart; kShapeShortestS to
   // kShapeLongestS at rate()).
@@ -178,12 +210,13 @@ class LibraryIndex {
   // The index of the shape length nearest `frames` (by ratio).
   int ShapeLengthNearest(int64_t frames) const;
   // The k windows of length shape_lengths()[length] nearest `query`'s shape (the query resampled
-  // to kShapeSamples poses), nearest first, of the allowed clips (empty: all). A clip shorter
+  // to kShapeSamples poses), nearest first, of which `selector` admits a frame (a window inside
+  // the excluded range would take a place for results it cannot give). A clip shorter
   // than a length but at least a quarter of it is one window of that length, whole (resampled
   // alike). The windows and their kd-trees are built by the first call (thread-safe): about
   // 1.8 windows a frame at 30 Hz, shape_index_dims floats each (shape_bytes()).
   std::vector<ShapeWindow> NearestShapes(CoordinateView query, int length, int k, float epsilon,
-                                         const std::vector<bool>& allowed_clips) const;
+                                         const FrameSelector& selector) const;
 
   // Bytes held: the coordinate blocks; the kd-trees and the seed windows they index; the shape
   // windows and their kd-trees (0 until a search asks for them).
@@ -202,21 +235,22 @@ class LibraryIndex {
   // their entries.
   void AddBlock(std::vector<LibraryClip> clips, int64_t first_frame);
   void AddEntry(ClipEntry entry, int block);
-  // Frames of the allowed clips (empty: all).
-  int64_t AllowedFrames(const std::vector<bool>& allowed_clips) const;
+  // Frames of the clips `selector` allows.
+  int64_t AllowedFrames(const FrameSelector& selector) const;
   // Block b's seed windows, built on first use (thread-safe).
   const Windows& WindowsOf(int b) const;
   // The shape windows of every block, built on first use (thread-safe).
   const Shapes& ShapesOf() const;
-  // The k nearest over one kd-tree of every block (tree_of(b): block b's, null if none),
-  // merged; the first block's must exist.
+  // The k nearest frames `selector` admits over one kd-tree of every block (tree_of(b): block
+  // b's, null if none); the first block's must exist.
   std::vector<Neighbour> TreeNearest(absl::FunctionRef<const Tree*(int block)> tree_of,
-                                     const float* point, int dims, int k, float epsilon) const;
-  // The k nearest frames of the allowed clips by `distance` (frame of a clip, by index): through
-  // `tree_nearest` (the k nearest of every clip) when `tree_usable` and the allowed clips hold
+                                     const float* point, int dims, int k, float epsilon,
+                                     const FrameSelector& selector) const;
+  // The k nearest frames `selector` admits by `distance` (frame of a clip, by index): through
+  // `tree_nearest` (TreeNearest with the selector) when `tree_usable` and the allowed clips hold
   // most frames, else by a scan.
   std::vector<Neighbour> FilteredNearest(
-      int k, const std::vector<bool>& allowed_clips, bool tree_usable,
+      int k, const FrameSelector& selector, bool tree_usable,
       absl::FunctionRef<std::vector<Neighbour>(int k)> tree_nearest,
       absl::FunctionRef<float(int clip, int64_t frame)> distance) const;
 

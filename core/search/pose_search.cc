@@ -15,25 +15,6 @@ namespace {
 // dtw_dims, and moving to the best frame near each may bring two together.
 constexpr int kPlacesPerResult = 4;
 
-// The frame within `reach` of `frame` in `clip` nearest to `pose` over `dims`, and its distance:
-// the kd-tree holds every n-th frame only (core/index/coarse_rate.h).
-SearchResult NearestFrameAround(const LibraryIndex& library, const float* pose, int dims, int clip,
-                                int64_t frame, int64_t reach) {
-  const CoordinateView coordinates = library.clip_coordinates(clip);
-  SearchResult best;
-  best.clip_index = clip;
-  best.score = INFINITY;
-  const int64_t last = std::min(coordinates.rows - 1, frame + reach);
-  for (int64_t f = std::max<int64_t>(0, frame - reach); f <= last; ++f) {
-    const double distance = Distance(pose, coordinates.row(f), dims);
-    if (distance < best.score) {
-      best.score = distance;
-      best.first_frame = best.last_frame = best.seed_frame = f;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, CoordinateView pose,
@@ -51,7 +32,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
                         std::llround(kPoseSeparationS * library.rate()));
   const std::vector<Neighbour> places =
       library.NearestPlaces(pose.row(0), params.ann_dims, kPlacesPerResult * params.max_results,
-                            separation, params.epsilon, filter.allowed);
+                            separation, params.epsilon, filter);
   stats.seeds = stats.clusters = static_cast<int64_t>(places.size());
   stats.seeds_ms = MillisecondsSince(start);
 
@@ -61,8 +42,13 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
   candidates.reserve(places.size());
   for (const Neighbour& place : places) {
     const auto [clip, frame] = library.Locate(place.frame);
-    SearchResult candidate =
-        NearestFrameAround(library, pose.row(0), params.dtw_dims, clip, frame, reach);
+    // The kd-tree holds every n-th frame only (core/index/coarse_rate.h).
+    const auto [nearest, distance] =
+        library.NearestFrameAround(pose.row(0), params.dtw_dims, clip, frame, reach);
+    SearchResult candidate;
+    candidate.clip_index = clip;
+    candidate.first_frame = candidate.last_frame = candidate.seed_frame = nearest;
+    candidate.score = distance;
     // A result is its one frame (the range below only serves the overlap rule).
     if (filter.Admits(clip, candidate.seed_frame, candidate.seed_frame)) {
       candidates.push_back(std::move(candidate));

@@ -116,13 +116,9 @@ absl::StatusOr<SearchResponse> ShapeSearch(const LibraryIndex& library, Coordina
   std::vector<ShapeWindow> windows;
   for (int length = std::max(0, nearest - params.shape_lengths_either_side);
        length <= std::min(lengths - 1, nearest + params.shape_lengths_either_side); ++length) {
-    for (const ShapeWindow& w : library.NearestShapes(query, length, params.shape_windows,
-                                                      params.epsilon, filter.allowed)) {
-      // A window inside the excluded range would take a clip's place for results it cannot give.
-      const bool excluded = w.clip == filter.excluded_clip &&
-                            w.first_frame >= filter.excluded_first &&
-                            w.first_frame + w.frames - 1 <= filter.excluded_last;
-      if (!excluded) windows.push_back(w);
+    for (const ShapeWindow& w :
+         library.NearestShapes(query, length, params.shape_windows, params.epsilon, filter)) {
+      windows.push_back(w);
     }
     if (stop.Done(kCellsPerWindow * params.shape_windows)) return SearchStopped();
   }

@@ -184,7 +184,7 @@ int CoarseRow(int frame, int factor, int64_t coarse_rows) {
 // (SearchParams::second_anchor_scatter). `coarse_rows`, `factor`: the warps' query. Fills the
 // seed and cluster stages' stats. Counts its work in `stop`, and returns early once it says stop.
 std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView query, int anchor,
-                                 int64_t coarse_rows, int factor, const std::vector<bool>& allowed,
+                                 int64_t coarse_rows, int factor, const SearchFilter& filter,
                                  const SearchParams& params, SearchStats& stats, StopPoll& stop) {
   Clock::time_point stage = Clock::now();
   const int64_t gap = std::max<int64_t>(1, std::llround(params.cluster_gap_s * library.rate()));
@@ -195,23 +195,35 @@ std::vector<Seed> ClusteredSeeds(const LibraryIndex& library, CoordinateView que
     switch (params.seed_selection) {
       case SeedSelection::kDistinctPlaces:
         return library.NearestPlaces(query.row(query_frame), params.ann_dims, params.places,
-                                     PlaceSeparation(gap, query.rows), params.epsilon, allowed);
+                                     PlaceSeparation(gap, query.rows), params.epsilon, filter);
       case SeedSelection::kNearestWindows:
         return library.NearestWindows(query, query_frame, params.ann_dims, count, params.epsilon,
-                                      allowed);
+                                      filter);
       case SeedSelection::kNearestFrames:
       case SeedSelection::kShapeWindows:  // Search() runs the shape search instead
         break;
     }
-    return library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon, allowed);
+    return library.Nearest(query.row(query_frame), params.ann_dims, count, params.epsilon, filter);
   };
+  // A warp pins its query row CoarseRow(anchor) to its seed and samples the clip every factor-th
+  // frame from there, but the kd-tree holds only every tree_every()-th frame of the library: a
+  // seed as found can be a frame out of step with the query, and then so is every sample of its
+  // warp (a take's exact copy an odd number of frames after it scored as a near copy does, and
+  // refinement never saw it: bench/notes/2026-12-07-copy-miss.md). So each seed moves to the
+  // frame nearest the pinned query frame's pose, up to a sampling step either side.
+  const int64_t reach = std::max(library.tree_every(), factor) - 1;
   const auto seeds_of = [&](int query_frame, int count) {
     const std::vector<Neighbour> neighbours = nearest_of(query_frame, count);
-    stop.Done(kCellsPerNeighbour * static_cast<int64_t>(neighbours.size()));
+    // A move compares a cell's worth of pose for each frame it looks at.
+    stop.Done((kCellsPerNeighbour + 2 * reach + 1) * static_cast<int64_t>(neighbours.size()));
+    const float* pinned = query.row(CoarseRow(query_frame, factor, coarse_rows) * factor);
     std::vector<Seed> seeds;
     seeds.reserve(neighbours.size());
     for (const Neighbour& n : neighbours) {
-      const auto [clip, frame] = library.Locate(n.frame);
+      const auto [clip, found] = library.Locate(n.frame);
+      const int64_t frame =
+          reach > 0 ? library.NearestFrameAround(pinned, params.dtw_dims, clip, found, reach).first
+                    : found;
       seeds.push_back({clip, frame, n.distance, query_frame});
     }
     return seeds;
@@ -292,8 +304,8 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
   stats.threads = static_cast<int>(members.size());
   StopPoll& stop = members[0].stop;
   if (stop.Done(query.rows)) return SearchStopped();
-  std::vector<Seed> order = ClusteredSeeds(library, query, anchor, warp_query.rows, factor,
-                                           filter.allowed, params, stats, stop);
+  std::vector<Seed> order =
+      ClusteredSeeds(library, query, anchor, warp_query.rows, factor, filter, params, stats, stop);
   if (stop.stopped()) return SearchStopped();
 
   Clock::time_point stage = Clock::now();

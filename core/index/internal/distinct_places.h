@@ -23,10 +23,11 @@ namespace motiondb {
 
 class DistinctPlaces final : public flann::ResultSet<float> {
  public:
-  // `clip_of` gives a global frame's clip; frames of clips that `allowed` (when not empty)
-  // marks false are ignored. Both must outlive this.
-  DistinctPlaces(int k, int64_t separation, absl::FunctionRef<int(int64_t)> clip_of,
-                 const std::vector<bool>& allowed);
+  // `locate` gives a global frame's clip and frame in it (LibraryIndex::Locate); frames that
+  // `selector` does not admit are ignored. Both must outlive this.
+  DistinctPlaces(int k, int64_t separation,
+                 absl::FunctionRef<std::pair<int, int64_t>(int64_t)> locate,
+                 const FrameSelector& selector);
 
   // The rows the next addPoint() calls name: row r is global frame first_frame + r * every.
   void set_rows(int64_t first_frame, int every) {
@@ -57,8 +58,8 @@ class DistinctPlaces final : public flann::ResultSet<float> {
 
   int k_;
   int64_t separation_;
-  absl::FunctionRef<int(int64_t)> clip_of_;
-  const std::vector<bool>& allowed_;
+  absl::FunctionRef<std::pair<int, int64_t>(int64_t)> locate_;
+  const FrameSelector& selector_;
   int64_t first_frame_ = 0;
   int every_ = 1;
   int kept_ = 0;

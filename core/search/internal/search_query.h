@@ -17,12 +17,10 @@
 namespace motiondb {
 
 // SearchParams' filters resolved against a library: the clips a search looks in, and the range
-// of one that no result may overlap.
-struct SearchFilter {
-  std::vector<bool> allowed;  // by clip index; empty: every clip
-  int excluded_clip = -1;     // the excluded range's clip index; -1: none
-  int64_t excluded_first = 0, excluded_last = -1;
-
+// of one that no result may overlap. As a FrameSelector, the frames the seed and shape searches
+// may return: a seed inside the excluded range anchors only warps that overlap it.
+struct SearchFilter : FrameSelector {
+  using FrameSelector::Admits;
   // Whether a result in the clip of index `clip` over frames first..last may be returned.
   bool Admits(int clip, int64_t first, int64_t last) const {
     return clip != excluded_clip || last < excluded_first || first > excluded_last;
