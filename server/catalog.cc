@@ -1,6 +1,7 @@
 #include "server/catalog.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/space/canonical_pose.h"
 #include "core/space/search_coordinates.h"
 #include "server/skeleton_map.h"
 #include "storage/content_hash.h"
@@ -190,6 +191,53 @@ absl::StatusOr<storage::ClipRecord> Catalog::UpdateClip(int64_t clip_id,
     return SnapshotWithClipInfo(space, clip_id, record.name, record.tags);
   }));
   return record;
+}
+
+absl::StatusOr<SkeletonMapView> Catalog::MapSkeleton(int64_t skeleton_id,
+                                                     const storage::SlotOverrideChange& change,
+                                                     const AnswerLimit& answers,
+                                                     const std::function<bool()>& should_stop) {
+  std::lock_guard<std::mutex> lock(write_mutex_);
+  // Checked before the write: a change whose answer could not be sent is not made. A
+  // skeleton's joints never change, so the check holds for the answer after the write.
+  MOTIONDB_ASSIGN_OR_RETURN(const storage::SkeletonRecord before,
+                            database_.GetSkeleton(skeleton_id));
+  MOTIONDB_RETURN_IF_ERROR(CheckSkeletonAnswer(before, answers));
+  std::vector<std::shared_ptr<const SpaceSnapshot>> spaces = registry_.OfSkeleton(skeleton_id);
+  std::erase_if(spaces, [](const auto& space) { return !space->space->canonical(); });
+  std::vector<storage::SpaceReprojection> reprojections;
+  if (!spaces.empty()) {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<SlotOverride> overrides,
+                              storage::OverridesAfterChange(before, change));
+    MOTIONDB_ASSIGN_OR_RETURN(const HumanoidMap map, MapHumanoid(*before.skeleton, overrides));
+    MOTIONDB_RETURN_IF_ERROR(
+        Prefixed(absl::StrCat("space ", spaces.front()->record.name, " lists skeleton ",
+                              skeleton_id, "; the change is refused"),
+                 CheckCanonicalMap(map, absl::StrCat(skeleton_id))));
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<int64_t> clip_ids,
+                              database_.ClipsOfSkeleton(skeleton_id));
+    for (const auto& space : spaces) reprojections.push_back({space->record.space_id, {}});
+    for (const int64_t clip_id : clip_ids) {
+      if (should_stop && should_stop()) {
+        return absl::CancelledError("the map change was stopped by its caller; nothing changed");
+      }
+      MOTIONDB_ASSIGN_OR_RETURN(const storage::StoredClip stored, database_.GetClip(clip_id));
+      for (size_t i = 0; i < spaces.size(); ++i) {
+        MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates,
+                                  SearchCoordinates(*spaces[i]->space, stored.clip, -1, &map));
+        reprojections[i].projections.push_back({clip_id, std::move(coordinates)});
+      }
+    }
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(storage::SkeletonRecord record,
+                            database_.UpdateSlotOverrides(skeleton_id, change, reprojections,
+                                                          {.should_stop = should_stop}));
+  for (const auto& space : spaces) {
+    absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> reloaded = LoadSpace(space->record);
+    if (!reloaded.ok()) return StaleIndexError(space->record.name, reloaded.status());
+    registry_.Put(*std::move(reloaded));
+  }
+  return SkeletonView(std::move(record));
 }
 
 absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> Catalog::CreateSpace(

@@ -24,7 +24,9 @@
 
 #include "absl/status/statusor.h"
 #include "core/motion/clip.h"
+#include "server/answer_limit.h"
 #include "server/index_registry.h"
+#include "server/skeleton_map.h"
 #include "server/space_builder.h"
 #include "storage/database.h"
 
@@ -79,6 +81,18 @@ class Catalog {
   // every space of its skeleton a snapshot that shows the new name and tags.
   absl::StatusOr<storage::ClipRecord> UpdateClip(int64_t clip_id, const storage::ClipUpdate& update,
                                                  const std::function<bool()>& should_stop = {});
+
+  // Stores `change` to skeleton `skeleton_id`'s humanoid map (storage::Database::
+  // UpdateSlotOverrides, whose errors it returns) and shows the skeleton as updated. Its clips
+  // are projected again into every space over several skeletons that lists it, whose poses
+  // follow the map, in the same transaction, and those spaces' indices follow: a search sees the
+  // old map or the new one. FAILED_PRECONDITION, nothing changed, when the map would then lack
+  // a slot such a space needs; RESOURCE_EXHAUSTED when the answer could exceed `answers`.
+  // `should_stop` is also polled between clips.
+  absl::StatusOr<SkeletonMapView> MapSkeleton(int64_t skeleton_id,
+                                              const storage::SlotOverrideChange& change,
+                                              const AnswerLimit& answers,
+                                              const std::function<bool()>& should_stop);
 
   // `should_stop` is also polled between clips while the space is built.
   absl::StatusOr<std::shared_ptr<const SpaceSnapshot>> CreateSpace(

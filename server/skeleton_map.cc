@@ -20,13 +20,16 @@ int64_t SkeletonAnswerBytes(const Skeleton& skeleton) {
   return bytes;
 }
 
-absl::Status CheckAnswer(const storage::SkeletonRecord& record, const AnswerLimit& answers) {
+}  // namespace
+
+absl::Status CheckSkeletonAnswer(const storage::SkeletonRecord& record,
+                                 const AnswerLimit& answers) {
   return answers.Check(SkeletonAnswerBytes(*record.skeleton),
                        absl::StrCat("skeleton ", record.summary.skeleton_id, "'s joints and map"),
                        "raise --max-answer-mb");
 }
 
-absl::StatusOr<SkeletonMapView> View(storage::SkeletonRecord record) {
+absl::StatusOr<SkeletonMapView> SkeletonView(storage::SkeletonRecord record) {
   SkeletonMapView view;
   MOTIONDB_ASSIGN_OR_RETURN(view.map, MapHumanoid(*record.skeleton, record.slot_overrides));
   for (const SlotOverride& pinned : record.slot_overrides) {
@@ -36,28 +39,11 @@ absl::StatusOr<SkeletonMapView> View(storage::SkeletonRecord record) {
   return view;
 }
 
-}  // namespace
-
 absl::StatusOr<SkeletonMapView> ShowSkeleton(storage::Database& database, int64_t skeleton_id,
                                              const AnswerLimit& answers) {
   MOTIONDB_ASSIGN_OR_RETURN(storage::SkeletonRecord record, database.GetSkeleton(skeleton_id));
-  MOTIONDB_RETURN_IF_ERROR(CheckAnswer(record, answers));
-  return View(std::move(record));
-}
-
-absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t skeleton_id,
-                                            const storage::SlotOverrideChange& change,
-                                            const AnswerLimit& answers,
-                                            const std::function<bool()>& should_stop) {
-  // Checked before the write: a change whose answer could not be sent is not made. A
-  // skeleton's joints never change, so the check holds for the answer after the write.
-  MOTIONDB_ASSIGN_OR_RETURN(const storage::SkeletonRecord before,
-                            database.GetSkeleton(skeleton_id));
-  MOTIONDB_RETURN_IF_ERROR(CheckAnswer(before, answers));
-  MOTIONDB_ASSIGN_OR_RETURN(
-      storage::SkeletonRecord record,
-      database.UpdateSlotOverrides(skeleton_id, change, {.should_stop = should_stop}));
-  return View(std::move(record));
+  MOTIONDB_RETURN_IF_ERROR(CheckSkeletonAnswer(record, answers));
+  return SkeletonView(std::move(record));
 }
 
 absl::StatusOr<HumanoidMap> CanonicalMapOfSkeleton(storage::Database& database,
@@ -66,6 +52,14 @@ absl::StatusOr<HumanoidMap> CanonicalMapOfSkeleton(storage::Database& database,
                             database.GetSkeleton(skeleton_id));
   MOTIONDB_ASSIGN_OR_RETURN(HumanoidMap map, MapHumanoid(*record.skeleton, record.slot_overrides));
   MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(map, absl::StrCat(skeleton_id)));
+  return map;
+}
+
+absl::StatusOr<HumanoidMap> CanonicalMapOfClip(storage::Database& database, const Clip& clip) {
+  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database.FindSkeleton(clip.skeleton()));
+  if (skeleton_id >= 0) return CanonicalMapOfSkeleton(database, skeleton_id);
+  MOTIONDB_ASSIGN_OR_RETURN(HumanoidMap map, MapHumanoid(clip.skeleton()));
+  MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(map, "of the query"));
   return map;
 }
 

@@ -27,18 +27,22 @@ struct SkeletonMapView {
 absl::StatusOr<SkeletonMapView> ShowSkeleton(storage::Database& database, int64_t skeleton_id,
                                              const AnswerLimit& answers);
 
-// Stores `change` (storage::Database::UpdateSlotOverrides, whose errors it returns) and shows
-// the skeleton as updated.
-absl::StatusOr<SkeletonMapView> MapSkeleton(storage::Database& database, int64_t skeleton_id,
-                                            const storage::SlotOverrideChange& change,
-                                            const AnswerLimit& answers,
-                                            const std::function<bool()>& should_stop);
+// RESOURCE_EXHAUSTED when skeleton `record`'s joints' names could take more than `answers`.
+absl::Status CheckSkeletonAnswer(const storage::SkeletonRecord& record, const AnswerLimit& answers);
+
+// `record` as shown: its map with the stored overrides applied first.
+absl::StatusOr<SkeletonMapView> SkeletonView(storage::SkeletonRecord record);
 
 // The map of skeleton `skeleton_id`, its stored overrides applied, for its clips' canonical poses
 // (core/space/canonical_pose.h) in a space over several skeletons; FAILED_PRECONDITION naming the
 // slots it lacks when it cannot join one. NOT_FOUND for an unknown skeleton.
 absl::StatusOr<HumanoidMap> CanonicalMapOfSkeleton(storage::Database& database,
                                                    int64_t skeleton_id);
+
+// The map of `clip`'s skeleton for its canonical poses: a stored skeleton's with its overrides,
+// any other's (an uploaded query's) as MapHumanoid makes it; FAILED_PRECONDITION naming the
+// slots it lacks.
+absl::StatusOr<HumanoidMap> CanonicalMapOfClip(storage::Database& database, const Clip& clip);
 
 // The mirror (core/motion/clip_mirror.h) of a clip of skeleton `skeleton_id` whose own joints
 // are `skeleton` (offsets differ between a skeleton's clips), by the skeleton's map as

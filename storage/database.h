@@ -194,6 +194,18 @@ struct SlotOverrideChange {
   std::vector<HumanoidSlot> clear{};
 };
 
+// The projections of one skeleton's clips into a space over several skeletons, made again with
+// the skeleton's map as an override change leaves it (UpdateSlotOverrides).
+struct SpaceReprojection {
+  int64_t space_id = 0;
+  std::vector<Projection> projections;  // one for every clip of the skeleton
+};
+
+// `stored`'s overrides once `change` is applied, in slot order: what UpdateSlotOverrides would
+// store. INVALID_ARGUMENT as UpdateSlotOverrides says.
+absl::StatusOr<std::vector<SlotOverride>> OverridesAfterChange(const SkeletonRecord& stored,
+                                                               const SlotOverrideChange& change);
+
 struct Counts {
   int64_t skeletons = 0, clips = 0, frames = 0, spaces = 0, projections = 0, labels = 0;
 };
@@ -355,10 +367,15 @@ class Database {
   // Sets and clears a skeleton's slot overrides in one transaction and returns the skeleton as
   // updated. NOT_FOUND for an unknown skeleton; INVALID_ARGUMENT naming `set[i].joint` for a
   // joint the skeleton lacks or that another override (stored, or set here) gives to another
-  // slot, `set[i].slot` for a slot set twice or both set and cleared. Nothing changes on error.
-  absl::StatusOr<SkeletonRecord> UpdateSlotOverrides(int64_t skeleton_id,
-                                                     const SlotOverrideChange& change,
-                                                     const WriteOptions& write = {});
+  // slot, `set[i].slot` for a slot set twice or both set and cleared. In the same transaction,
+  // the skeleton's clips' projections into each space of `reprojections` are replaced by its
+  // (the spaces over several skeletons that list it, whose poses follow its map):
+  // FAILED_PRECONDITION when such a space does not list the skeleton or a clip of the skeleton
+  // lacks its projection, INVALID_ARGUMENT for a projection of another clip or of the wrong
+  // width. Nothing changes on error.
+  absl::StatusOr<SkeletonRecord> UpdateSlotOverrides(
+      int64_t skeleton_id, const SlotOverrideChange& change,
+      const std::vector<SpaceReprojection>& reprojections = {}, const WriteOptions& write = {});
 
   absl::StatusOr<Counts> GetCounts();
 

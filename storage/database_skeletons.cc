@@ -1,13 +1,16 @@
 // Skeletons: their listing, their joints and their humanoid slot overrides.
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <utility>
 
+#include "absl/container/flat_hash_set.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "storage/database.h"
 #include "storage/internal/database_impl.h"
+#include "storage/internal/record_checks.h"
 #include "storage/internal/record_rows.h"
 #include "util/status_macros.h"
 #include "util/status_prefix.h"
@@ -130,7 +133,67 @@ absl::StatusOr<std::map<HumanoidSlot, std::string>> ChangedOverrides(
   return overrides;
 }
 
+// Replaces skeleton `skeleton_id`'s clips' projections into `reprojection`'s space.
+absl::Status ReplaceProjections(SqliteConnection& db, int64_t skeleton_id,
+                                const SpaceReprojection& reprojection) {
+  const std::string space = absl::StrCat("space ", reprojection.space_id);
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement listed,
+      db.Prepare("SELECT s.dims FROM spaces s JOIN space_skeletons k ON k.space_id = s.space_id "
+                 "WHERE s.space_id = ? AND k.skeleton_id = ?"));
+  MOTIONDB_ASSIGN_OR_RETURN(
+      const bool found,
+      listed.BindInt64(1, reprojection.space_id).BindInt64(2, skeleton_id).Step());
+  if (!found) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        space, " is no space over several skeletons that lists skeleton ", skeleton_id));
+  }
+  const int dims = static_cast<int>(listed.ColumnInt64(0));
+  absl::flat_hash_set<int64_t> clips;
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement of_skeleton,
+                            db.Prepare("SELECT clip_id FROM clips WHERE skeleton_id = ?"));
+  of_skeleton.BindInt64(1, skeleton_id);
+  while (true) {
+    MOTIONDB_ASSIGN_OR_RETURN(const bool row, of_skeleton.Step());
+    if (!row) break;
+    clips.insert(of_skeleton.ColumnInt64(0));
+  }
+  MOTIONDB_ASSIGN_OR_RETURN(
+      SqliteStatement erase,
+      db.Prepare("DELETE FROM projections WHERE space_id = ? AND clip_id = ?"));
+  MOTIONDB_ASSIGN_OR_RETURN(SqliteStatement insert, PrepareProjectionInsert(db));
+  for (const Projection& projection : reprojection.projections) {
+    if (clips.erase(projection.clip_id) == 0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "projection into ", space, " of clip ", projection.clip_id,
+          ", which is not one of skeleton ", skeleton_id, "'s clips (or given twice)"));
+    }
+    MOTIONDB_RETURN_IF_ERROR(
+        CheckProjection(projection.coordinates, dims,
+                        absl::StrCat("projection of clip ", projection.clip_id, " into ", space)));
+    erase.Reset();
+    MOTIONDB_RETURN_IF_ERROR(
+        erase.BindInt64(1, reprojection.space_id).BindInt64(2, projection.clip_id).Run());
+    MOTIONDB_RETURN_IF_ERROR(InsertProjection(insert, reprojection.space_id, projection.clip_id,
+                                              projection.coordinates));
+  }
+  if (!clips.empty()) {
+    return absl::FailedPreconditionError(absl::StrCat("no new projection into ", space, " of clip ",
+                                                      *std::min_element(clips.begin(), clips.end()),
+                                                      " of skeleton ", skeleton_id));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
+
+absl::StatusOr<std::vector<SlotOverride>> OverridesAfterChange(const SkeletonRecord& stored,
+                                                               const SlotOverrideChange& change) {
+  MOTIONDB_ASSIGN_OR_RETURN(const auto overrides, ChangedOverrides(stored, change));
+  std::vector<SlotOverride> after;
+  for (const auto& [slot, joint] : overrides) after.push_back({slot, joint});
+  return after;
+}
 
 absl::StatusOr<std::vector<SkeletonSummary>> Database::ListSkeletons() {
   std::vector<SkeletonSummary> skeletons;
@@ -155,9 +218,9 @@ absl::StatusOr<SkeletonRecord> Database::GetSkeleton(int64_t skeleton_id) {
   return *std::move(record);
 }
 
-absl::StatusOr<SkeletonRecord> Database::UpdateSlotOverrides(int64_t skeleton_id,
-                                                             const SlotOverrideChange& change,
-                                                             const WriteOptions& write) {
+absl::StatusOr<SkeletonRecord> Database::UpdateSlotOverrides(
+    int64_t skeleton_id, const SlotOverrideChange& change,
+    const std::vector<SpaceReprojection>& reprojections, const WriteOptions& write) {
   std::optional<SkeletonRecord> record;
   MOTIONDB_RETURN_IF_ERROR(impl_->Write(write, [&](SqliteConnection& db) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(const SkeletonRecord stored, ReadSkeleton(db, skeleton_id));
@@ -176,6 +239,9 @@ absl::StatusOr<SkeletonRecord> Database::UpdateSlotOverrides(int64_t skeleton_id
                                    .BindText(2, std::string(HumanoidSlotName(slot)))
                                    .BindText(3, joint)
                                    .Run());
+    }
+    for (const SpaceReprojection& reprojection : reprojections) {
+      MOTIONDB_RETURN_IF_ERROR(ReplaceProjections(db, skeleton_id, reprojection));
     }
     MOTIONDB_ASSIGN_OR_RETURN(record, ReadSkeleton(db, skeleton_id));
     return absl::OkStatus();

@@ -189,6 +189,23 @@ class ServerTest : public ::testing::Test {
     return space;
   }
 
+  // Creates the space `name` over the skeleton of clip `clip_id` as a space over several
+  // skeletons (canonical bone directions), as one skeleton's.
+  v1::Space CreateBonesSpace(Client& client, int64_t clip_id, const std::string& name = "bones") {
+    v1::GetClipRequest get;
+    get.set_clip_id(clip_id);
+    v1::Clip clip;
+    EXPECT_TRUE(client.clips().GetClip(client.Context().get(), get, &clip).ok());
+    v1::CreateSpaceRequest request;
+    request.set_name(name);
+    request.add_skeleton_ids(clip.skeleton_id());
+    v1::Space space;
+    const grpc::Status status = client.CreateSpace(request, &space);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(space.representation(), "canonical-bones");
+    return space;
+  }
+
   std::filesystem::path dir_;
   std::string db_;
   std::vector<std::unique_ptr<testing::ServerProcess>> servers_;

@@ -2,8 +2,9 @@
 // the same takes re-rigged (testing/rerigged_copy.h: renamed joints, an extra spine joint, no
 // toes, another rotation order and rest pose, 3-channel joints, another scale, Z up) in one
 // space; each take's range finds its re-rigged copy's same frames first and the other way
-// round, a take ingested after the space joins it, an upload of either rig searches it,
-// propagation runs in it, and a skeleton that lacks slots is refused naming them.
+// round, a take ingested after the space joins it, an upload of either rig searches it (also
+// with its mirror), propagation runs in it, and a skeleton that lacks slots is refused naming
+// them.
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,10 +13,13 @@
 #include <gtest/gtest.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_reader.h"
+#include "google/protobuf/text_format.h"
 #include "testing/corpus_paths.h"
 #include "testing/rerigged_copy.h"
 #include "testing/server_process.h"
+#include "testing/synthetic_corpus.h"
 #include "tests/server_fixture.h"
 
 namespace motiondb {
@@ -140,11 +144,113 @@ TEST_F(ServerTest, TakesAndTheirReriggedCopiesFindEachOtherInASpaceOverBothSkele
   }
   EXPECT_TRUE(reached_copy);
 
-  // A mirrored search is refused there, saying why.
+  // A mirrored search runs there too: the upload still finds its take and copy first, unmarked
+  // (a bow is nearly its own mirror, so its mirror's hits follow them), each result marked by
+  // the half that found it.
   upload.set_mirror(true);
+  upload.set_max_results(6);
   status = client.Search(upload, &found);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(found.results_size(), 2);
+  EXPECT_FALSE(found.results(0).mirrored());
+  EXPECT_THAT((std::vector<int64_t>{found.results(0).clip_id(), found.results(1).clip_id()}),
+              ::testing::UnorderedElementsAre(originals[2], copies[2]));
+}
+
+// A rig whose sides are mislabelled: `bvh` with Left and Right swapped in every joint's name.
+std::string SidesSwapped(const std::string& bvh) {
+  return absl::StrReplaceAll(
+      absl::StrReplaceAll(absl::StrReplaceAll(bvh, {{"Left", "\x01"}}), {{"Right", "Left"}}),
+      {{"\x01", "Right"}});
+}
+
+// A skeleton's map changed under a space over several skeletons re-projects its clips there:
+// the humanoid library's map given its sides swapped makes its clips what a rig with the
+// sides' names swapped captures, so that such a rig's upload of a library range finds that
+// range exactly. A change that would leave a slot the bones need empty is refused and changes
+// nothing.
+TEST_F(ServerTest, AMapChangeProjectsTheSkeletonsClipsAgainInSpacesOverSeveralSkeletons) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  const v1::Space space = CreateBonesSpace(client, ids[0]);
+  ASSERT_EQ(space.skeleton_ids_size(), 1);
+  const int64_t skeleton_id = space.skeleton_ids(0);
+
+  const testing::SyntheticSegment* raise = nullptr;
+  for (const testing::SyntheticSegment& segment : Humanoid().segments) {
+    if (segment.action == testing::SyntheticAction::kLeftArmRaise) raise = &segment;
+  }
+  ASSERT_NE(raise, nullptr);
+  const absl::StatusOr<Clip> range =
+      Humanoid().clips[raise->clip].Slice({raise->first_frame, raise->last_frame});
+  ASSERT_TRUE(range.ok());
+  v1::SearchRequest request;
+  request.set_space("bones");
+  request.mutable_bvh()->set_bvh(SidesSwapped(BvhText(*range)));
+  request.set_max_results(1);
+  v1::SearchResponse before;
+  grpc::Status status = client.Search(request, &before);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(before.results_size(), 1);
+  // The range as the library's own rig captured it: what "found exactly" scores (the range's
+  // ends smooth its velocities otherwise than the whole clip's do).
+  v1::SearchRequest own = request;
+  own.mutable_bvh()->set_bvh(BvhText(*range));
+  v1::SearchResponse exact;
+  status = client.Search(own, &exact);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(exact.results_size(), 1);
+  ASSERT_EQ(exact.results(0).clip_id(), ids[raise->clip]);
+
+  const auto map = [&](const std::string& text, v1::SkeletonDetail* detail) {
+    v1::MapSkeletonRequest change;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &change));
+    change.set_skeleton_id(skeleton_id);
+    return client.clips().MapSkeleton(client.Context().get(), change, detail);
+  };
+  std::string swap;
+  for (const auto& [slot, joint] :
+       std::vector<std::pair<std::string, std::string>>{{"UpperArm", "Shoulder"},
+                                                        {"LowerArm", "Elbow"},
+                                                        {"Hand", "Wrist"},
+                                                        {"UpperLeg", "Hip"},
+                                                        {"LowerLeg", "Knee"},
+                                                        {"Foot", "Ankle"}}) {
+    absl::StrAppend(&swap, "set { slot: 'Left", slot, "' joint: 'Right", joint, "' } ",
+                    "set { slot: 'Right", slot, "' joint: 'Left", joint, "' } ");
+  }
+  v1::SkeletonDetail swapped;
+  status = map(swap, &swapped);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  v1::SearchResponse after;
+  status = client.Search(request, &after);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(after.results_size(), 1);
+  EXPECT_EQ(after.results(0).clip_id(), ids[raise->clip]);
+  EXPECT_NEAR(after.results(0).start_frame(), raise->first_frame, 2);
+  EXPECT_NEAR(after.results(0).end_frame(), raise->last_frame, 2);
+  // Not equal: the space's basis was fitted to the library's sides, not to their swap.
+  EXPECT_NEAR(after.results(0).score(), exact.results(0).score(), 0.1 * exact.results(0).score());
+  EXPECT_GT(before.results(0).score(), 2 * after.results(0).score())
+      << before.results(0).score() << " then " << after.results(0).score();
+
+  // The neck given the head's joint leaves the head without one: refused, nothing changed.
+  v1::SkeletonDetail refused;
+  status = map("set { slot: 'Neck' joint: 'Head' }", &refused);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
-  EXPECT_THAT(status.error_message(), HasSubstr("several skeletons"));
+  EXPECT_THAT(status.error_message(), HasSubstr("space bones lists skeleton"));
+  EXPECT_THAT(status.error_message(), HasSubstr("Head"));
+  v1::GetSkeletonRequest show;
+  show.set_skeleton_id(skeleton_id);
+  v1::SkeletonDetail shown;
+  ASSERT_TRUE(client.clips().GetSkeleton(client.Context().get(), show, &shown).ok());
+  EXPECT_EQ(shown.SerializeAsString(), swapped.SerializeAsString());
+  v1::SearchResponse again;
+  ASSERT_TRUE(client.Search(request, &again).ok());
+  ASSERT_EQ(again.results_size(), 1);
+  EXPECT_EQ(again.results(0).SerializeAsString(), after.results(0).SerializeAsString());
 }
 
 TEST_F(ServerTest, ASkeletonWithoutArmsCannotJoinASpaceOverSeveral) {

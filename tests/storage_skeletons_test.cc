@@ -78,8 +78,9 @@ TEST_F(StorageTest, BadSlotOverridesChangeNothing) {
   refused({.set = {{Slot::kNeck, "Neck"}}}, absl::StatusCode::kInvalidArgument,
           "set[0].joint: 'Neck' is already the override of slot Head; clear that slot or set it "
           "to another joint");
-  const absl::StatusOr<SkeletonRecord> stopped = Db().UpdateSlotOverrides(
-      skeleton_id, {.set = {{Slot::kLeftHand, "Hand_L"}}}, {.should_stop = [] { return true; }});
+  const absl::StatusOr<SkeletonRecord> stopped =
+      Db().UpdateSlotOverrides(skeleton_id, {.set = {{Slot::kLeftHand, "Hand_L"}}}, {},
+                               {.should_stop = [] { return true; }});
   EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
   EXPECT_EQ(AsPairs(Db().GetSkeleton(skeleton_id)->slot_overrides), before);
   EXPECT_EQ(Db().UpdateSlotOverrides(skeleton_id + 1, {.clear = {Slot::kHead}}).status().code(),

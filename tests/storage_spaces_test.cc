@@ -312,5 +312,64 @@ TEST_F(StorageSpaceTest, ReopenKeepsEverything) {
   EXPECT_EQ(*Raw()->QueryInt64("PRAGMA user_version"), LatestSchemaVersion());
 }
 
+// A map change re-projects a skeleton's clips into its spaces over several skeletons in the
+// overrides' transaction: all of its clips or none, into spaces that list it, of the space's
+// width; on any error neither the overrides nor a projection change.
+TEST_F(StorageSpaceTest, OverridesAndTheirReprojectionsAreOneTransaction) {
+  const int64_t walk = Insert(Named("walk"), walk_);
+  const int64_t wave = Insert(Named("wave"), wave_);
+  const int64_t skeleton = Db().GetClipRecord(walk)->skeleton_id;
+  SpaceOptions options;
+  options.representation = SpaceRepresentation::kCanonicalBones;
+  const absl::StatusOr<MotionSpace> bones =
+      MotionSpace::Build({{"walk.bvh", walk_, std::nullopt}}, options);
+  ASSERT_TRUE(bones.ok()) << bones.status();
+  const auto projection = [&](int64_t clip_id, const Clip& clip, double shift) {
+    Projection p{clip_id, bones->ProjectClip(clip, 8)->cast<float>()};
+    p.coordinates.array() += static_cast<float>(shift);
+    return p;
+  };
+  SpaceRecord record = SpaceNamed("bones", skeleton);
+  record.skeleton_ids = {skeleton};
+  const absl::StatusOr<int64_t> space =
+      Db().InsertSpace(record, *bones, {projection(walk, walk_, 0), projection(wave, wave_, 0)});
+  ASSERT_TRUE(space.ok()) << space.status();
+  const int64_t joints = *Db().InsertSpace(SpaceNamed("body", skeleton), space_,
+                                           {ProjectionOf(walk, walk_), ProjectionOf(wave, wave_)});
+  const SlotOverrideChange change{.set = {{HumanoidSlot::kHead, "Neck"}}};
+  const auto stored = [&] { return Db().LoadProjections(*space)->front().coordinates; };
+  const RowMatrixXf before = stored();
+
+  for (const auto& [reprojection, code, message] :
+       std::vector<std::tuple<SpaceReprojection, absl::StatusCode, std::string>>{
+           {{*space, {projection(walk, walk_, 1)}},
+            absl::StatusCode::kFailedPrecondition,
+            absl::StrCat("no new projection into space ", *space, " of clip ", wave)},
+           {{*space,
+             {projection(walk, walk_, 1), projection(wave, wave_, 1), projection(walk, walk_, 1)}},
+            absl::StatusCode::kInvalidArgument,
+            "which is not one of skeleton"},
+           {{*space, {projection(walk, walk_, 1), {wave, RowMatrixXf::Zero(3, 40)}}},
+            absl::StatusCode::kInvalidArgument,
+            "projection of clip"},
+           {{joints, {projection(walk, walk_, 1), projection(wave, wave_, 1)}},
+            absl::StatusCode::kFailedPrecondition,
+            "is no space over several skeletons that lists skeleton"}}) {
+    const absl::StatusOr<SkeletonRecord> refused =
+        Db().UpdateSlotOverrides(skeleton, change, {reprojection});
+    EXPECT_EQ(refused.status().code(), code) << message;
+    EXPECT_THAT(std::string(refused.status().message()), ::testing::HasSubstr(message));
+    EXPECT_TRUE(Db().GetSkeleton(skeleton)->slot_overrides.empty()) << message;
+    EXPECT_EQ(stored(), before) << message;
+  }
+
+  const absl::StatusOr<SkeletonRecord> changed = Db().UpdateSlotOverrides(
+      skeleton, change, {{*space, {projection(walk, walk_, 1), projection(wave, wave_, 1)}}});
+  ASSERT_TRUE(changed.ok()) << changed.status();
+  EXPECT_EQ(changed->slot_overrides.size(), 1u);
+  EXPECT_EQ(stored(), (before.array() + 1.0f).matrix());
+  EXPECT_EQ(Db().LoadProjections(*space)->size(), 2u);
+}
+
 }  // namespace
 }  // namespace motiondb::storage

@@ -127,7 +127,7 @@ grpc::Status ClipServiceImpl::MapSkeleton(grpc::ServerContext* context,
     MOTIONDB_ASSIGN_OR_RETURN(const storage::SlotOverrideChange change, FromProto(*request));
     MOTIONDB_ASSIGN_OR_RETURN(
         const SkeletonMapView view,
-        server::MapSkeleton(database_, request->skeleton_id(), change, answers_, should_stop));
+        catalog_.MapSkeleton(request->skeleton_id(), change, answers_, should_stop));
     ToProto(view, response);
     return absl::OkStatus();
   });
