@@ -14,9 +14,12 @@
 //    space's index, searched with the query and with its mirror (mirrored and projected as the
 //    server does): the same precisions, and its search time for both.
 // `--takes first-half|second-half` loads half of each content's takes (testing::Takes): the
-// second half is held out from the defaults chosen since issue 39.
+// second half is held out from the defaults chosen since issue 39. `--space canonical-bones`
+// builds the space as one over several skeletons (here over the folder's one), whose queries
+// mirror their bone directions (MirrorCanonicalPoses) instead of their joints.
 //
 // usage: mirrored_search [--folder DIR] [--rounds N] [--takes all|first-half|second-half]
+//                        [--space joint-rotations|canonical-bones]
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,12 +35,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "bench/window_vector_baseline.h"
-#include "core/motion/clip_mirror.h"
-#include "core/space/search_coordinates.h"
+#include "core/space/canonical_pose.h"
 #include "server/catalog.h"
 #include "server/index_registry.h"
+#include "server/query_mirror.h"
 #include "server/search_runner.h"
-#include "server/skeleton_map.h"
 #include "storage/database.h"
 #include "testing/corpus_paths.h"
 #include "testing/labelled_index.h"
@@ -73,7 +75,8 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-absl::Status Run(const std::filesystem::path& folder, int rounds, testing::Takes takes) {
+absl::Status Run(const std::filesystem::path& folder, int rounds, testing::Takes takes,
+                 SpaceRepresentation representation) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / absl::StrCat("mirrored_search_", ::getpid());
   std::filesystem::create_directories(dir);
@@ -97,14 +100,20 @@ absl::Status Run(const std::filesystem::path& folder, int rounds, testing::Takes
   }
   server::SpaceRequest space;
   space.name = "bandai";
+  if (representation == SpaceRepresentation::kCanonicalBones) {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord first,
+                              database->GetClipRecord(content.begin()->first));
+    space.skeleton_ids = {first.skeleton_id};
+  }
   MOTIONDB_RETURN_IF_ERROR(catalog.CreateSpace(space, {}).status());
   const server::SearchRunner runner(registry, *database, {});
   const std::shared_ptr<const server::SpaceSnapshot> snapshot = registry.Find("bandai");
   const LibraryIndex& library = *snapshot->index;
   MOTIONDB_ASSIGN_OR_RETURN(const std::unique_ptr<bench::WindowVectorBaseline> baseline,
                             bench::WindowVectorBaseline::Build(library, {}));
-  absl::PrintF("%d clips of %s in one space; window baseline %.1f MiB\n", files.size(),
-               folder.string(), baseline->memory_bytes() / 1048576.0);
+  absl::PrintF("%d clips of %s in one space (%s); window baseline %.1f MiB\n", files.size(),
+               folder.string(), SpaceRepresentationName(representation),
+               baseline->memory_bytes() / 1048576.0);
 
   const std::map<std::string, std::string> other = {{"wave-left-hand", "wave-right-hand"},
                                                     {"wave-right-hand", "wave-left-hand"}};
@@ -125,14 +134,9 @@ absl::Status Run(const std::filesystem::path& folder, int rounds, testing::Takes
       const int own = library.FindClip(clip_id);
       std::vector<bool> allowed(library.clip_count(), true);
       allowed[own] = false;
-      const Clip& clip = *clips.at(clip_id);
       MOTIONDB_ASSIGN_OR_RETURN(
-          const SkeletonMirror mirror_map,
-          server::MirrorOfSkeleton(*database, snapshot->record.skeleton_id, clip.skeleton(),
-                                   snapshot->space->data().references));
-      MOTIONDB_ASSIGN_OR_RETURN(const Clip mirrored_clip, MirrorClip(clip, mirror_map));
-      MOTIONDB_ASSIGN_OR_RETURN(const RowMatrixXf mirrored_rows,
-                                SearchCoordinates(*snapshot->space, mirrored_clip));
+          const RowMatrixXf mirrored_rows,
+          server::MirroredCoordinates(*database, *snapshot, *clips.at(clip_id)));
       const auto window_start = std::chrono::steady_clock::now();
       const std::vector<SearchResult> window_plain =
           baseline->Search(library.clip_coordinates(own), 20, allowed);
@@ -191,6 +195,7 @@ int main(int argc, char** argv) {
   std::filesystem::path folder;
   int rounds = 3;
   motiondb::testing::Takes takes = motiondb::testing::Takes::kAll;
+  motiondb::SpaceRepresentation representation = motiondb::SpaceRepresentation::kJointRotations;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     if (flag == "--folder") {
@@ -203,10 +208,13 @@ int main(int argc, char** argv) {
       takes = motiondb::testing::Takes::kFirstHalf;
     } else if (flag == "--takes" && std::string(argv[i + 1]) == "second-half") {
       takes = motiondb::testing::Takes::kSecondHalf;
+    } else if (flag == "--space" && motiondb::ParseSpaceRepresentation(argv[i + 1]).ok()) {
+      representation = *motiondb::ParseSpaceRepresentation(argv[i + 1]);
     } else {
       std::fprintf(stderr,
                    "usage: mirrored_search [--folder DIR] [--rounds N] "
-                   "[--takes all|first-half|second-half]\n");
+                   "[--takes all|first-half|second-half] "
+                   "[--space joint-rotations|canonical-bones]\n");
       return 2;
     }
   }
@@ -218,7 +226,7 @@ int main(int argc, char** argv) {
     }
     folder = *mocap / "bandai2-normal";
   }
-  const absl::Status status = motiondb::Run(folder, rounds, takes);
+  const absl::Status status = motiondb::Run(folder, rounds, takes, representation);
   if (!status.ok()) {
     std::fprintf(stderr, "%s\n", std::string(status.message()).c_str());
     return 1;

@@ -12,6 +12,7 @@
 #include "core/search/motion_search.h"
 #include "core/search/warp/time_warp.h"
 #include "core/space/search_coordinates.h"
+#include "server/query_mirror.h"
 #include "server/skeleton_map.h"
 #include "server/space_lookup.h"
 #include "util/parallel_for.h"
@@ -107,39 +108,36 @@ absl::StatusOr<Query> StoredQuery(const ClipSelection& range, const SpaceSnapsho
   return query;
 }
 
-// `clip` projected whole, as a stored clip is, as the query of the frames `range` (numbered from
-// `frame_offset`, the query clip's frame that is `clip`'s first).
-absl::StatusOr<Query> ProjectedQuery(const Clip& clip, FrameRange range, int frame_offset,
-                                     const SpaceSnapshot& snapshot,
-                                     const HumanoidMap* map = nullptr) {
+// `coordinates`, `clip`'s search coordinates whole, as the query of the frames `range` (numbered
+// from `frame_offset`, the query clip's frame that is `clip`'s first).
+Query CoordinatesQuery(RowMatrixXf coordinates, const Clip& clip, FrameRange range,
+                       int frame_offset, const SpaceSnapshot& snapshot) {
   Query query;
-  MOTIONDB_ASSIGN_OR_RETURN(query.uploaded, SearchCoordinates(*snapshot.space, clip, -1, map));
   query.frames = FrameConversion(clip.fps(), clip.frame_count(), snapshot.space->sample_rate(),
-                                 query.uploaded->rows());
+                                 coordinates.rows());
+  query.uploaded = std::move(coordinates);
   query.range = range;
   query.frame_offset = frame_offset;
   SetRows(&query);
   return query;
 }
 
-// `clip`, an uploaded file's, as the query of its frames `upload` asks for.
-// The humanoid map of an uploaded query's skeleton in a space over several skeletons: a stored
-// skeleton's with its overrides, any other's as MapHumanoid makes it; FAILED_PRECONDITION naming
-// the slots it lacks.
-absl::StatusOr<HumanoidMap> UploadMap(const Clip& clip, storage::Database& database) {
-  MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id, database.FindSkeleton(clip.skeleton()));
-  if (skeleton_id >= 0) return CanonicalMapOfSkeleton(database, skeleton_id);
-  MOTIONDB_ASSIGN_OR_RETURN(HumanoidMap map, MapHumanoid(clip.skeleton()));
-  MOTIONDB_RETURN_IF_ERROR(CheckCanonicalMap(map, "of the query"));
-  return map;
+// `clip` projected whole, as a stored clip is, as the query of the frames `range` (as above).
+absl::StatusOr<Query> ProjectedQuery(const Clip& clip, FrameRange range, int frame_offset,
+                                     const SpaceSnapshot& snapshot,
+                                     const HumanoidMap* map = nullptr) {
+  MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates,
+                            SearchCoordinates(*snapshot.space, clip, -1, map));
+  return CoordinatesQuery(std::move(coordinates), clip, range, frame_offset, snapshot);
 }
 
+// `clip`, an uploaded file's, as the query of its frames `upload` asks for.
 absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& clip,
                                     const SpaceSnapshot& snapshot, storage::Database& database,
                                     int max_rows) {
   std::optional<HumanoidMap> map;
   if (snapshot.space->canonical()) {
-    MOTIONDB_ASSIGN_OR_RETURN(map, UploadMap(clip, database));
+    MOTIONDB_ASSIGN_OR_RETURN(map, CanonicalMapOfClip(database, clip));
   } else if (!clip.skeleton().SameTopology(snapshot.space->skeleton())) {
     return absl::FailedPreconditionError(absl::StrCat(
         "bvh: the query's skeleton (", clip.skeleton().joint_count(), " joints, root '",
@@ -167,11 +165,6 @@ absl::StatusOr<Query> QueryOfUpload(const UploadedQuery& upload, const Clip& cli
 absl::StatusOr<Query> MirroredQuery(const Query& query, const std::optional<Clip>& uploaded,
                                     const SearchRequest& request, const SpaceSnapshot& snapshot,
                                     storage::Database& database) {
-  if (snapshot.space->canonical()) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "mirror: space '", snapshot.record.name,
-        "' is over several skeletons; a mirrored search runs in a space over one skeleton"));
-  }
   std::optional<Clip> stored;
   if (!uploaded) {
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -180,11 +173,9 @@ absl::StatusOr<Query> MirroredQuery(const Query& query, const std::optional<Clip
     stored = std::move(range.clip);
   }
   const Clip& clip = uploaded ? *uploaded : *stored;
-  MOTIONDB_ASSIGN_OR_RETURN(const SkeletonMirror mirror,
-                            MirrorOfSkeleton(database, snapshot.record.skeleton_id, clip.skeleton(),
-                                             snapshot.space->data().references));
-  MOTIONDB_ASSIGN_OR_RETURN(const Clip mirrored, MirrorClip(clip, mirror));
-  return ProjectedQuery(mirrored, query.range, uploaded ? 0 : query.range.first, snapshot);
+  MOTIONDB_ASSIGN_OR_RETURN(RowMatrixXf coordinates, MirroredCoordinates(database, snapshot, clip));
+  return CoordinatesQuery(std::move(coordinates), clip, query.range,
+                          uploaded ? 0 : query.range.first, snapshot);
 }
 
 // A query frame (at its clip's rate, in its numbering) as a row of the query at the space rate.

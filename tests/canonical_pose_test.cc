@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/bvh/bvh_reader.h"
+#include "core/motion/clip_mirror.h"
 #include "core/motion/forward_kinematics.h"
 #include "core/space/motion_space.h"
 #include "core/space/space_serialization.h"
@@ -81,6 +82,69 @@ TEST(CanonicalPoseTest, TakeAndReriggedCopyGiveTheSamePoses) {
   EXPECT_LT((a.rightCols(3) - b.rightCols(3)).cwiseAbs().maxCoeff(), 1e-2);
   // A walk: forwards (the last column, leg lengths/s) by more than half a leg length a second.
   EXPECT_GT(a.col(a.cols() - 1).mean(), 0.5);
+}
+
+// `clip` with its whole world turned by `turn`: its root's rotation and translation turned.
+Clip Turned(const Clip& clip, const Eigen::Matrix3d& turn) {
+  EXPECT_EQ(clip.skeleton().position_slot(0), 0) << "the root must hold the first translation";
+  RowMatrixXd rotations = clip.rotations();
+  RowMatrixXd positions = clip.positions();
+  const Quat q_turn(turn);
+  for (int f = 0; f < clip.frame_count(); ++f) {
+    const Quat root = q_turn * clip.rotation(f, 0);
+    rotations.block<1, 4>(f, 0) << root.w(), root.x(), root.y(), root.z();
+    positions.block<1, 3>(f, 0) = (turn * positions.block<1, 3>(f, 0).transpose()).transpose();
+  }
+  absl::StatusOr<Clip> turned =
+      Clip::Create(clip.shared_skeleton(), clip.frame_time(), rotations, positions);
+  EXPECT_TRUE(turned.ok()) << turned.status();
+  return *std::move(turned);
+}
+
+// A real walk with turns (CMU 01_01: a T-pose rest, so its rest pose is the mirror's
+// reference): mirroring its canonical poses gives the canonical poses of the clip mirrored
+// joint by joint (clip_mirror.h), bones, yaw rate and velocity, and mirroring twice gives them
+// back.
+TEST(CanonicalPoseTest, MirroredPosesAreThePosesOfTheMirroredClip) {
+  const std::optional<std::filesystem::path> dir = testing::MocapDir();
+  if (!dir) GTEST_SKIP() << "../shared/mocap is absent; skipped";
+  const absl::StatusOr<BvhReadResult> read =
+      ReadBvhFile((*dir / "cmu" / "01_01_motionbuilder.bvh").string());
+  ASSERT_TRUE(read.ok()) << read.status();
+  const Clip& clip = read->clip;
+  const absl::StatusOr<HumanoidMap> map = MapHumanoid(clip.skeleton());
+  ASSERT_TRUE(map.ok());
+  const absl::StatusOr<SkeletonMirror> mirror = MakeSkeletonMirror(clip.skeleton(), *map);
+  ASSERT_TRUE(mirror.ok()) << mirror.status();
+  absl::StatusOr<Clip> mirrored = MirrorClip(clip, *mirror);
+  ASSERT_TRUE(mirrored.ok()) << mirrored.status();
+  // The reference pose's lateral axis leans about a degree off the horizontal (CMU's rest pose
+  // is not quite upright), so its mirror leans the world by twice that; canonical poses mirror
+  // through a vertical plane. The two reflections' product, a turn, stands the mirror up.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d lateral = mirror->lateral;
+  const Eigen::Vector3d level = (lateral - lateral.dot(up) * up).normalized();
+  const Eigen::Matrix3d reflect = Eigen::Matrix3d::Identity() - 2 * lateral * lateral.transpose();
+  const Eigen::Matrix3d reflect_level = Eigen::Matrix3d::Identity() - 2 * level * level.transpose();
+  mirrored = Turned(*mirrored, reflect_level * reflect);
+  const absl::StatusOr<HumanoidMap> mirrored_map = MapHumanoid(mirrored->skeleton());
+  ASSERT_TRUE(mirrored_map.ok());
+
+  const PoseOptions options;
+  const RowMatrixXd poses = CanonicalPoses(clip, *map, options);
+  const RowMatrixXd want = CanonicalPoses(*mirrored, *mirrored_map, options);
+  RowMatrixXd got = poses;
+  ASSERT_TRUE(MirrorCanonicalPoses(options, &got).ok());
+  ASSERT_EQ(got.rows(), want.rows());
+  EXPECT_LT((got - want).cwiseAbs().maxCoeff(), 1e-9);
+  // The mirror is not the clip: the walk turns, its arms swing out of step.
+  EXPECT_GT((got - poses).cwiseAbs().maxCoeff(), 0.5);
+  EXPECT_GT(poses.col(3 * kCanonicalBoneCount).cwiseAbs().maxCoeff(), 0.1);  // it turns
+  ASSERT_TRUE(MirrorCanonicalPoses(options, &got).ok());
+  EXPECT_LT((got - poses).cwiseAbs().maxCoeff(), 1e-12);
+
+  RowMatrixXd narrow = poses.leftCols(10);
+  EXPECT_EQ(MirrorCanonicalPoses(options, &narrow).code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(CanonicalPoseTest, SpaceOverTwoRigsProjectsBothAlikeAndRoundTrips) {

@@ -39,13 +39,11 @@ std::optional<SyntheticAction> ActionAt(int clip, int first, int last) {
   return std::nullopt;
 }
 
-TEST_F(ServerTest, AMirroredQueryFindsItsSourceMarkedMirroredAndLeavesItsOwnRangeOut) {
-  ServerProcess* server = StartServer();
-  ASSERT_NE(server, nullptr);
-  Client client(testing::InsecureChannel(server->address()));
-  const std::vector<int64_t> ids = IngestHumanoid(client);
-  CreateHumanoidSpace(client);
-
+// In `space`, over the humanoid library `ids`: a right-arm raise (a left one mirrored) finds
+// right-arm raises; with `mirror` its source first, marked, and left-arm raises among the rest;
+// a stored query's own range left out of both halves.
+void ExpectMirroredSearchWorks(Client& client, const std::vector<int64_t>& ids,
+                               const std::string& space) {
   // A left-arm raise, mirrored here into a right-arm raise and sent as the query.
   const SyntheticSegment& left = FirstOf(SyntheticAction::kLeftArmRaise);
   const absl::StatusOr<Clip> source =
@@ -59,7 +57,7 @@ TEST_F(ServerTest, AMirroredQueryFindsItsSourceMarkedMirroredAndLeavesItsOwnRang
   ASSERT_TRUE(mirrored.ok());
 
   v1::SearchRequest request;
-  request.set_space("body");
+  request.set_space(space);
   request.mutable_bvh()->set_bvh(BvhText(*mirrored));
   request.set_max_results(8);
   v1::SearchResponse plain;
@@ -111,7 +109,7 @@ TEST_F(ServerTest, AMirroredQueryFindsItsSourceMarkedMirroredAndLeavesItsOwnRang
   // A stored query's own range is left out of both halves. Both arms raised: the query's mirror
   // moves as the query does, and would find its own range.
   const SyntheticSegment& both_arms = FirstOf(SyntheticAction::kBothArmsRaise);
-  request = ClipQuery("body", ids[both_arms.clip], both_arms.first_frame, both_arms.last_frame);
+  request = ClipQuery(space, ids[both_arms.clip], both_arms.first_frame, both_arms.last_frame);
   request.set_mirror(true);
   request.set_max_results(6);
   request.set_characteristic_frame((both_arms.peak_first_frame + both_arms.peak_last_frame) / 2);
@@ -136,6 +134,26 @@ TEST_F(ServerTest, AMirroredQueryFindsItsSourceMarkedMirroredAndLeavesItsOwnRang
   ASSERT_TRUE(status.ok()) << status.error_message();
   ASSERT_GE(excluded.results_size(), 1);
   for (const v1::SearchResult& result : excluded.results()) EXPECT_FALSE(own(result));
+}
+
+TEST_F(ServerTest, AMirroredQueryFindsItsSourceMarkedMirroredAndLeavesItsOwnRangeOut) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateHumanoidSpace(client);
+  ExpectMirroredSearchWorks(client, ids, "body");
+}
+
+// The same in a space of canonical bone directions (a space over several skeletons, here over
+// the humanoid's one): the query's poses are mirrored, not its joints.
+TEST_F(ServerTest, AMirroredQueryWorksInASpaceOverSeveralSkeletons) {
+  ServerProcess* server = StartServer();
+  ASSERT_NE(server, nullptr);
+  Client client(testing::InsecureChannel(server->address()));
+  const std::vector<int64_t> ids = IngestHumanoid(client);
+  CreateBonesSpace(client, ids[0]);
+  ExpectMirroredSearchWorks(client, ids, "bones");
 }
 
 TEST_F(ServerTest, ASkeletonItsMapCannotMirrorIsRefused) {

@@ -46,6 +46,11 @@ constexpr std::array<BoneEnds, kCanonicalBoneCount> kBones = {{
      Slot::kLeftUpperArm},
 }};
 
+// Each bone's mirror partner in kBones, and whether the partner runs the other way (the
+// shoulder line, from right to left, mirrors into itself from left to right).
+constexpr std::array<int, kCanonicalBoneCount> kMirrorBone = {2, 3, 0, 1, 6, 7, 4, 5, 8, 9, 10};
+constexpr int kReversedByMirror = 10;
+
 // The slots the bones read, in enum order.
 constexpr std::array<Slot, 13> kUsedSlots = {
     Slot::kHead,          Slot::kLeftUpperArm,  Slot::kLeftLowerArm,  Slot::kLeftHand,
@@ -202,6 +207,26 @@ RowMatrixXd CanonicalPoses(const Clip& clip, const HumanoidMap& map, const PoseO
     }
   }
   return poses;
+}
+
+absl::Status MirrorCanonicalPoses(const PoseOptions& options, RowMatrixXd* poses) {
+  if (poses->cols() != CanonicalPoseDims(options)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "canonical poses have ", poses->cols(), " numbers; expected ", CanonicalPoseDims(options)));
+  }
+  const RowMatrixXd source = *poses;
+  for (int b = 0; b < kCanonicalBoneCount; ++b) {
+    // (left, up, forward) of the partner, the mirror's left negated.
+    const auto partner = source.middleCols<3>(3 * kMirrorBone[b]);
+    auto bone = poses->middleCols<3>(3 * b);
+    bone.col(0) = -partner.col(0);
+    bone.rightCols<2>() = partner.rightCols<2>();
+    if (b == kReversedByMirror) bone = -bone;
+  }
+  const int yaw_rate = 3 * kCanonicalBoneCount;
+  poses->col(yaw_rate) = -source.col(yaw_rate);
+  if (options.root_velocity) poses->col(yaw_rate + 1) = -source.col(yaw_rate + 1);  // leftward
+  return absl::OkStatus();
 }
 
 }  // namespace motiondb

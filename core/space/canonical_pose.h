@@ -65,6 +65,15 @@ int CanonicalPoseDims(const PoseOptions& options);
 // `map` must pass CheckCanonicalMap.
 RowMatrixXd CanonicalPoses(const Clip& clip, const HumanoidMap& map, const PoseOptions& options);
 
+// `poses` (CanonicalPoses' with `options`) turned into the poses of the clip's left/right mirror
+// image, as CanonicalPoses would give for the clip mirrored through any vertical plane
+// (clip_mirror.h): each bone takes its partner's direction (the shoulder line its own, reversed)
+// with its leftward part negated, and the yaw rate and leftward velocity change sign. The
+// heading frame is the mirror's own (the hips' line stays its left), which is why no plane
+// needs choosing. Mirroring twice gives the poses back. INVALID_ARGUMENT for poses of another
+// width.
+absl::Status MirrorCanonicalPoses(const PoseOptions& options, RowMatrixXd* poses);
+
 }  // namespace motiondb
 
 #endif  // MOTIONDB_CORE_SPACE_CANONICAL_POSE_H_

@@ -17,6 +17,12 @@ namespace motiondb {
 absl::StatusOr<RowMatrixXf> SearchCoordinates(const MotionSpace& space, const Clip& clip,
                                               int dims = -1, const HumanoidMap* map = nullptr);
 
+// The same for pose vectors (n x space.dims(), MotionSpace::EncodeClip's), e.g. a query's
+// poses mirrored.
+absl::StatusOr<RowMatrixXf> SearchCoordinatesOfPoses(const MotionSpace& space,
+                                                     const Eigen::Ref<const RowMatrixXd>& poses,
+                                                     int dims = -1);
+
 }  // namespace motiondb
 
 #endif  // MOTIONDB_CORE_SPACE_SEARCH_COORDINATES_H_
