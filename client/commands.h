@@ -91,6 +91,7 @@ void AddLabelCommands(Commands& commands);                 // label_commands.cc:
 void AddJobCommands(Commands& commands);                   // job_commands.cc: propagate, jobs, job
 void AddInfo(Commands& commands);                          // info_command.cc
 void AddBackup(Commands& commands);                        // backup_command.cc
+void AddClusterCommands(Commands& commands);               // cluster_commands.cc: cluster
 // op_commands.cc: `op` and its reconstruct, interpolate, blend; the rest of `op` in
 // op_edit_commands.cc (fill-gap, scale, translate, smooth) and op_detect_command.cc (detect).
 void AddOpCommands(Commands& commands);

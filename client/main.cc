@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   motiondb::cli::AddJobCommands(commands);
   motiondb::cli::AddInfo(commands);
   motiondb::cli::AddBackup(commands);
+  motiondb::cli::AddClusterCommands(commands);
   motiondb::cli::AddOpCommands(commands);
   commands.AddHelp();
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {

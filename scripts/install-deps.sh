@@ -45,3 +45,8 @@ DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-
 if [[ " ${missing[*]} " == *" prometheus "* && -d /run/systemd/system ]]; then
   "${sudo[@]}" systemctl disable --now prometheus.service
 fi
+# Likewise etcd-server's etcd (on 127.0.0.1:2379): the cluster tests and scripts/cluster.sh start
+# their own on free ports.
+if [[ " ${missing[*]} " == *" etcd-server "* && -d /run/systemd/system ]]; then
+  "${sudo[@]}" systemctl disable --now etcd.service
+fi

@@ -4,6 +4,7 @@
 //       [--max-message-mb 256] [--max-bvh-mb 1024] [--auth-token-file FILE]
 //       [--tls-cert CERT.pem --tls-key KEY.pem] [--http 127.0.0.1:8080|off] [--web-root DIR]
 //       [--http-allowed-hosts HOSTS] [--http-cors-origins ORIGINS] [--quiet]
+//       [--cluster ETCD_ENDPOINTS --node-id ID [--role shard|router] [--cluster-name NAME]]
 //
 // (`--help` lists them with their defaults; they are parsed with CLI11.)
 // Runs until SIGTERM or SIGINT, then stops accepting calls, lets running ones finish (up to 10 s)
@@ -23,6 +24,8 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "cluster/cluster_keys.h"
+#include "cluster/cluster_node.h"
 #include "server/grpc/motiondb_server.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
@@ -51,6 +54,70 @@ struct ServerFlags {
   std::string auth_token_file, tls_cert, tls_key;
   bool quiet = false;
 };
+
+// The cluster a node joins (cluster/); none without --cluster.
+struct ClusterFlags {
+  std::string etcd;
+  motiondb::cluster::ClusterOptions options;
+  int lease_s = 5;
+};
+
+void AddClusterFlags(CLI::App& app, ClusterFlags* cluster) {
+  CLI::Option* etcd = app.add_option("--cluster", cluster->etcd,
+                                     "join the cluster kept in this etcd (its members' HOST:PORT, "
+                                     "comma-separated); without it, a single node")
+                          ->type_name("ETCD_ENDPOINTS");
+  app.add_option("--node-id", cluster->options.node.node_id,
+                 "with --cluster: this node's id, unique among the cluster's live nodes")
+      ->type_name("ID")
+      ->needs(etcd);
+  motiondb::cli::OneOf(app.add_option("--role", cluster->options.node.role,
+                                      "with --cluster: hold shards, or route (the router does "
+                                      "not route yet: it registers)"),
+                       {"shard", "router"})
+      ->capture_default_str()
+      ->needs(etcd);
+  app.add_option("--cluster-name", cluster->options.cluster,
+                 "with --cluster: the cluster's name, its etcd keys' prefix")
+      ->type_name("NAME")
+      ->capture_default_str()
+      ->needs(etcd);
+  app.add_option("--cluster-lease-s", cluster->lease_s,
+                 "with --cluster: a node that stops renewing its registration is dropped after "
+                 "this long")
+      ->type_name("S")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 3600).description(""))
+      ->needs(etcd);
+}
+
+// The cluster options the flags give, checked before anything starts.
+absl::Status ReadClusterFlags(ClusterFlags* cluster) {
+  if (cluster->etcd.empty()) return absl::OkStatus();
+  MOTIONDB_ASSIGN_OR_RETURN(cluster->options.etcd.endpoints,
+                            motiondb::cluster::ParseEtcdEndpoints(cluster->etcd));
+  if (cluster->options.node.node_id.empty()) {
+    return absl::InvalidArgumentError("--cluster needs --node-id");
+  }
+  MOTIONDB_RETURN_IF_ERROR(
+      motiondb::cluster::CheckClusterName(cluster->options.cluster, "--cluster-name"));
+  MOTIONDB_RETURN_IF_ERROR(
+      motiondb::cluster::CheckClusterName(cluster->options.node.node_id, "--node-id"));
+  cluster->options.lease_ttl = absl::Seconds(cluster->lease_s);
+  cluster->options.log = [](const std::string& line) { motiondb::server::LogLine(line); };
+  return absl::OkStatus();
+}
+
+// Joins the cluster as the node at `server`'s port: ready (health, /readyz) only while
+// registered.
+absl::StatusOr<std::unique_ptr<motiondb::cluster::ClusterNode>> JoinCluster(
+    ClusterFlags& cluster, const std::string& listen, motiondb::server::MotionDbServer& server) {
+  cluster.options.node.address =
+      absl::StrCat(listen.substr(0, listen.rfind(':')), ":", server.port());
+  server.SetServing(false);
+  return motiondb::cluster::ClusterNode::Start(
+      cluster.options, [&server](bool registered) { server.SetServing(registered); });
+}
 
 void AddHttpFlags(CLI::App& app, motiondb::server::HttpOptions* http, ServerFlags* flags) {
   app.add_option("--http", http->listen,
@@ -279,10 +346,15 @@ int main(int argc, char** argv) {
   AddFlags(app, &options, &flags);
   motiondb::server::HttpOptions http_options;
   AddHttpFlags(app, &http_options, &flags);
+  ClusterFlags cluster;
+  AddClusterFlags(app, &cluster);
   if (const std::optional<int> exit_code = motiondb::cli::ParseCommandLine(app, argc, argv)) {
     return *exit_code;
   }
   if (const absl::Status status = ReadFlagFiles(flags, &options); !status.ok()) {
+    return motiondb::cli::UsageError(app, std::string(status.message()));
+  }
+  if (const absl::Status status = ReadClusterFlags(&cluster); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
   }
   http_options.loop.head_timeout = std::chrono::seconds(flags.http_request_timeout_s);
@@ -306,6 +378,16 @@ int main(int argc, char** argv) {
     }
     http = *std::move(started);
   }
+  std::unique_ptr<motiondb::cluster::ClusterNode> cluster_node;
+  if (!cluster.etcd.empty()) {
+    absl::StatusOr<std::unique_ptr<motiondb::cluster::ClusterNode>> joined =
+        JoinCluster(cluster, options.listen, **server);
+    if (!joined.ok()) {
+      std::cerr << "motiondb-server: " << joined.status().message() << "\n";
+      return 1;
+    }
+    cluster_node = *std::move(joined);
+  }
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);
   motiondb::server::LogLine(absl::StrCat(
@@ -314,6 +396,9 @@ int main(int argc, char** argv) {
   // the calls under way, the HTTP face's among them, finish within the grace; what the HTTP
   // face still writes then is cut at the same deadline.
   const auto steady_deadline = std::chrono::steady_clock::now() + kShutdownGrace;
+  // Leaving the cluster first (its lease revoked) tells the others at once, and ends the
+  // registration's readiness changes before Shutdown() turns the health NOT_SERVING.
+  cluster_node.reset();
   if (http) http->BeginStop();
   (*server)->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
   if (http) http->Stop(steady_deadline);

@@ -211,6 +211,12 @@ void MotionDbServer::Shutdown(std::chrono::system_clock::time_point deadline) {
 
 void MotionDbServer::Wait() { state_->server->Wait(); }
 
+void MotionDbServer::SetServing(bool serving) {
+  if (grpc::HealthCheckServiceInterface* health = state_->server->GetHealthCheckService()) {
+    health->SetServingStatus(serving);
+  }
+}
+
 std::shared_ptr<grpc::Channel> MotionDbServer::InProcessChannel() const {
   grpc::ChannelArguments arguments;
   // Responses are limited by what the services make, as on the network (gRPC clients default

@@ -32,6 +32,10 @@ class MotionDbServer {
   void Shutdown(std::chrono::system_clock::time_point deadline);
   // Blocks until Shutdown() has completed.
   void Wait();
+  // Readiness: what the health service (and so /readyz) answers for the server as a whole,
+  // SERVING from the start; a cluster node is ready only while registered. Call it before
+  // Shutdown(), which turns it NOT_SERVING for good.
+  void SetServing(bool serving);
 
   // A channel to the same services inside this process (the HTTP face's): no network, no
   // credentials (the caller checks the token), the calls logged and counted as any other, with

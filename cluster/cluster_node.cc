@@ -1,0 +1,35 @@
+#include "cluster/cluster_node.h"
+
+#include "absl/strings/str_cat.h"
+#include "cluster/cluster_keys.h"
+#include "util/status_macros.h"
+
+namespace motiondb::cluster {
+
+absl::StatusOr<std::unique_ptr<ClusterNode>> ClusterNode::Start(
+    const ClusterOptions& options, std::function<void(bool registered)> on_registered) {
+  MOTIONDB_RETURN_IF_ERROR(CheckClusterName(options.cluster, "--cluster-name"));
+  MOTIONDB_RETURN_IF_ERROR(CheckClusterName(options.node.node_id, "--node-id"));
+  if (!IsNodeRole(options.node.role)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--role '", options.node.role, "': want shard or router"));
+  }
+  std::unique_ptr<ClusterNode> node(new ClusterNode());
+  MOTIONDB_ASSIGN_OR_RETURN(node->etcd_, EtcdClient::Create(options.etcd));
+  MOTIONDB_ASSIGN_OR_RETURN(node->registration_, NodeRegistration::Start(*node->etcd_, options,
+                                                                         std::move(on_registered)));
+  NodeRegistration* registration = node->registration_.get();
+  const std::string node_id = options.node.node_id;
+  node->watcher_ = std::make_unique<ShardMapWatcher>(
+      *node->etcd_, options, [registration, node_id](const ShardMap& map) {
+        registration->SetShards(map.ShardsOf(node_id));
+      });
+  return node;
+}
+
+ClusterNode::~ClusterNode() {
+  watcher_.reset();  // it writes to the registration
+  registration_.reset();
+}
+
+}  // namespace motiondb::cluster

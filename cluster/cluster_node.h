@@ -1,0 +1,44 @@
+// A server's part in a cluster: its registration under a lease and the shard map it follows,
+// both kept up on threads of their own while the server serves. etcd going away stops neither
+// the server nor this: the node keeps the last map it saw and registers again when etcd is
+// back. Thread-safe.
+#ifndef MOTIONDB_CLUSTER_CLUSTER_NODE_H_
+#define MOTIONDB_CLUSTER_CLUSTER_NODE_H_
+
+#include <functional>
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "cluster/cluster_options.h"
+#include "cluster/etcd_client.h"
+#include "cluster/node_registration.h"
+#include "cluster/shard_map.h"
+#include "cluster/shard_map_watcher.h"
+
+namespace motiondb::cluster {
+
+class ClusterNode {
+ public:
+  // Registers the node (NodeRegistration::Start: ALREADY_EXISTS when its id is held by a live
+  // node; INVALID_ARGUMENT for a bad name, id or role) and starts following the map.
+  // `on_registered` runs whenever the registration is won or lost.
+  static absl::StatusOr<std::unique_ptr<ClusterNode>> Start(
+      const ClusterOptions& options, std::function<void(bool registered)> on_registered);
+  // Deregisters (the lease revoked) and stops watching.
+  ~ClusterNode();
+
+  bool registered() const { return registration_->registered(); }
+  // The newest map seen, nullptr before the first.
+  std::shared_ptr<const ShardMap> map() const { return watcher_->map(); }
+
+ private:
+  ClusterNode() = default;
+
+  std::unique_ptr<EtcdClient> etcd_;
+  std::unique_ptr<NodeRegistration> registration_;
+  std::unique_ptr<ShardMapWatcher> watcher_;
+};
+
+}  // namespace motiondb::cluster
+
+#endif  // MOTIONDB_CLUSTER_CLUSTER_NODE_H_

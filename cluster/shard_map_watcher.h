@@ -1,0 +1,48 @@
+// The last shard map a node has seen, kept current by a watch on its key, and read without
+// waiting: readers copy a shared_ptr under a short lock (read-copy-update, as
+// server/index_registry.h holds the indices). A map replaces the one held only when its epoch
+// is higher, so a stale read never undoes a newer map; while etcd is unreachable the last map
+// stays. Thread-safe.
+#ifndef MOTIONDB_CLUSTER_SHARD_MAP_WATCHER_H_
+#define MOTIONDB_CLUSTER_SHARD_MAP_WATCHER_H_
+
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "cluster/cluster_options.h"
+#include "cluster/etcd_client.h"
+#include "cluster/shard_map.h"
+#include "cluster/shard_map_store.h"
+
+namespace motiondb::cluster {
+
+class ShardMapWatcher {
+ public:
+  // Starts watching `options.cluster`'s map; `on_change` runs on the watch's thread with each
+  // newer map. `etcd` must outlive the watcher.
+  ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& options,
+                  std::function<void(const ShardMap&)> on_change);
+  ~ShardMapWatcher();
+
+  // The newest map seen; nullptr before the first (the cluster not initialised yet, or etcd
+  // unreachable since the start).
+  std::shared_ptr<const ShardMap> map() const;
+
+ private:
+  // Reads the map afresh (on every new stream: what changed while none was open).
+  void Refresh();
+  void Offer(const ShardMap& map);
+
+  const ShardMapStore store_;
+  const ClusterOptions options_;
+  const std::function<void(const ShardMap&)> on_change_;
+  mutable std::mutex mutex_;
+  std::shared_ptr<const ShardMap> map_;  // guarded by mutex_
+  std::unique_ptr<EtcdWatch> watch_;     // last: stopped first
+};
+
+}  // namespace motiondb::cluster
+
+#endif  // MOTIONDB_CLUSTER_SHARD_MAP_WATCHER_H_

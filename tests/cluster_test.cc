@@ -1,0 +1,337 @@
+// The cluster layer against real etcd processes on loopback (testing/etcd_processes.h): the
+// client, the shard map's compare-and-swap, membership under a lease, the map's watch, failover
+// between etcd members, and a real motiondb-server --cluster through etcd going away and back.
+// Every wait polls with a generous bound; nothing asserts how long something took.
+#include <signal.h>
+
+#include <chrono>
+#include <functional>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include "cluster/cluster_keys.h"
+#include "cluster/etcd_client.h"
+#include "cluster/node_info.h"
+#include "cluster/node_registration.h"
+#include "cluster/shard_map.h"
+#include "cluster/shard_map_store.h"
+#include "cluster/shard_map_watcher.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "motiondb/v1/server_service.grpc.pb.h"
+#include "testing/etcd_processes.h"
+#include "testing/server_process.h"
+#include "tests/test_data.h"
+
+namespace motiondb::cluster {
+namespace {
+
+using motiondb::testing::EtcdProcesses;
+using ::testing::HasSubstr;
+
+// Far beyond any wait these tests need on a loaded machine: a bound, not an expectation.
+constexpr auto kBound = std::chrono::seconds(60);
+
+bool PollUntil(const std::function<bool()>& condition) {
+  const auto give_up = std::chrono::steady_clock::now() + kBound;
+  while (std::chrono::steady_clock::now() < give_up) {
+    if (condition()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return condition();
+}
+
+std::unique_ptr<EtcdClient> ClientOf(const EtcdProcesses& etcd) {
+  return *EtcdClient::Create(EtcdOptions{.endpoints = etcd.endpoints(),
+                                         .call_timeout = absl::Seconds(5),
+                                         .attempt_timeout = absl::Seconds(2)});
+}
+
+ClusterOptions NodeOptions(const EtcdProcesses& etcd, const std::string& cluster,
+                           const std::string& node_id, const std::string& role = "shard") {
+  ClusterOptions options;
+  options.etcd.endpoints = etcd.endpoints();
+  options.cluster = cluster;
+  options.node.node_id = node_id;
+  options.node.address = "127.0.0.1:1";
+  options.node.role = role;
+  options.lease_ttl = absl::Seconds(2);
+  return options;
+}
+
+bool Listed(const EtcdClient& client, const std::string& cluster, const std::string& node_id) {
+  const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(client, cluster);
+  if (!nodes.ok()) return false;
+  for (const NodeInfo& node : *nodes) {
+    if (node.node_id == node_id) return true;
+  }
+  return false;
+}
+
+TEST(ShardMapTest, ShardOfClipIsFixedForEver) {
+  // Pinned: these say where stored clips live; a change here strands every cluster's data.
+  EXPECT_EQ(ShardOfClip(0, 64), 0);
+  EXPECT_EQ(ShardOfClip(1, 64), 37);
+  EXPECT_EQ(ShardOfClip(2, 64), 10);
+  EXPECT_EQ(ShardOfClip(42, 64), 34);
+  EXPECT_EQ(ShardOfClip(123456789, 64), 32);
+  EXPECT_EQ(ShardOfClip(-1, 64), 59);
+  EXPECT_EQ(ShardOfClip(42, 7), 3);
+}
+
+TEST(ShardMapTest, JsonRoundTripAndBadValues) {
+  const ShardMap map{.epoch = 3, .owners = {"a", "b", "a"}};
+  const absl::StatusOr<ShardMap> back = ShardMap::FromJson(map.ToJson());
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->epoch, 3);
+  EXPECT_EQ(back->owners, map.owners);
+  EXPECT_EQ(back->ShardsOf("a"), (std::vector<int>{0, 2}));
+  for (const char* bad : {"", "{}", "[1]", R"({"epoch":0,"owners":["a"]})",
+                          R"({"epoch":1,"owners":[]})", R"({"epoch":1,"owners":[3]})"}) {
+    EXPECT_EQ(ShardMap::FromJson(bad).status().code(), absl::StatusCode::kInvalidArgument) << bad;
+  }
+}
+
+class ClusterEtcdTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
+    std::string error;
+    ASSERT_TRUE(etcd_.Start(1, &error)) << error;
+    client_ = ClientOf(etcd_);
+  }
+
+  EtcdProcesses etcd_;
+  std::unique_ptr<EtcdClient> client_;
+};
+
+TEST_F(ClusterEtcdTest, KeysAndCompareAndSwap) {
+  ASSERT_TRUE(client_->Put("/t/a", "1").ok());
+  ASSERT_TRUE(client_->Put("/t/b", "2").ok());
+  ASSERT_TRUE(client_->Put("/u", "3").ok());
+  const absl::StatusOr<std::vector<KeyValue>> range = client_->Range("/t/");
+  ASSERT_TRUE(range.ok()) << range.status();
+  ASSERT_EQ(range->size(), 2u);
+  EXPECT_EQ((*range)[1].value, "2");
+
+  absl::StatusOr<SwapOutcome> swap = client_->CompareAndSwap("/t/c", 0, "new");
+  ASSERT_TRUE(swap.ok() && swap->written);
+  swap = client_->CompareAndSwap("/t/c", 0, "again");  // exists now
+  ASSERT_TRUE(swap.ok());
+  EXPECT_FALSE(swap->written);
+  ASSERT_TRUE(swap->current.has_value());
+  EXPECT_EQ(swap->current->value, "new");
+  swap = client_->CompareAndSwap("/t/c", swap->current->mod_revision, "changed");
+  ASSERT_TRUE(swap.ok() && swap->written);
+  EXPECT_EQ((*client_->Get("/t/c"))->value, "changed");
+
+  ASSERT_TRUE(client_->Delete("/t/c").ok());
+  EXPECT_FALSE(client_->Get("/t/c")->has_value());
+}
+
+TEST_F(ClusterEtcdTest, ShardMapCompareAndSwapRefusesAStaleEpoch) {
+  const ShardMapStore store(*client_, "stale");
+  EXPECT_EQ(store.Read().status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(store.Read().status().message()), HasSubstr("not initialised"));
+  const absl::StatusOr<StoredShardMap> created = store.Create(8, {"a", "b"});
+  ASSERT_TRUE(created.ok()) << created.status();
+  EXPECT_EQ(created->map.epoch, 1);
+  EXPECT_EQ(created->map.ShardsOf("b"), (std::vector<int>{1, 3, 5, 7}));
+  EXPECT_EQ(store.Create(8, {"a"}).status().code(), absl::StatusCode::kAlreadyExists);
+
+  ShardMap first = created->map;
+  first.epoch = 2;
+  first.owners[0] = "b";
+  ASSERT_TRUE(store.Replace(*created, first).ok());
+  ShardMap second = created->map;  // made from the same, now stale, map
+  second.epoch = 2;
+  second.owners[1] = "a";
+  const absl::StatusOr<StoredShardMap> stale = store.Replace(*created, second);
+  EXPECT_EQ(stale.status().code(), absl::StatusCode::kAborted);
+  EXPECT_THAT(std::string(stale.status().message()), HasSubstr("epoch 2 now"));
+  const absl::StatusOr<StoredShardMap> now = store.Read();
+  ASSERT_TRUE(now.ok());
+  EXPECT_EQ(now->map.owners, first.owners);  // the refused change left nothing
+
+  ShardMap skipped = now->map;
+  skipped.epoch = 5;
+  EXPECT_EQ(store.Replace(*now, skipped).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(ClusterEtcdTest, MoveShardNeedsALiveShardNodeAndAShardInRange) {
+  const ShardMapStore store(*client_, "move");
+  EXPECT_EQ(store.MoveShard(0, "b").status().code(), absl::StatusCode::kNotFound);  // no map
+  ASSERT_TRUE(store.Create(4, {"a"}).ok());
+  auto b = NodeRegistration::Start(*client_, NodeOptions(etcd_, "move", "b"), nullptr);
+  auto r = NodeRegistration::Start(*client_, NodeOptions(etcd_, "move", "r", "router"), nullptr);
+  ASSERT_TRUE(b.ok() && r.ok());
+  EXPECT_EQ(store.MoveShard(4, "b").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(store.MoveShard(-1, "b").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(store.MoveShard(0, "ghost").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(store.MoveShard(0, "r").status().code(), absl::StatusCode::kFailedPrecondition);
+  const absl::StatusOr<StoredShardMap> moved = store.MoveShard(2, "b");
+  ASSERT_TRUE(moved.ok()) << moved.status();
+  EXPECT_EQ(moved->map.epoch, 2);
+  EXPECT_EQ(moved->map.owners, (std::vector<std::string>{"a", "a", "b", "a"}));
+  EXPECT_EQ(store.MoveShard(2, "b").status().code(), absl::StatusCode::kFailedPrecondition);
+}
+
+TEST_F(ClusterEtcdTest, RegistrationRefusesAHeldIdAndEndsWithItsNode) {
+  std::vector<bool> changes;
+  auto first =
+      NodeRegistration::Start(*client_, NodeOptions(etcd_, "reg", "n1"),
+                              [&changes](bool registered) { changes.push_back(registered); });
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_TRUE((*first)->registered());
+  EXPECT_EQ(changes, std::vector<bool>{true});
+  EXPECT_TRUE(Listed(*client_, "reg", "n1"));
+
+  const auto second = NodeRegistration::Start(*client_, NodeOptions(etcd_, "reg", "n1"), nullptr);
+  EXPECT_EQ(second.status().code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_THAT(std::string(second.status().message()), HasSubstr("held by the shard node at"));
+
+  (*first)->SetShards({3, 4});
+  EXPECT_TRUE(PollUntil([&] {
+    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client_, "reg");
+    return nodes.ok() && nodes->size() == 1 && (*nodes)[0].shards == std::vector<int>{3, 4};
+  }));
+  first->reset();  // revokes its lease: the key goes at once
+  EXPECT_FALSE(Listed(*client_, "reg", "n1"));
+  EXPECT_TRUE(NodeRegistration::Start(*client_, NodeOptions(etcd_, "reg", "n1"), nullptr).ok());
+}
+
+TEST_F(ClusterEtcdTest, WatchDeliversMapChanges) {
+  std::mutex mutex;
+  std::vector<int64_t> epochs;
+  ShardMapWatcher watcher(*client_, NodeOptions(etcd_, "watch", "a"), [&](const ShardMap& map) {
+    std::lock_guard<std::mutex> lock(mutex);
+    epochs.push_back(map.epoch);
+  });
+  EXPECT_EQ(watcher.map(), nullptr);
+  const ShardMapStore store(*client_, "watch");
+  absl::StatusOr<StoredShardMap> stored = store.Create(4, {"a", "b"});
+  ASSERT_TRUE(stored.ok());
+  ASSERT_TRUE(PollUntil([&] { return watcher.map() != nullptr; }));
+  for (int epoch = 2; epoch <= 4; ++epoch) {
+    ShardMap next = stored->map;
+    next.epoch = epoch;
+    next.owners[epoch - 1] = "a";
+    stored = store.Replace(*stored, next);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+  }
+  ASSERT_TRUE(PollUntil([&] { return watcher.map()->epoch == 4; }));
+  EXPECT_EQ(watcher.map()->ShardsOf("a"), (std::vector<int>{0, 1, 2, 3}));
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_TRUE(std::is_sorted(epochs.begin(), epochs.end()));
+  EXPECT_EQ(epochs.back(), 4);
+}
+
+TEST(ClusterFailoverTest, ClientAndWatchGoOnWhenAMemberIsKilled) {
+  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
+  EtcdProcesses etcd;
+  std::string error;
+  ASSERT_TRUE(etcd.Start(3, &error)) << error;
+  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
+  const ShardMapStore store(*client, "failover");
+  absl::StatusOr<StoredShardMap> stored = store.Create(4, {"a"});
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  ShardMapWatcher watcher(*client, NodeOptions(etcd, "failover", "a"), nullptr);
+  ASSERT_TRUE(PollUntil([&] { return watcher.map() != nullptr; }));
+
+  etcd.Stop(0, /*graceful=*/false);  // the member every call and the watch went to first
+  ASSERT_TRUE(client->Put("/failover/probe", "after").ok());
+  EXPECT_EQ((*client->Get("/failover/probe"))->value, "after");
+  ShardMap next = stored->map;
+  next.epoch = 2;
+  next.owners[0] = "b";
+  ASSERT_TRUE(store.Replace(*stored, next).ok());
+  EXPECT_TRUE(PollUntil([&] { return watcher.map()->epoch == 2; }));
+}
+
+// The standard health answer for the server as a whole ("" service): readiness.
+bool Serving(const std::shared_ptr<grpc::Channel>& channel) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  grpc::health::v1::HealthCheckResponse response;
+  return grpc::health::v1::Health::NewStub(channel)
+             ->Check(&context, grpc::health::v1::HealthCheckRequest(), &response)
+             .ok() &&
+         response.status() == grpc::health::v1::HealthCheckResponse::SERVING;
+}
+
+TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
+  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
+  EtcdProcesses etcd;
+  std::string error;
+  ASSERT_TRUE(etcd.Start(1, &error)) << error;
+  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_server");
+  const std::vector<std::string> node_flags = {
+      "--cluster", etcd.endpoints_flag(), "--node-id", "s1", "--cluster-lease-s", "2", "--quiet"};
+  std::vector<std::string> args = {"--db", (dir / "s1.sqlite").string()};
+  args.insert(args.end(), node_flags.begin(), node_flags.end());
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.Start(args, &error)) << error;
+  const auto channel = testing::InsecureChannel(server.address());
+  ASSERT_TRUE(PollUntil([&] { return Listed(*client, "motiondb", "s1") && Serving(channel); }))
+      << server.Log();
+
+  // A second node under the same id is refused, and exits.
+  testing::ServerProcess twin;
+  std::vector<std::string> twin_args = {"--db", (dir / "twin.sqlite").string()};
+  twin_args.insert(twin_args.end(), node_flags.begin(), node_flags.end());
+  ASSERT_TRUE(twin.Start(twin_args, &error)) << error;  // it serves, then joins the cluster
+  EXPECT_TRUE(PollUntil([&] {
+    return twin.Log().find("node id 's1' of cluster 'motiondb' is held by") != std::string::npos;
+  })) << twin.Log();
+  EXPECT_EQ(twin.Stop(SIGTERM), 1);  // exited 1 already: the signal finds it gone
+
+  const std::string ep = etcd.endpoints_flag();
+  testing::CommandResult cli = testing::RunCli({"cluster", "status", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_THAT(cli.out, HasSubstr("not initialised"));
+  cli = testing::RunCli({"cluster", "init", "--etcd", ep, "--shards", "8"});
+  ASSERT_EQ(cli.exit_code, 0) << cli.err;
+  cli = testing::RunCli({"cluster", "status", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_THAT(cli.out, HasSubstr("shard map epoch 1, 8 shards"));
+  EXPECT_THAT(cli.out, ::testing::ContainsRegex("s1 +shard +127.0.0.1:[0-9]+ +[0-9]+ s +8"));
+  cli = testing::RunCli({"cluster", "init", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 1);
+  EXPECT_THAT(cli.err, HasSubstr("initialised already"));
+  cli = testing::RunCli({"cluster", "move-shard", "8", "s1", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 1);
+  EXPECT_THAT(cli.err, HasSubstr("shard 8 is out of range"));
+  cli = testing::RunCli({"cluster", "move-shard", "0", "ghost", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 1);
+  EXPECT_THAT(cli.err, HasSubstr("'ghost' is not a live node"));
+  // The node writes the shards the map gives it to its key.
+  EXPECT_TRUE(PollUntil([&] {
+    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client, "motiondb");
+    return nodes.ok() && nodes->size() == 1 && (*nodes)[0].shards.size() == 8;
+  }));
+
+  // etcd gone: the server keeps answering, no longer ready; etcd back: registered again.
+  etcd.Stop(0, /*graceful=*/true);
+  cli = testing::RunCli({"cluster", "status", "--etcd", ep});
+  EXPECT_EQ(cli.exit_code, 1);
+  EXPECT_THAT(cli.err, HasSubstr("etcd is unreachable"));
+  ASSERT_TRUE(PollUntil([&] { return !Serving(channel); })) << server.Log();
+  {
+    grpc::ClientContext context;
+    v1::ServerInfo info;
+    EXPECT_TRUE(v1::ServerService::NewStub(channel)->GetServerInfo(&context, {}, &info).ok());
+  }
+  ASSERT_TRUE(etcd.Restart(0, &error)) << error;
+  EXPECT_TRUE(PollUntil([&] { return Listed(*client, "motiondb", "s1") && Serving(channel); }))
+      << server.Log();
+
+  // Killed, it stops renewing: its key goes within the lease.
+  server.Stop(SIGKILL);
+  EXPECT_TRUE(PollUntil([&] { return !Listed(*client, "motiondb", "s1"); }));
+}
+
+}  // namespace
+}  // namespace motiondb::cluster
