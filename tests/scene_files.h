@@ -1,31 +1,16 @@
-// FBX and glTF files made from BVH takes by Debian's Blender, as a studio's tools make them:
-// `blender -b` runs tests/scene/bvh_to_scene.py. Tests skip, saying so, when Blender is absent.
+// The tests' FBX and glTF files, made once a process from Bandai takes by Debian's Blender
+// (testing/blender_scene_files.h). Tests skip, saying so, when Blender is absent.
 #ifndef MOTIONDB_TESTS_SCENE_FILES_H_
 #define MOTIONDB_TESTS_SCENE_FILES_H_
 
 #include <filesystem>
 #include <string>
-#include <vector>
 
 #include <gtest/gtest.h>
 #include "absl/status/statusor.h"
+#include "testing/blender_scene_files.h"
 
 namespace motiondb::testing {
-
-struct SceneFileRequest {
-  // The first take's skeleton and motion; each further one (of the same skeleton) another take
-  // of the FBX.
-  std::vector<std::filesystem::path> takes;
-  char up_axis = 'Y';               // 'Z': the FBX is written Z up
-  std::string formats = "fbx,glb";  // of "fbx", "glb"
-};
-
-// Writes `base`.fbx and/or `base`.glb. UNAVAILABLE when Blender is not installed (its message
-// is the skip's), INTERNAL with Blender's output when it fails.
-absl::Status MakeSceneFiles(const SceneFileRequest& request, const std::filesystem::path& base);
-
-// The skip message of a test that needs Blender, or empty when it is installed.
-std::string BlenderMissing();
 
 // The Bandai takes the files below are made from (../shared/mocap/bandai2-normal).
 std::filesystem::path FirstTake();
