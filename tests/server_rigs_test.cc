@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "core/bvh/bvh_reader.h"
+#include "core/motion/humanoid_map.h"
 #include "google/protobuf/text_format.h"
 #include "testing/corpus_paths.h"
 #include "testing/rerigged_copy.h"
@@ -123,12 +124,23 @@ TEST_F(ServerTest, TakesAndTheirReriggedCopiesFindEachOtherInASpaceOverBothSkele
   upload.set_space("rigs");
   upload.mutable_bvh()->set_bvh(BvhText(rigs->copies[2]));
   upload.set_max_results(2);
+  upload.set_explain(true);
   v1::SearchResponse found;
   status = client.Search(upload, &found);
   ASSERT_TRUE(status.ok()) << status.error_message();
   ASSERT_EQ(found.results_size(), 2);
   EXPECT_THAT((std::vector<int64_t>{found.results(0).clip_id(), found.results(1).clip_id()}),
               ::testing::UnorderedElementsAre(originals[2], copies[2]));
+  // Explained by the humanoid's slots, whichever rig: each bone by its slot, the shoulder line
+  // by both shoulders, and the heading's two extra parts.
+  std::vector<std::string> parts;
+  for (const v1::JointShare& part : found.results(0).explanation().joints()) {
+    parts.push_back(part.name());
+    EXPECT_TRUE(ParseHumanoidSlot(part.name()).has_value() || part.name() == "Shoulders" ||
+                part.name() == "yaw rate" || part.name() == "root velocity")
+        << part.name();
+  }
+  EXPECT_THAT(parts, ::testing::IsSupersetOf({"LeftUpperLeg", "RightLowerArm", "Spine"}));
 
   // Propagation runs in the space: a label on the walk reaches the walk's re-rigged copy.
   AddLabelsOrFail(client, {FrameLabel(originals[0], 10, 90, "walk", 1.0)});

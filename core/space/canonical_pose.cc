@@ -17,7 +17,9 @@ namespace {
 
 using Slot = HumanoidSlot;
 
-// A bone's two ends: a slot each, or the midpoint of a left/right pair of slots (`*_pair`).
+// A bone's two ends: a slot each, or the midpoint of a left/right pair of slots (`*_pair`). A bone
+// is named by its slot, as HumanIK and VRM name theirs (the thigh is "LeftUpperLeg"; the trunk,
+// hips to shoulders, "Spine"); the shoulder line, two slots' bone, "Shoulders".
 struct BoneEnds {
   absl::string_view name;
   Slot from;
@@ -27,20 +29,21 @@ struct BoneEnds {
 };
 
 constexpr std::array<BoneEnds, kCanonicalBoneCount> kBones = {{
-    {"LeftThigh", Slot::kLeftUpperLeg, Slot::kLeftUpperLeg, Slot::kLeftLowerLeg,
+    {"LeftUpperLeg", Slot::kLeftUpperLeg, Slot::kLeftUpperLeg, Slot::kLeftLowerLeg,
      Slot::kLeftLowerLeg},
-    {"LeftShin", Slot::kLeftLowerLeg, Slot::kLeftLowerLeg, Slot::kLeftFoot, Slot::kLeftFoot},
-    {"RightThigh", Slot::kRightUpperLeg, Slot::kRightUpperLeg, Slot::kRightLowerLeg,
+    {"LeftLowerLeg", Slot::kLeftLowerLeg, Slot::kLeftLowerLeg, Slot::kLeftFoot, Slot::kLeftFoot},
+    {"RightUpperLeg", Slot::kRightUpperLeg, Slot::kRightUpperLeg, Slot::kRightLowerLeg,
      Slot::kRightLowerLeg},
-    {"RightShin", Slot::kRightLowerLeg, Slot::kRightLowerLeg, Slot::kRightFoot, Slot::kRightFoot},
+    {"RightLowerLeg", Slot::kRightLowerLeg, Slot::kRightLowerLeg, Slot::kRightFoot,
+     Slot::kRightFoot},
     {"LeftUpperArm", Slot::kLeftUpperArm, Slot::kLeftUpperArm, Slot::kLeftLowerArm,
      Slot::kLeftLowerArm},
-    {"LeftForearm", Slot::kLeftLowerArm, Slot::kLeftLowerArm, Slot::kLeftHand, Slot::kLeftHand},
+    {"LeftLowerArm", Slot::kLeftLowerArm, Slot::kLeftLowerArm, Slot::kLeftHand, Slot::kLeftHand},
     {"RightUpperArm", Slot::kRightUpperArm, Slot::kRightUpperArm, Slot::kRightLowerArm,
      Slot::kRightLowerArm},
-    {"RightForearm", Slot::kRightLowerArm, Slot::kRightLowerArm, Slot::kRightHand,
+    {"RightLowerArm", Slot::kRightLowerArm, Slot::kRightLowerArm, Slot::kRightHand,
      Slot::kRightHand},
-    {"Trunk", Slot::kLeftUpperLeg, Slot::kRightUpperLeg, Slot::kLeftUpperArm, Slot::kRightUpperArm},
+    {"Spine", Slot::kLeftUpperLeg, Slot::kRightUpperLeg, Slot::kLeftUpperArm, Slot::kRightUpperArm},
     {"Neck", Slot::kLeftUpperArm, Slot::kRightUpperArm, Slot::kHead, Slot::kHead},
     {"Shoulders", Slot::kRightUpperArm, Slot::kRightUpperArm, Slot::kLeftUpperArm,
      Slot::kLeftUpperArm},

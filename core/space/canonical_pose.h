@@ -47,7 +47,9 @@ absl::StatusOr<SpaceRepresentation> ParseSpaceRepresentation(absl::string_view n
 
 inline constexpr int kCanonicalBoneCount = 11;
 
-// The bone's name: "LeftThigh", "LeftShin", ..., "Trunk", "Neck", "Shoulders".
+// The bone's name, its humanoid slot's (humanoid_map.h): "LeftUpperLeg" (the thigh),
+// "LeftLowerLeg", ..., "RightLowerArm", "Spine" (hips to shoulders), "Neck", and "Shoulders" (the
+// shoulder line).
 absl::string_view CanonicalBoneName(int bone);
 
 // How a skeleton's joints are found: its humanoid map (with any overrides its owner stores).

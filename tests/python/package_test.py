@@ -151,7 +151,7 @@ class PackageTest(unittest.TestCase):
         space = client.create_space("rigs", skeleton_ids=skeletons[1:])
         self.assertEqual((list(space.skeleton_ids), space.representation),
                          (skeletons[1:], "canonical-bones"))
-        self.assertIn("LeftThigh", [w.joint for w in space.report.joint_weights])
+        self.assertIn("LeftUpperLeg", [w.joint for w in space.report.joint_weights])
         results = client.search("rigs", clip="01_01", first=200, last=440, max_results=3)
         self.assertGreater(len(results), 0)
         client.delete_space("rigs")
