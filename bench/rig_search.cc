@@ -42,6 +42,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "bench/window_vector_baseline.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/scene/scene_reader.h"
@@ -424,6 +425,7 @@ absl::Status ReriggedTakes(const fs::path& mocap) {
     const double query_fps = 1.0 / query.frame_time;
     const int length = static_cast<int>(std::lround(4 * query_fps));
     Share share, base_share;
+    std::map<std::string, int> others;  // what the misses were, by content
     const auto is_kind = [&](int64_t id) {
       const std::string& c = walk_content[id];
       return kind == "walk" ? c.rfind("walk", 0) == 0 : c == "run";
@@ -432,7 +434,13 @@ absl::Status ReriggedTakes(const fs::path& mocap) {
       MOTIONDB_ASSIGN_OR_RETURN(
           const server::SearchOutcome outcome,
           walks->Search("both", query.clip_id, first, first + length - 1, "bandai", 5));
-      for (const server::SearchHit& hit : outcome.hits) share.Add(is_kind(hit.clip_id));
+      for (const server::SearchHit& hit : outcome.hits) {
+        share.Add(is_kind(hit.clip_id));
+        if (!is_kind(hit.clip_id)) {
+          ++others[absl::StrCat(walk_content[hit.clip_id], " (frames ", first, "-",
+                                first + length - 1, ")")];
+        }
+      }
       for (const SearchResult& r : walk_base.Search(
                query.clip_id, first, first + length - 1, query_fps,
                [&](int64_t id) { return walk_content.contains(id); }, 5)) {
@@ -440,9 +448,10 @@ absl::Status ReriggedTakes(const fs::path& mocap) {
       }
     }
     absl::PrintF(
-        "3. %s (27 joints) 4 s ranges among Bandai takes: %ss in the first five %s; "
-        "baseline %s\n",
-        name, kind, share.Text(), base_share.Text());
+        "3. %s (27 joints) 4 s ranges among Bandai takes: %ss in the first five %s (the rest: "
+        "%s); baseline %s\n",
+        name, kind, share.Text(), absl::StrJoin(others, ", ", absl::PairFormatter(" x")),
+        base_share.Text());
   }
   return absl::OkStatus();
 }
