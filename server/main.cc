@@ -4,7 +4,8 @@
 //       [--max-message-mb 256] [--max-bvh-mb 1024] [--auth-token-file FILE]
 //       [--tls-cert CERT.pem --tls-key KEY.pem] [--http 127.0.0.1:8080|off] [--web-root DIR]
 //       [--http-allowed-hosts HOSTS] [--http-cors-origins ORIGINS] [--quiet]
-//       [--cluster ETCD_ENDPOINTS --node-id ID [--role shard|router] [--cluster-name NAME]]
+//       [--cluster ETCD_ENDPOINTS --node-id ID [--role shard|router] [--cluster-name NAME]
+//        [--advertise HOST[:PORT]]]
 //
 // (`--help` lists them with their defaults; they are parsed with CLI11.)
 // Runs until SIGTERM or SIGINT, then stops accepting calls, lets running ones finish (up to 10 s)
@@ -26,6 +27,7 @@
 #include "absl/strings/str_cat.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/cluster_node.h"
+#include "cluster/node_address.h"
 #include "server/grpc/motiondb_server.h"
 #include "server/grpc/request_logger.h"
 #include "server/grpc/server_options.h"
@@ -58,6 +60,7 @@ struct ServerFlags {
 // The cluster a node joins (cluster/); none without --cluster.
 struct ClusterFlags {
   std::string etcd;
+  std::string advertise;
   motiondb::cluster::ClusterOptions options;
   int lease_s = 5;
 };
@@ -82,6 +85,12 @@ void AddClusterFlags(CLI::App& app, ClusterFlags* cluster) {
       ->type_name("NAME")
       ->capture_default_str()
       ->needs(etcd);
+  app.add_option("--advertise", cluster->advertise,
+                 "with --cluster: where other nodes reach this one (HOST, or HOST:PORT when a "
+                 "proxy or a Service's port stands between); default: the --listen host at the "
+                 "port served, a wildcard host replaced by this machine's name")
+      ->type_name("HOST[:PORT]")
+      ->needs(etcd);
   app.add_option("--cluster-lease-s", cluster->lease_s,
                  "with --cluster: a node that stops renewing its registration is dropped after "
                  "this long")
@@ -103,6 +112,9 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
       motiondb::cluster::CheckClusterName(cluster->options.cluster, "--cluster-name"));
   MOTIONDB_RETURN_IF_ERROR(
       motiondb::cluster::CheckClusterName(cluster->options.node.node_id, "--node-id"));
+  // The port is known once bound (JoinCluster); the rest is checked now.
+  MOTIONDB_RETURN_IF_ERROR(
+      motiondb::cluster::AdvertisedAddress(cluster->advertise, "", 1, "").status());
   cluster->options.lease_ttl = absl::Seconds(cluster->lease_s);
   cluster->options.log = [](const std::string& line) { motiondb::server::LogLine(line); };
   return absl::OkStatus();
@@ -112,8 +124,10 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
 // registered.
 absl::StatusOr<std::unique_ptr<motiondb::cluster::ClusterNode>> JoinCluster(
     ClusterFlags& cluster, const std::string& listen, motiondb::server::MotionDbServer& server) {
-  cluster.options.node.address =
-      absl::StrCat(listen.substr(0, listen.rfind(':')), ":", server.port());
+  MOTIONDB_ASSIGN_OR_RETURN(
+      cluster.options.node.address,
+      motiondb::cluster::AdvertisedAddress(cluster.advertise, listen, server.port(),
+                                           motiondb::cluster::MachineHostName()));
   server.SetServing(false);
   return motiondb::cluster::ClusterNode::Start(
       cluster.options, [&server](bool registered) { server.SetServing(registered); });

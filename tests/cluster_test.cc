@@ -14,6 +14,7 @@
 
 #include "cluster/cluster_keys.h"
 #include "cluster/etcd_client.h"
+#include "cluster/node_address.h"
 #include "cluster/node_info.h"
 #include "cluster/node_registration.h"
 #include "cluster/shard_map.h"
@@ -79,6 +80,27 @@ TEST(ShardMapTest, ShardOfClipIsFixedForEver) {
   EXPECT_EQ(ShardOfClip(123456789, 64), 32);
   EXPECT_EQ(ShardOfClip(-1, 64), 59);
   EXPECT_EQ(ShardOfClip(42, 7), 3);
+}
+
+TEST(NodeAddressTest, AdvertisedAddressIsReachable) {
+  // Without --advertise: the listening host at the port served, a wildcard made the host name.
+  EXPECT_EQ(*AdvertisedAddress("", "127.0.0.1:0", 50123, "box"), "127.0.0.1:50123");
+  EXPECT_EQ(*AdvertisedAddress("", "0.0.0.0:50051", 50051, "box"), "box:50051");
+  EXPECT_EQ(*AdvertisedAddress("", "[::]:50051", 50051, "box"), "box:50051");
+  EXPECT_EQ(*AdvertisedAddress("", "[::1]:0", 4000, "box"), "[::1]:4000");
+  // --advertise: a host takes the port served; a port of its own stays.
+  EXPECT_EQ(*AdvertisedAddress("shard-0.motiondb", "0.0.0.0:0", 4000, "box"),
+            "shard-0.motiondb:4000");
+  EXPECT_EQ(*AdvertisedAddress("shard-0.motiondb:7000", "0.0.0.0:0", 4000, "box"),
+            "shard-0.motiondb:7000");
+  EXPECT_EQ(*AdvertisedAddress("[fd00::7]:7000", "0.0.0.0:0", 4000, "box"), "[fd00::7]:7000");
+  EXPECT_EQ(*AdvertisedAddress("fd00::7", "0.0.0.0:0", 4000, "box"), "[fd00::7]:4000");
+  for (const char* bad :
+       {"0.0.0.0", "[::]:7000", ":7000", "host:0", "host:70000", "host:x", "a host", "host/path"}) {
+    const absl::StatusOr<std::string> address = AdvertisedAddress(bad, "127.0.0.1:0", 1, "box");
+    EXPECT_TRUE(absl::IsInvalidArgument(address.status())) << bad;
+    EXPECT_THAT(address.status().message(), HasSubstr("--advertise")) << bad;
+  }
 }
 
 TEST(ShardMapTest, JsonRoundTripAndBadValues) {
@@ -331,6 +353,32 @@ TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   // Killed, it stops renewing: its key goes within the lease.
   server.Stop(SIGKILL);
   EXPECT_TRUE(PollUntil([&] { return !Listed(*client, "motiondb", "s1"); }));
+}
+
+// A node registers where others reach it (--advertise), and refuses an address nobody reaches.
+TEST(ClusterServerTest, RegistersTheAdvertisedAddress) {
+  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
+  EtcdProcesses etcd;
+  std::string error;
+  ASSERT_TRUE(etcd.Start(1, &error)) << error;
+  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_advertise");
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.Start(
+      {"--db", (dir / "a.sqlite").string(), "--http", "off", "--quiet", "--cluster",
+       etcd.endpoints_flag(), "--node-id", "a", "--advertise", "shard-0.motiondb-shard:7000"},
+      &error))
+      << error;
+  EXPECT_TRUE(PollUntil([&] {
+    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client, "motiondb");
+    return nodes.ok() && nodes->size() == 1 && (*nodes)[0].address == "shard-0.motiondb-shard:7000";
+  })) << server.Log();
+
+  testing::ServerProcess wildcard;
+  EXPECT_FALSE(wildcard.Start({"--db", (dir / "b.sqlite").string(), "--http", "off", "--cluster",
+                               etcd.endpoints_flag(), "--node-id", "b", "--advertise", "0.0.0.0"},
+                              &error));
+  EXPECT_THAT(error, HasSubstr("--advertise '0.0.0.0': a wildcard host reaches no node"));
 }
 
 }  // namespace
