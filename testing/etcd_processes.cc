@@ -1,10 +1,8 @@
 #include "testing/etcd_processes.h"
 
-#include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -16,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "cluster/etcd_client.h"
+#include "testing/child_process.h"
 
 namespace motiondb::testing {
 namespace {
@@ -85,7 +84,7 @@ bool EtcdProcesses::Start(int members, std::string* error) {
 bool EtcdProcesses::Launch(int member, std::string* error) {
   const std::string name = absl::StrCat("m", member);
   const std::string client = "http://" + endpoints_[member];
-  std::vector<std::string> args = {
+  const std::vector<std::string> argv = {
       Binary(), "--name", name, "--data-dir", dir_ + "/" + name, "--listen-client-urls", client,
       "--advertise-client-urls", client, "--listen-peer-urls", peers_[member],
       "--initial-advertise-peer-urls", peers_[member], "--initial-cluster", initial_cluster_,
@@ -94,21 +93,11 @@ bool EtcdProcesses::Launch(int member, std::string* error) {
       // A leader killed is replaced within a second, not several.
       "--heartbeat-interval", "50", "--election-timeout", "500", "--logger", "zap", "--log-level",
       "warn"};
-  std::vector<char*> argv;
-  for (std::string& arg : args) argv.push_back(arg.data());
-  argv.push_back(nullptr);
-  const std::string log = absl::StrCat(dir_, "/", name, ".log");
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    const int null = ::open("/dev/null", O_RDWR);
-    if (out < 0 || null < 0) ::_exit(126);
-    ::dup2(null, STDIN_FILENO);
-    ::dup2(out, STDOUT_FILENO);
-    ::dup2(out, STDERR_FILENO);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
+  // Appended: a restarted member's log keeps what it said before.
+  const pid_t pid = SpawnChild(argv, ChildOptions{.log_path = absl::StrCat(dir_, "/", name, ".log"),
+                                                  .stdout_to_log = true,
+                                                  .append = true,
+                                                  .max_open_files = 0});
   if (pid < 0) {
     *error = "fork failed";
     return false;
@@ -120,9 +109,7 @@ bool EtcdProcesses::Launch(int member, std::string* error) {
 void EtcdProcesses::Stop(int member, bool graceful) {
   const pid_t pid = pids_[member];
   if (pid <= 0) return;
-  ::kill(pid, graceful ? SIGTERM : SIGKILL);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  StopChild(pid, graceful ? SIGTERM : SIGKILL, std::chrono::seconds(30));
   pids_[member] = -1;
 }
 

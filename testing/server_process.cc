@@ -1,9 +1,6 @@
 #include "testing/server_process.h"
 
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,18 +13,9 @@
 #include <thread>
 
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "testing/child_process.h"
 
 namespace motiondb::testing {
-namespace {
-
-// 128 + signal for a signalled child, as a shell reports it.
-int ExitCode(int status) {
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return -1;
-}
-
-}  // namespace
 
 std::string ServerPath() {
   const char* given = std::getenv("MOTIONDB_SERVER_BIN");
@@ -35,11 +23,7 @@ std::string ServerPath() {
 }
 
 ServerProcess::~ServerProcess() {
-  if (pid_ > 0) {
-    ::kill(pid_, SIGKILL);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-  }
+  if (pid_ > 0) StopChild(pid_, SIGKILL, std::chrono::seconds(30));
   if (!log_path_.empty()) std::filesystem::remove(log_path_);
 }
 
@@ -56,26 +40,10 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   const auto http = std::find(argv_strings.begin(), argv_strings.end(), "--http");
   const bool http_off = http + 1 < argv_strings.end() && http[1] == "off";
-  std::vector<char*> argv;
-  for (std::string& arg : argv_strings) argv.push_back(arg.data());
-  argv.push_back(nullptr);
-
-  pid_ = ::fork();
-  if (pid_ == 0) {
-    const int log = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int null = ::open("/dev/null", O_RDWR);
-    if (log < 0 || null < 0) ::_exit(126);
-    ::dup2(null, STDIN_FILENO);
-    ::dup2(null, STDOUT_FILENO);
-    ::dup2(log, STDERR_FILENO);
-    if (max_open_files_ > 0) {
-      const rlimit files{static_cast<rlim_t>(max_open_files_),
-                         static_cast<rlim_t>(max_open_files_)};
-      if (::setrlimit(RLIMIT_NOFILE, &files) != 0) ::_exit(125);
-    }
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
+  pid_ = SpawnChild(argv_strings, ChildOptions{.log_path = log_path_,
+                                               .stdout_to_log = false,
+                                               .append = false,
+                                               .max_open_files = max_open_files_});
   if (pid_ < 0) {
     *error = "fork failed";
     return false;
@@ -92,10 +60,9 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
       http_port_ = http_off ? 0 : std::stoi(http_match[1]);
       return true;
     }
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+    if (const std::optional<int> code = ExitedChild(pid_)) {
       pid_ = -1;
-      *error = "the server exited with code " + std::to_string(ExitCode(status)) + ":\n" + Log();
+      *error = "the server exited with code " + std::to_string(*code) + ":\n" + Log();
       return false;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -106,20 +73,9 @@ bool ServerProcess::Start(const std::vector<std::string>& args, std::string* err
 
 int ServerProcess::Stop(int signal, std::chrono::seconds timeout) {
   if (pid_ <= 0) return -1;
-  ::kill(pid_, signal);
-  const auto give_up = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  while (std::chrono::steady_clock::now() < give_up) {
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      pid_ = -1;
-      return ExitCode(status);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ::kill(pid_, SIGKILL);
-  ::waitpid(pid_, &status, 0);
+  const int code = StopChild(pid_, signal, timeout);
   pid_ = -1;
-  return -1;
+  return code;
 }
 
 std::string ServerProcess::Log() const {

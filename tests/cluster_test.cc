@@ -116,17 +116,23 @@ TEST(ShardMapTest, JsonRoundTripAndBadValues) {
   }
 }
 
+// Real etcd for each test, with a client to it; the test is skipped when etcd is not installed.
 class ClusterEtcdTest : public ::testing::Test {
  protected:
+  explicit ClusterEtcdTest(int members = 1) : members_(members) {}
+
   void SetUp() override {
     if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
     std::string error;
-    ASSERT_TRUE(etcd_.Start(1, &error)) << error;
+    ASSERT_TRUE(etcd_.Start(members_, &error)) << error;
     client_ = ClientOf(etcd_);
   }
 
   EtcdProcesses etcd_;
   std::unique_ptr<EtcdClient> client_;
+
+ private:
+  const int members_;
 };
 
 TEST_F(ClusterEtcdTest, KeysAndCompareAndSwap) {
@@ -250,21 +256,22 @@ TEST_F(ClusterEtcdTest, WatchDeliversMapChanges) {
   EXPECT_EQ(epochs.back(), 4);
 }
 
-TEST(ClusterFailoverTest, ClientAndWatchGoOnWhenAMemberIsKilled) {
-  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
-  EtcdProcesses etcd;
-  std::string error;
-  ASSERT_TRUE(etcd.Start(3, &error)) << error;
-  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
-  const ShardMapStore store(*client, "failover");
+// Three members, so that one can be killed.
+class ClusterFailoverTest : public ClusterEtcdTest {
+ protected:
+  ClusterFailoverTest() : ClusterEtcdTest(3) {}
+};
+
+TEST_F(ClusterFailoverTest, ClientAndWatchGoOnWhenAMemberIsKilled) {
+  const ShardMapStore store(*client_, "failover");
   absl::StatusOr<StoredShardMap> stored = store.Create(4, {"a"});
   ASSERT_TRUE(stored.ok()) << stored.status();
-  ShardMapWatcher watcher(*client, NodeOptions(etcd, "failover", "a"), nullptr);
+  ShardMapWatcher watcher(*client_, NodeOptions(etcd_, "failover", "a"), nullptr);
   ASSERT_TRUE(PollUntil([&] { return watcher.map() != nullptr; }));
 
-  etcd.Stop(0, /*graceful=*/false);  // the member every call and the watch went to first
-  ASSERT_TRUE(client->Put("/failover/probe", "after").ok());
-  EXPECT_EQ((*client->Get("/failover/probe"))->value, "after");
+  etcd_.Stop(0, /*graceful=*/false);  // the member every call and the watch went to first
+  ASSERT_TRUE(client_->Put("/failover/probe", "after").ok());
+  EXPECT_EQ((*client_->Get("/failover/probe"))->value, "after");
   ShardMap next = stored->map;
   next.epoch = 2;
   next.owners[0] = "b";
@@ -283,21 +290,19 @@ bool Serving(const std::shared_ptr<grpc::Channel>& channel) {
          response.status() == grpc::health::v1::HealthCheckResponse::SERVING;
 }
 
-TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
-  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
-  EtcdProcesses etcd;
+class ClusterServerTest : public ClusterEtcdTest {};
+
+TEST_F(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   std::string error;
-  ASSERT_TRUE(etcd.Start(1, &error)) << error;
-  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
   const std::filesystem::path dir = testing::MakeTempDir("cluster_server");
   const std::vector<std::string> node_flags = {
-      "--cluster", etcd.endpoints_flag(), "--node-id", "s1", "--cluster-lease-s", "2", "--quiet"};
+      "--cluster", etcd_.endpoints_flag(), "--node-id", "s1", "--cluster-lease-s", "2", "--quiet"};
   std::vector<std::string> args = {"--db", (dir / "s1.sqlite").string()};
   args.insert(args.end(), node_flags.begin(), node_flags.end());
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(args, &error)) << error;
   const auto channel = testing::InsecureChannel(server.address());
-  ASSERT_TRUE(PollUntil([&] { return Listed(*client, "motiondb", "s1") && Serving(channel); }))
+  ASSERT_TRUE(PollUntil([&] { return Listed(*client_, "motiondb", "s1") && Serving(channel); }))
       << server.Log();
 
   // A second node under the same id is refused, and exits.
@@ -310,7 +315,7 @@ TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   })) << twin.Log();
   EXPECT_EQ(twin.Stop(SIGTERM), 1);  // exited 1 already: the signal finds it gone
 
-  const std::string ep = etcd.endpoints_flag();
+  const std::string ep = etcd_.endpoints_flag();
   testing::CommandResult cli = testing::RunCli({"cluster", "status", "--etcd", ep});
   EXPECT_EQ(cli.exit_code, 0) << cli.err;
   EXPECT_THAT(cli.out, HasSubstr("not initialised"));
@@ -331,12 +336,12 @@ TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   EXPECT_THAT(cli.err, HasSubstr("'ghost' is not a live node"));
   // The node writes the shards the map gives it to its key.
   EXPECT_TRUE(PollUntil([&] {
-    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client, "motiondb");
+    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client_, "motiondb");
     return nodes.ok() && nodes->size() == 1 && (*nodes)[0].shards.size() == 8;
   }));
 
   // etcd gone: the server keeps answering, no longer ready; etcd back: registered again.
-  etcd.Stop(0, /*graceful=*/true);
+  etcd_.Stop(0, /*graceful=*/true);
   cli = testing::RunCli({"cluster", "status", "--etcd", ep});
   EXPECT_EQ(cli.exit_code, 1);
   EXPECT_THAT(cli.err, HasSubstr("etcd is unreachable"));
@@ -346,13 +351,13 @@ TEST(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
     v1::ServerInfo info;
     EXPECT_TRUE(v1::ServerService::NewStub(channel)->GetServerInfo(&context, {}, &info).ok());
   }
-  ASSERT_TRUE(etcd.Restart(0, &error)) << error;
-  EXPECT_TRUE(PollUntil([&] { return Listed(*client, "motiondb", "s1") && Serving(channel); }))
+  ASSERT_TRUE(etcd_.Restart(0, &error)) << error;
+  EXPECT_TRUE(PollUntil([&] { return Listed(*client_, "motiondb", "s1") && Serving(channel); }))
       << server.Log();
 
   // Killed, it stops renewing: its key goes within the lease.
   server.Stop(SIGKILL);
-  EXPECT_TRUE(PollUntil([&] { return !Listed(*client, "motiondb", "s1"); }));
+  EXPECT_TRUE(PollUntil([&] { return !Listed(*client_, "motiondb", "s1"); }));
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.
