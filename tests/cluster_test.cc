@@ -361,27 +361,23 @@ TEST_F(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.
-TEST(ClusterServerTest, RegistersTheAdvertisedAddress) {
-  if (EtcdProcesses::Binary().empty()) GTEST_SKIP() << "etcd is not installed (etcd-server)";
-  EtcdProcesses etcd;
+TEST_F(ClusterServerTest, RegistersTheAdvertisedAddress) {
   std::string error;
-  ASSERT_TRUE(etcd.Start(1, &error)) << error;
-  const std::unique_ptr<EtcdClient> client = ClientOf(etcd);
   const std::filesystem::path dir = testing::MakeTempDir("cluster_advertise");
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(
       {"--db", (dir / "a.sqlite").string(), "--http", "off", "--quiet", "--cluster",
-       etcd.endpoints_flag(), "--node-id", "a", "--advertise", "shard-0.motiondb-shard:7000"},
+       etcd_.endpoints_flag(), "--node-id", "a", "--advertise", "shard-0.motiondb-shard:7000"},
       &error))
       << error;
   EXPECT_TRUE(PollUntil([&] {
-    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client, "motiondb");
+    const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client_, "motiondb");
     return nodes.ok() && nodes->size() == 1 && (*nodes)[0].address == "shard-0.motiondb-shard:7000";
   })) << server.Log();
 
   testing::ServerProcess wildcard;
   EXPECT_FALSE(wildcard.Start({"--db", (dir / "b.sqlite").string(), "--http", "off", "--cluster",
-                               etcd.endpoints_flag(), "--node-id", "b", "--advertise", "0.0.0.0"},
+                               etcd_.endpoints_flag(), "--node-id", "b", "--advertise", "0.0.0.0"},
                               &error));
   EXPECT_THAT(error, HasSubstr("--advertise '0.0.0.0': a wildcard host reaches no node"));
 }
