@@ -52,6 +52,9 @@ absl::StatusOr<std::string> AdvertisedAddress(absl::string_view advertise, absl:
                      "; expected HOST or HOST:PORT that other nodes reach this one at"));
   };
   if (IsWildcard(given.host)) return bad("a wildcard host reaches no node");
+  if (absl::StartsWith(given.host, "[") != absl::EndsWith(given.host, "]")) {
+    return bad("an IPv6 host's brackets do not close");
+  }
   for (const char c : given.host) {
     if (absl::ascii_isspace(static_cast<unsigned char>(c)) || c == '/') {
       return bad("the host holds a space or '/'");

@@ -95,8 +95,8 @@ TEST(NodeAddressTest, AdvertisedAddressIsReachable) {
             "shard-0.motiondb:7000");
   EXPECT_EQ(*AdvertisedAddress("[fd00::7]:7000", "0.0.0.0:0", 4000, "box"), "[fd00::7]:7000");
   EXPECT_EQ(*AdvertisedAddress("fd00::7", "0.0.0.0:0", 4000, "box"), "[fd00::7]:4000");
-  for (const char* bad :
-       {"0.0.0.0", "[::]:7000", ":7000", "host:0", "host:70000", "host:x", "a host", "host/path"}) {
+  for (const char* bad : {"0.0.0.0", "[::]:7000", ":7000", "host:0", "host:70000", "host:x",
+                          "a host", "host/path", "[fd00::7", "[fd00::7]x"}) {
     const absl::StatusOr<std::string> address = AdvertisedAddress(bad, "127.0.0.1:0", 1, "box");
     EXPECT_TRUE(absl::IsInvalidArgument(address.status())) << bad;
     EXPECT_THAT(address.status().message(), HasSubstr("--advertise")) << bad;
