@@ -30,6 +30,22 @@ absl::Status Unary(const EtcdChannels& channels,
       });
 }
 
+// The transaction's condition: `key`'s mod_revision is `expected_revision`, or the key is absent
+// for 0 (an absent key has no mod_revision to compare: its create_revision is 0).
+void CompareRevision(const std::string& key, int64_t expected_revision,
+                     etcdserverpb::TxnRequest* request) {
+  Compare* compare = request->add_compare();
+  compare->set_key(key);
+  compare->set_result(Compare::EQUAL);
+  if (expected_revision == 0) {
+    compare->set_target(Compare::CREATE);
+    compare->set_create_revision(0);
+  } else {
+    compare->set_target(Compare::MOD);
+    compare->set_mod_revision(expected_revision);
+  }
+}
+
 // etcd answers an unknown lease with NOT_FOUND ("requested lease not found"), and a keep-alive
 // of one with a TTL of 0.
 absl::Status LeaseGone(int64_t lease) {
@@ -109,17 +125,7 @@ absl::StatusOr<SwapOutcome> EtcdClient::CompareAndSwap(const std::string& key,
                                                        const std::string& value,
                                                        int64_t lease) const {
   etcdserverpb::TxnRequest request;
-  Compare* compare = request.add_compare();
-  compare->set_key(key);
-  compare->set_result(Compare::EQUAL);
-  // An absent key has no mod_revision to compare: its create_revision is 0.
-  if (expected_revision == 0) {
-    compare->set_target(Compare::CREATE);
-    compare->set_create_revision(0);
-  } else {
-    compare->set_target(Compare::MOD);
-    compare->set_mod_revision(expected_revision);
-  }
+  CompareRevision(key, expected_revision, &request);
   etcdserverpb::PutRequest* put = request.add_success()->mutable_request_put();
   put->set_key(key);
   put->set_value(value);
@@ -135,6 +141,17 @@ absl::StatusOr<SwapOutcome> EtcdClient::CompareAndSwap(const std::string& key,
     outcome.current = FromProto(response.responses(0).response_range().kvs(0));
   }
   return outcome;
+}
+
+absl::StatusOr<bool> EtcdClient::DeleteIfRevision(const std::string& key,
+                                                  int64_t expected_revision) const {
+  etcdserverpb::TxnRequest request;
+  CompareRevision(key, expected_revision, &request);
+  request.add_success()->mutable_request_delete_range()->set_key(key);
+  etcdserverpb::TxnResponse response;
+  const absl::Status status = Unary(*channels_, &etcdserverpb::KV::Stub::Txn, request, &response);
+  if (!status.ok()) return status;
+  return response.succeeded();
 }
 
 absl::StatusOr<int64_t> EtcdClient::GrantLease(absl::Duration ttl) const {

@@ -55,6 +55,9 @@ class EtcdClient {
   // is absent), in one transaction.
   absl::StatusOr<SwapOutcome> CompareAndSwap(const std::string& key, int64_t expected_revision,
                                              const std::string& value, int64_t lease = 0) const;
+  // Deletes `key` only when its mod_revision is still `expected_revision` (> 0), in one
+  // transaction: whether it did.
+  absl::StatusOr<bool> DeleteIfRevision(const std::string& key, int64_t expected_revision) const;
 
   // A new lease of `ttl` (etcd rounds up to whole seconds and may raise it to its minimum).
   absl::StatusOr<int64_t> GrantLease(absl::Duration ttl) const;

@@ -155,8 +155,19 @@ TEST_F(ClusterEtcdTest, KeysAndCompareAndSwap) {
   ASSERT_TRUE(swap.ok() && swap->written);
   EXPECT_EQ((*client_->Get("/t/c"))->value, "changed");
 
-  ASSERT_TRUE(client_->Delete("/t/c").ok());
+  absl::StatusOr<bool> deleted = client_->DeleteIfRevision("/t/c", swap->revision - 1);  // stale
+  ASSERT_TRUE(deleted.ok()) << deleted.status();
+  EXPECT_FALSE(*deleted);
+  EXPECT_TRUE(client_->Get("/t/c")->has_value());
+  deleted = client_->DeleteIfRevision("/t/c", swap->revision);
+  ASSERT_TRUE(deleted.ok() && *deleted);
   EXPECT_FALSE(client_->Get("/t/c")->has_value());
+  deleted = client_->DeleteIfRevision("/t/c", swap->revision);  // gone already
+  ASSERT_TRUE(deleted.ok());
+  EXPECT_FALSE(*deleted);
+
+  ASSERT_TRUE(client_->Delete("/t/a").ok());
+  EXPECT_FALSE(client_->Get("/t/a")->has_value());
 }
 
 TEST_F(ClusterEtcdTest, ShardMapCompareAndSwapRefusesAStaleEpoch) {
