@@ -1,7 +1,10 @@
 #include "cluster/cluster_keys.h"
 
+#include <charconv>
+
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "util/name_text.h"
 
 namespace motiondb::cluster {
 
@@ -15,6 +18,21 @@ std::string NodeKey(const std::string& cluster, const std::string& node_id) {
 
 std::string ShardMapKey(const std::string& cluster) {
   return absl::StrCat("/", cluster, "/shard_map");
+}
+
+std::string NextClipIdKey(const std::string& cluster) {
+  return absl::StrCat("/", cluster, "/next_clip_id");
+}
+
+absl::StatusOr<int64_t> PositiveDecimalOf(const std::string& key, const std::string& value) {
+  // std::from_chars, unlike absl::SimpleAtoi, takes neither a sign nor spaces: digits only.
+  int64_t number = 0;
+  const char* end = value.data() + value.size();
+  const std::from_chars_result parsed = std::from_chars(value.data(), end, number);
+  if (parsed.ec == std::errc() && parsed.ptr == end && number > 0) return number;
+  return absl::FailedPreconditionError(absl::StrCat("etcd key ", QuotedNameText(key), " holds ",
+                                                    QuotedNameText(value),
+                                                    ", not a positive decimal number"));
 }
 
 absl::Status CheckClusterName(const std::string& name, const std::string& what) {

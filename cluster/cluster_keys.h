@@ -3,9 +3,11 @@
 #ifndef MOTIONDB_CLUSTER_CLUSTER_KEYS_H_
 #define MOTIONDB_CLUSTER_CLUSTER_KEYS_H_
 
+#include <cstdint>
 #include <string>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 
 namespace motiondb::cluster {
 
@@ -15,6 +17,12 @@ std::string NodesPrefix(const std::string& cluster);
 std::string NodeKey(const std::string& cluster, const std::string& node_id);
 // /CLUSTER/shard_map: the ShardMap's JSON.
 std::string ShardMapKey(const std::string& cluster);
+// /CLUSTER/next_clip_id: the first clip id no router has reserved, in decimal (ClipIdBlocks).
+std::string NextClipIdKey(const std::string& cluster);
+
+// The positive decimal number (a clip id) that `key` holds as `value`; FAILED_PRECONDITION naming
+// the key otherwise, since only motiondb writes these keys.
+absl::StatusOr<int64_t> PositiveDecimalOf(const std::string& key, const std::string& value);
 
 // A cluster name or node id: 1-64 letters, digits, '.', '_' or '-' (a key's path element).
 // INVALID_ARGUMENT naming `what` ("--node-id") otherwise.

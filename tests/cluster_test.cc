@@ -6,12 +6,15 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
+#include <set>
 #include <thread>
 
 #include <gmock/gmock.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include "cluster/clip_id_blocks.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/etcd_client.h"
 #include "cluster/node_address.h"
@@ -265,6 +268,90 @@ TEST_F(ClusterEtcdTest, WatchDeliversMapChanges) {
   std::lock_guard<std::mutex> lock(mutex);
   EXPECT_TRUE(std::is_sorted(epochs.begin(), epochs.end()));
   EXPECT_EQ(epochs.back(), 4);
+}
+
+TEST_F(ClusterEtcdTest, ClipIdBlocksHandOutUniqueIdsInWholeBlocks) {
+  constexpr int64_t kBlock = 100;
+  constexpr int kThreads = 4;
+  constexpr int kIdsAThread = 625;  // with the four taken in turns, 5004 ids
+  const std::unique_ptr<EtcdClient> other_client = ClientOf(etcd_);
+  ClipIdBlocks routers[2] = {ClipIdBlocks(*client_, "ids", kBlock),
+                             ClipIdBlocks(*other_client, "ids", kBlock)};
+  // ids[r][0]: router r's taken in turns; ids[r][1 + t]: its thread t's; each in the order given.
+  std::vector<std::vector<int64_t>> ids[2];
+  // In turns: each router reserves a block of its own at its first id, then hands out of it.
+  ids[0].push_back({*routers[0].Next()});
+  ids[1].push_back({*routers[1].Next()});
+  ids[0][0].push_back(*routers[0].Next());
+  ids[1][0].push_back(*routers[1].Next());
+  EXPECT_EQ(ids[0][0], (std::vector<int64_t>{1, 2}));
+  EXPECT_EQ(ids[1][0], (std::vector<int64_t>{kBlock + 1, kBlock + 2}));
+
+  // Then from four threads each, the routers racing for the counter.
+  absl::Status failures[2][kThreads];
+  std::vector<std::thread> threads;
+  for (int r = 0; r < 2; ++r) {
+    ids[r].resize(1 + kThreads);
+    for (int t = 0; t < kThreads; ++t) {
+      threads.emplace_back([&routers, &ids, &failures, r, t] {
+        for (int i = 0; i < kIdsAThread; ++i) {
+          const absl::StatusOr<int64_t> id = routers[r].Next();
+          if (!id.ok()) {
+            failures[r][t] = id.status();
+            return;
+          }
+          ids[r][1 + t].push_back(*id);
+        }
+      });
+    }
+  }
+  for (std::thread& thread : threads) thread.join();
+
+  std::set<int64_t> all;
+  size_t count = 0;
+  std::map<int64_t, int> owner;    // block (from 0) -> its router
+  std::map<int64_t, int> used[2];  // router -> block -> ids handed out of it
+  for (int r = 0; r < 2; ++r) {
+    for (int t = 0; t < kThreads; ++t) ASSERT_TRUE(failures[r][t].ok()) << failures[r][t];
+    for (const std::vector<int64_t>& taken : ids[r]) {
+      EXPECT_TRUE(std::is_sorted(taken.begin(), taken.end()));
+      for (const int64_t id : taken) {
+        all.insert(id);
+        ++count;
+        const int64_t block = (id - 1) / kBlock;
+        EXPECT_EQ(owner.emplace(block, r).first->second, r) << "block " << block;
+        ++used[r][block];
+      }
+    }
+  }
+  EXPECT_EQ(count, 4u + 2 * kThreads * kIdsAThread);
+  EXPECT_EQ(all.size(), count);  // no id twice
+  for (int r = 0; r < 2; ++r) {
+    int partial = 0;  // only the block a router holds now is partly handed out
+    for (const auto& [block, ids_used] : used[r]) partial += ids_used < kBlock ? 1 : 0;
+    EXPECT_LE(partial, 1) << "router " << r;
+  }
+  // Every block reserved was handed out from, and the counter is past the last one.
+  EXPECT_EQ((*client_->Get(NextClipIdKey("ids")))->value,
+            std::to_string(1 + kBlock * static_cast<int64_t>(owner.size())));
+  EXPECT_EQ(owner.rbegin()->first + 1, static_cast<int64_t>(owner.size()));
+}
+
+TEST_F(ClusterEtcdTest, ClipIdBlocksRefuseACorruptCounter) {
+  const std::string key = NextClipIdKey("bad");
+  for (const char* bad : {"abc", "0", "-5", "12x", " 12", "+12", ""}) {
+    ASSERT_TRUE(client_->Put(key, bad).ok());
+    ClipIdBlocks blocks(*client_, "bad", 10);
+    const absl::StatusOr<int64_t> id = blocks.Next();
+    EXPECT_EQ(id.status().code(), absl::StatusCode::kFailedPrecondition) << bad;
+    EXPECT_THAT(std::string(id.status().message()), HasSubstr("etcd key '/bad/next_clip_id' holds"))
+        << bad;
+  }
+  // The counter holds the first id not reserved yet.
+  ASSERT_TRUE(client_->Put(key, "41").ok());
+  ClipIdBlocks blocks(*client_, "bad", 10);
+  EXPECT_EQ(*blocks.Next(), 41);
+  EXPECT_EQ((*client_->Get(key))->value, "51");
 }
 
 // Three members, so that one can be killed.
