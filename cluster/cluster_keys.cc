@@ -24,6 +24,10 @@ std::string NextClipIdKey(const std::string& cluster) {
   return absl::StrCat("/", cluster, "/next_clip_id");
 }
 
+std::string ClipNameKey(const std::string& cluster, const std::string& name) {
+  return absl::StrCat("/", cluster, "/clip_names/", name);
+}
+
 absl::StatusOr<int64_t> PositiveDecimalOf(const std::string& key, const std::string& value) {
   // std::from_chars, unlike absl::SimpleAtoi, takes neither a sign nor spaces: digits only.
   int64_t number = 0;

@@ -19,6 +19,11 @@ std::string NodeKey(const std::string& cluster, const std::string& node_id);
 std::string ShardMapKey(const std::string& cluster);
 // /CLUSTER/next_clip_id: the first clip id no router has reserved, in decimal (ClipIdBlocks).
 std::string NextClipIdKey(const std::string& cluster);
+// /CLUSTER/clip_names/NAME: the id of the clip the name is reserved for, in decimal (ClipNames).
+// NAME is the name's bytes unescaped: these keys are only read and written one at a time, never
+// ranged over or watched by prefix, so a name holding '/' or beginning another has a key of its
+// own all the same.
+std::string ClipNameKey(const std::string& cluster, const std::string& name);
 
 // The positive decimal number (a clip id) that `key` holds as `value`; FAILED_PRECONDITION naming
 // the key otherwise, since only motiondb writes these keys.

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "cluster/clip_id_blocks.h"
+#include "cluster/clip_names.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/etcd_client.h"
 #include "cluster/node_address.h"
@@ -352,6 +353,50 @@ TEST_F(ClusterEtcdTest, ClipIdBlocksRefuseACorruptCounter) {
   ClipIdBlocks blocks(*client_, "bad", 10);
   EXPECT_EQ(*blocks.Next(), 41);
   EXPECT_EQ((*client_->Get(key))->value, "51");
+}
+
+TEST_F(ClusterEtcdTest, ClipNamesHaveOneHolderAtATime) {
+  const ClipNames names(*client_, "names", 16);
+  ASSERT_TRUE(names.Reserve("walk", 7).ok());
+  EXPECT_TRUE(names.Reserve("walk", 7).ok());  // a retried request
+  const absl::Status taken = names.Reserve("walk", 8);
+  EXPECT_EQ(taken.code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_EQ(taken.message(), "clip name 'walk' is taken by clip 7");
+  EXPECT_EQ(*names.Lookup("walk"), 7);
+
+  EXPECT_FALSE(*names.Release("walk", 8));  // not its holder: left as it is
+  EXPECT_EQ(*names.Lookup("walk"), 7);
+  EXPECT_TRUE(*names.Release("walk", 7));
+  EXPECT_EQ(*names.Lookup("walk"), std::nullopt);
+  EXPECT_FALSE(*names.Release("walk", 7));  // released already
+  ASSERT_TRUE(names.Reserve("walk", 8).ok());
+  EXPECT_EQ(*names.Lookup("walk"), 8);
+
+  EXPECT_EQ(names.Reserve("", 1).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(names.Reserve(std::string(17, 'x'), 1).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(names.Reserve(std::string(16, 'x'), 1).ok());
+  EXPECT_EQ(names.Reserve("zero", 0).code(), absl::StatusCode::kInvalidArgument);
+
+  ASSERT_TRUE(client_->Put(ClipNameKey("names", "odd"), "seven").ok());
+  const absl::StatusOr<std::optional<int64_t>> odd = names.Lookup("odd");
+  EXPECT_EQ(odd.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(std::string(odd.status().message()), HasSubstr("'/names/clip_names/odd'"));
+}
+
+TEST_F(ClusterEtcdTest, ClipNamesWithSlashesAndPrefixesAreEachTheirOwn) {
+  const ClipNames names(*client_, "paths", 64);
+  for (const auto& [name, id] : std::vector<std::pair<std::string, int64_t>>{
+           {"run", 1}, {"run/fast", 2}, {"running", 3}, {"run/fast/left", 4}, {"Läufer 🏃", 5}}) {
+    ASSERT_TRUE(names.Reserve(name, id).ok()) << name;
+  }
+  EXPECT_TRUE(*names.Release("run", 1));
+  EXPECT_EQ(*names.Lookup("run"), std::nullopt);
+  EXPECT_EQ(*names.Lookup("run/fast"), 2);
+  EXPECT_EQ(*names.Lookup("running"), 3);
+  EXPECT_TRUE(*names.Release("run/fast", 2));
+  EXPECT_EQ(*names.Lookup("run/fast/left"), 4);
+  EXPECT_EQ(*names.Lookup("Läufer 🏃"), 5);
+  EXPECT_EQ(*names.Lookup("run/"), std::nullopt);
 }
 
 // Three members, so that one can be killed.
