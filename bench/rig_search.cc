@@ -32,8 +32,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
 #include <set>
@@ -53,6 +51,7 @@
 #include "testing/blender_scene_files.h"
 #include "testing/corpus_paths.h"
 #include "testing/rerigged_copy.h"
+#include "util/file_io.h"
 #include "util/status_macros.h"
 
 namespace motiondb {
@@ -458,8 +457,8 @@ absl::Status ReriggedTakes(const fs::path& mocap) {
 
 // The take of a file Blender made, read as the import process reads it.
 absl::StatusOr<Clip> ReadSceneTake(const fs::path& path, MotionFileFormat format) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  MOTIONDB_ASSIGN_OR_RETURN(const std::string bytes,
+                            ReadFileBytes(path.string(), int64_t{1} << 30));
   MOTIONDB_ASSIGN_OR_RETURN(SceneReadResult read, ReadScene(bytes, format));
   if (read.takes.size() != 1) {
     return absl::InternalError(absl::StrCat(path.string(), ": ", read.takes.size(), " takes"));

@@ -1,10 +1,9 @@
 #include "testing/blender_scene_files.h"
 
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "util/file_io.h"
 
 namespace motiondb::testing {
 namespace {
@@ -15,11 +14,10 @@ std::string Quoted(const std::string& text) {
   return quoted + "'";
 }
 
-std::string ReadText(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+// Blender's log, shown when it failed: its last lines say why, and a runaway log is cut.
+std::string BlenderLog(const std::filesystem::path& path) {
+  const absl::StatusOr<std::string> log = ReadFileBytes(path.string(), int64_t{1} << 20);
+  return log.ok() ? *log : log.status().ToString();
 }
 
 }  // namespace
@@ -48,7 +46,7 @@ absl::Status MakeSceneFiles(const SceneFileRequest& request, const std::filesyst
     if (request.formats.find(format) == std::string::npos) continue;
     if (status != 0 || !std::filesystem::exists(absl::StrCat(base.string(), ".", format))) {
       return absl::InternalError(absl::StrCat("blender did not write the ", format,
-                                              " file: ", command, "\n", ReadText(log)));
+                                              " file: ", command, "\n", BlenderLog(log)));
     }
   }
   return absl::OkStatus();

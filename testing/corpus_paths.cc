@@ -15,8 +15,11 @@ std::filesystem::path MocapRoot() {
 std::optional<std::filesystem::path> MocapDir() {
   const std::filesystem::path root = MocapRoot();
   std::error_code error;
-  if (std::filesystem::is_directory(root, error)) return root;
-  return std::nullopt;
+  // An empty folder is a corpus not fetched (a mount point, a cleared checkout): absent too, so
+  // that what needs it skips rather than fails on its first file.
+  if (!std::filesystem::is_directory(root, error)) return std::nullopt;
+  if (std::filesystem::is_empty(root, error) || error) return std::nullopt;
+  return root;
 }
 
 }  // namespace motiondb::testing

@@ -11,7 +11,7 @@ namespace motiondb::testing {
 
 // The folder, whether or not it exists.
 std::filesystem::path MocapRoot();
-// The folder, or nullopt when it does not exist (callers skip, saying so).
+// The folder, or nullopt when it does not exist or is empty (callers skip, saying so).
 std::optional<std::filesystem::path> MocapDir();
 
 }  // namespace motiondb::testing
