@@ -50,7 +50,7 @@ class ClipScan {
   // `bound()` is a cost that no result of other clips at or above it can rank with: paths
   // that cannot stay below it and below the clip's own k-th best are dropped. `stop` is told
   // each column's cells (a column of a long query costs as much as many short ones).
-  absl::Status Run(int clip_index, const SearchFilter& filter, StopPoll& stop,
+  absl::Status Run(int clip_index, int64_t clip_id, const SearchFilter& filter, StopPoll& stop,
                    absl::FunctionRef<float()> bound, StreamingTopResults& top, SearchStats& stats) {
     const auto threshold = [&] { return std::min(top.threshold(), bound()); };
     for (int64_t j = 0; j < clip_.rows; ++j) {
@@ -75,7 +75,7 @@ class ClipScan {
       const int64_t last = first_frame_ + frame_step_ * j;
       if (end_cost < kInfinity && filter.Admits(clip_index, first, last)) {
         const Warp warp{first, last, end_cost / static_cast<double>(m_), {}};
-        top.Offer(MakeResult(clip_index, warp, -1));
+        top.Offer(MakeResult(clip_index, clip_id, warp, -1));
       }
     }
     return absl::OkStatus();
@@ -207,12 +207,12 @@ class ClipScan {
 }  // namespace
 
 absl::Status ScanClip(CoordinateView query, CoordinateView clip, int64_t first_frame,
-                      int frame_step, int clip_index, const SearchParams& params,
+                      int frame_step, int clip_index, int64_t clip_id, const SearchParams& params,
                       const SearchFilter& filter, StopPoll& stop, absl::FunctionRef<float()> bound,
                       ClipScanWorkspace& workspace, StreamingTopResults& top, SearchStats& stats) {
   ClipScan scan(query, clip, first_frame, frame_step, params.slope_limit, params.dtw_dims,
                 workspace);
-  return scan.Run(clip_index, filter, stop, bound, top, stats);
+  return scan.Run(clip_index, clip_id, filter, stop, bound, top, stats);
 }
 
 void FinishedClips::Add(std::vector<SearchResult> results) {

@@ -19,24 +19,24 @@ absl::StatusOr<SearchResponse> ExactSearch(const LibraryIndex& library, Coordina
   FinishedClips finished(params.max_results, query.rows);
   std::vector<SearchStats> stats(ThreadsFor(params.exact_threads));
   std::vector<ClipScanWorkspace> workspaces(stats.size());
-  MOTIONDB_RETURN_IF_ERROR(
-      ParallelFor(library.clip_count(), static_cast<int>(stats.size()),
-                  [&](int64_t index, int thread) -> absl::Status {
-                    const int c = static_cast<int>(index);
-                    if (!filter.allowed.empty() && !filter.allowed[c]) return absl::OkStatus();
-                    // Each thread polls on its own; every one of them stops within a poll's work.
-                    StopPoll stop = SearchStop(params);
-                    if (stop.Done(query.rows)) return SearchStopped();
-                    StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
-                    MOTIONDB_RETURN_IF_ERROR(ScanClip(
-                        query, library.clip_coordinates(c), 0, 1, c, params, filter, stop,
-                        [&] { return finished.bound(); }, workspaces[thread], top, stats[thread]));
-                    // Most clips hold nothing under the bound: adding nothing would only take the
-                    // lock.
-                    std::vector<SearchResult> results = top.Take();
-                    if (!results.empty()) finished.Add(std::move(results));
-                    return absl::OkStatus();
-                  }));
+  MOTIONDB_RETURN_IF_ERROR(ParallelFor(
+      library.clip_count(), static_cast<int>(stats.size()),
+      [&](int64_t index, int thread) -> absl::Status {
+        const int c = static_cast<int>(index);
+        if (!filter.allowed.empty() && !filter.allowed[c]) return absl::OkStatus();
+        // Each thread polls on its own; every one of them stops within a poll's work.
+        StopPoll stop = SearchStop(params);
+        if (stop.Done(query.rows)) return SearchStopped();
+        StreamingTopResults top(params.max_results, params.max_overlap, query.rows);
+        MOTIONDB_RETURN_IF_ERROR(ScanClip(
+            query, library.clip_coordinates(c), 0, 1, c, library.clip(c).clip_id, params, filter,
+            stop, [&] { return finished.bound(); }, workspaces[thread], top, stats[thread]));
+        // Most clips hold nothing under the bound: adding nothing would only take the
+        // lock.
+        std::vector<SearchResult> results = top.Take();
+        if (!results.empty()) finished.Add(std::move(results));
+        return absl::OkStatus();
+      }));
   for (const SearchStats& thread_stats : stats) {
     response.stats.cells += thread_stats.cells;
     response.stats.pruned_blocks += thread_stats.pruned_blocks;

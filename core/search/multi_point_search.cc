@@ -255,6 +255,7 @@ SearchResult ChainResult(const std::vector<std::vector<SearchResult>>& matches,
   const SearchResult& last = matches.back()[end];
   SearchResult result;
   result.clip_index = first.clip_index;
+  result.clip_id = first.clip_id;
   result.first_frame = first.first_frame;
   result.last_frame = last.last_frame;
   result.seed_frame = first.seed_frame;

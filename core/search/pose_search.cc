@@ -47,6 +47,7 @@ absl::StatusOr<SearchResponse> PoseSearch(const LibraryIndex& library, Coordinat
         library.NearestFrameAround(pose.row(0), params.dtw_dims, clip, frame, reach);
     SearchResult candidate;
     candidate.clip_index = clip;
+    candidate.clip_id = library.clip(clip).clip_id;
     candidate.first_frame = candidate.last_frame = candidate.seed_frame = nearest;
     candidate.score = distance;
     // A result is its one frame (the range below only serves the overlap rule).

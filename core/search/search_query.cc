@@ -67,9 +67,10 @@ absl::StatusOr<SearchFilter> PrepareQuery(const LibraryIndex& library, Coordinat
   return filter;
 }
 
-SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame) {
+SearchResult MakeResult(int clip_index, int64_t clip_id, Warp warp, int64_t seed_frame) {
   SearchResult result;
   result.clip_index = clip_index;
+  result.clip_id = clip_id;
   result.first_frame = warp.first;
   result.last_frame = warp.last;
   result.score = warp.score;

@@ -31,8 +31,8 @@ bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap) 
 }
 
 bool RanksBefore(const SearchResult& a, const SearchResult& b) {
-  return std::tie(a.score, a.clip_index, a.last_frame, a.first_frame) <
-         std::tie(b.score, b.clip_index, b.last_frame, b.first_frame);
+  return std::tie(a.score, a.clip_id, a.clip_index, a.last_frame, a.first_frame) <
+         std::tie(b.score, b.clip_id, b.clip_index, b.last_frame, b.first_frame);
 }
 
 std::vector<size_t> RankedIndices(const std::vector<SearchResult>& candidates, double max_overlap,

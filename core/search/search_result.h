@@ -66,9 +66,12 @@ struct SearchResponse {
 // True when `a` overlaps `b` (same clip) by more than `max_overlap` of a's length.
 bool Overlaps(const SearchResult& a, const SearchResult& b, double max_overlap);
 
-// The ranking order: by score, equal scores by clip, end frame and start frame (the order in
-// which a clip's scan, ExactSearch, meets its warps). StreamingTopResults and RankResults keep
-// the same results only because they break ties alike.
+// The ranking order: by score, equal scores by clip id (then index, for results without ids),
+// end frame and start frame (the order in which a clip's scan, ExactSearch, meets its warps).
+// Ties go by clip id, not by where a clip sits in a library, so that libraries holding the same
+// clips in another order, or split in parts (the shards of a cluster, MergePartResults), rank
+// alike: an exact copy of a take ranks the same wherever it is. StreamingTopResults and
+// RankResults keep the same results only because they break ties alike.
 bool RanksBefore(const SearchResult& a, const SearchResult& b);
 
 // Sorts by RanksBefore, drops every result that overlaps a better kept one by more than

@@ -87,8 +87,8 @@ absl::StatusOr<std::vector<SearchResult>> ScanRanges(
         library.clip_coordinates(range.clip).middle_rows(range.first, range.last - range.first + 1),
         factor);
     MOTIONDB_RETURN_IF_ERROR(ScanClip(
-        query, clip, range.first, factor, range.clip, params, filter, stop,
-        [&] { return finished.bound(); }, workspace, top, stats));
+        query, clip, range.first, factor, range.clip, library.clip(range.clip).clip_id, params,
+        filter, stop, [&] { return finished.bound(); }, workspace, top, stats));
     std::vector<SearchResult> results = top.Take();
     if (results.empty()) continue;
     ++stats.warps;

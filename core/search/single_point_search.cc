@@ -361,8 +361,8 @@ absl::StatusOr<SearchResponse> SinglePointSearch(const LibraryIndex& library, Co
         if (!warps[i].warp) return absl::OkStatus();
         ++stats.warps;
         const Seed& seed = order[i];
-        SearchResult candidate =
-            MakeResult(seed.clip, *std::move(warps[i].warp), seed.frame / factor);
+        SearchResult candidate = MakeResult(seed.clip, library.clip(seed.clip).clip_id,
+                                            *std::move(warps[i].warp), seed.frame / factor);
         ToClipFrames(factor, seed.frame % factor, candidate);
         if (seed.anchor != anchor) {
           candidate.seed_frame = candidate.path[warp_anchor];

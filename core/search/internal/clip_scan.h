@@ -45,7 +45,7 @@ struct ClipScanWorkspace {
 // threshold are dropped. Uses slope_limit and dtw_dims of `params`; `stop` is told every
 // column's cells. Adds its cells and skipped blocks to `stats`.
 absl::Status ScanClip(CoordinateView query, CoordinateView clip, int64_t first_frame,
-                      int frame_step, int clip_index, const SearchParams& params,
+                      int frame_step, int clip_index, int64_t clip_id, const SearchParams& params,
                       const SearchFilter& filter, StopPoll& stop, absl::FunctionRef<float()> bound,
                       ClipScanWorkspace& workspace, StreamingTopResults& top, SearchStats& stats);
 

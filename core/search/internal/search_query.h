@@ -36,9 +36,9 @@ struct SearchFilter : FrameSelector {
 absl::StatusOr<SearchFilter> PrepareQuery(const LibraryIndex& library, CoordinateView query,
                                           const SearchParams& params);
 
-// A candidate: the clip by index, the warp's frames and score. Its clip id, name and times are
-// filled by FinishResults, only for the results kept.
-SearchResult MakeResult(int clip_index, Warp warp, int64_t seed_frame);
+// A candidate: the clip by index and id (equal scores rank by id), the warp's frames and score.
+// Its name and times are filled by FinishResults, only for the results kept.
+SearchResult MakeResult(int clip_index, int64_t clip_id, Warp warp, int64_t seed_frame);
 
 // The candidates `filter` admits, ranked (RankResults), then each kept result's clip id, name
 // and start and end in seconds.
