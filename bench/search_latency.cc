@@ -20,9 +20,12 @@
 
 #include "absl/strings/str_cat.h"
 #include "bench/measure.h"
+#include "bench/window_vector_baseline.h"
+#include "cluster/shard_map.h"
 #include "core/bvh/bvh_reader.h"
 #include "core/index/library_index.h"
 #include "core/search/exact_search.h"
+#include "core/search/merge_part_results.h"
 #include "core/search/motion_search.h"
 #include "core/space/search_coordinates.h"
 #include "testing/perturbed_copy.h"
@@ -224,6 +227,8 @@ struct VariantFlags {
   std::vector<int> shape_clips;        // candidates from the query's shape (kShapeWindows)
   std::vector<int> threads;            // the default search on these many threads
   std::vector<int> shape_windows;      // their windows a length (empty: the default)
+  std::vector<int> parts;              // the library split in these many shards (ShardOfClip)
+  bool baseline = true;                // the window-vector baseline beside (issue 39)
 };
 
 // The fast search as configured by default (the thesis's seeds, refined), without
@@ -290,6 +295,111 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
     variants.emplace_back(absl::StrCat("fast, ", count, " distinct places"), params);
   }
   return variants;
+}
+
+// The window-vector baseline over the whole library, on the fast search's queries.
+absl::Status BaselineRun(const Bench& bench, const Run& exact, int count) {
+  const Clock::time_point start = Clock::now();
+  MOTIONDB_ASSIGN_OR_RETURN(const std::unique_ptr<bench::WindowVectorBaseline> baseline,
+                            bench::WindowVectorBaseline::Build(*bench.library, {}));
+  const double build_s = SecondsSince(start);
+  Run run;
+  for (int q = 0; q < count && q < static_cast<int>(bench.queries.size()); ++q) {
+    const Clock::time_point query_start = Clock::now();
+    std::vector<SearchResult> results = baseline->Search(
+        CoordinateView::Of(bench.queries[q].coordinates), SearchParams().max_results, {});
+    run.latencies.push_back(SecondsSince(query_start) * 1000);
+    run.responses.push_back({.results = std::move(results), .stats = {}});
+  }
+  std::printf(
+      "window baseline: build %.1f s, %.1f MiB: p50 %.3f ms  p99 %.3f ms | recall@10 vs "
+      "exact %.3f\n",
+      build_s, baseline->memory_bytes() / 1048576.0, Percentile(run.latencies, 0.5),
+      Percentile(run.latencies, 0.99), RecallAtTen(run, exact));
+  return absl::OkStatus();
+}
+
+// The library split in `count` parts by ShardOfClip, as a cluster's shards hold it, each part
+// searched alone with the defaults and the parts' answers merged (MergePartResults): latency of
+// the slowest part (shards on machines of their own) and of the parts one after another (one
+// machine), recall against the whole library's exact search, and the exact search over the parts
+// merged against the whole's.
+absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queries) {
+  const LibraryIndex& whole = *bench.library;
+  std::vector<std::vector<LibraryClip>> clips(count);
+  for (int c = 0; c < whole.clip_count(); ++c) {
+    const LibraryIndex::ClipEntry& entry = whole.clip(c);
+    clips[cluster::ShardOfClip(entry.clip_id, count)].push_back(
+        {entry.clip_id, entry.name, entry.tags, whole.CopyClipCoordinates(c)});
+  }
+  std::vector<std::unique_ptr<LibraryIndex>> parts;
+  for (std::vector<LibraryClip>& part : clips) {
+    if (part.empty()) continue;
+    MOTIONDB_ASSIGN_OR_RETURN(std::unique_ptr<LibraryIndex> index,
+                              LibraryIndex::Build(std::move(part), whole.rate(), {}));
+    parts.push_back(std::move(index));
+  }
+  const auto search_parts = [&](int q, bool exact_mode, std::vector<double>& slowest,
+                                std::vector<double>& serial,
+                                double& seeds) -> absl::StatusOr<SearchResponse> {
+    SearchParams params;
+    params.characteristic_frame = bench.queries[q].characteristic_frame;
+    const CoordinateView query = CoordinateView::Of(bench.queries[q].coordinates);
+    std::vector<std::vector<SearchResult>> answers;
+    double max_ms = 0, sum_ms = 0;
+    for (const std::unique_ptr<LibraryIndex>& part : parts) {
+      MOTIONDB_ASSIGN_OR_RETURN(SearchResponse answer, exact_mode
+                                                           ? ExactSearch(*part, query, params)
+                                                           : Search(*part, query, params));
+      max_ms = std::max(max_ms, answer.stats.total_ms);
+      sum_ms += answer.stats.total_ms;
+      seeds += answer.stats.seeds;
+      answers.push_back(std::move(answer.results));
+    }
+    slowest.push_back(max_ms);
+    serial.push_back(sum_ms);
+    SearchResponse merged{.results = MergePartResults(std::move(answers), params.max_results),
+                          .stats = {}};
+    // RecallAtTen compares results by the whole library's clip indices.
+    for (SearchResult& result : merged.results) result.clip_index = whole.FindClip(result.clip_id);
+    return merged;
+  };
+  Run fast;
+  std::vector<double> serial;
+  double seeds = 0;
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    for (int q = 0; q < queries && q < static_cast<int>(bench.queries.size()); ++q) {
+      MOTIONDB_ASSIGN_OR_RETURN(SearchResponse merged,
+                                search_parts(q, false, fast.latencies, serial, seeds));
+      if (repeat == 0) fast.responses.push_back(std::move(merged));
+    }
+  }
+  bool same = true;
+  std::vector<double> exact_slowest, exact_serial;
+  double exact_seeds = 0;
+  for (size_t q = 0; q < exact.responses.size(); ++q) {
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const SearchResponse merged,
+        search_parts(static_cast<int>(q), true, exact_slowest, exact_serial, exact_seeds));
+    const std::vector<SearchResult>& want = exact.responses[q].results;
+    same = same && merged.results.size() == want.size();
+    for (size_t i = 0; same && i < want.size(); ++i) {
+      same = merged.results[i].clip_id == want[i].clip_id &&
+             merged.results[i].first_frame == want[i].first_frame &&
+             merged.results[i].last_frame == want[i].last_frame &&
+             merged.results[i].score == want[i].score;
+    }
+  }
+  std::printf(
+      "fast over %d parts (ShardOfClip): p50 %.3f ms, p99 %.3f ms of the slowest part; parts one "
+      "after another p50 %.3f ms | %.0f seeds | recall@10 vs exact %.3f\n",
+      count, Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99),
+      Percentile(serial, 0.5), seeds / std::max<size_t>(1, serial.size()),
+      RecallAtTen(fast, exact));
+  std::printf("exact over %d parts, merged: p50 %.1f ms of the slowest part | results %s\n", count,
+              Percentile(exact_slowest, 0.5), same ? "identical" : "DIFFER");
+  std::fflush(stdout);
+  return absl::OkStatus();
 }
 
 absl::Status Scenario(const std::string& name, double duration_s, double rate, int queries,
@@ -360,6 +470,10 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
         run.seeds_ms, run.clusters_ms, run.warps_ms, run.refine_ms, run.ranking_ms, run.seeds,
         run.clusters, run.warps, run.results, RecallAtTen(run, exact));
     std::fflush(stdout);
+  }
+  if (variant_flags.baseline) MOTIONDB_RETURN_IF_ERROR(BaselineRun(bench, exact, queries));
+  for (const int count : variant_flags.parts) {
+    MOTIONDB_RETURN_IF_ERROR(PartsRun(bench, count, exact, queries));
   }
   std::printf("exact, 1 thread: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
@@ -478,6 +592,14 @@ int main(int argc, char** argv) {
                  "numbers of threads (SearchParams::threads)")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(1));
+  app.add_option("--parts", variants.parts,
+                 "also measure the library split in these many parts by ShardOfClip, as a "
+                 "cluster's shards hold it, each searched alone and the answers merged")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(2));
+  app.add_flag("--baseline,!--no-baseline", variants.baseline,
+               "the window-vector baseline beside (on by default)")
+      ->capture_default_str();
   app.add_option("--shape-windows", variants.shape_windows,
                  "--shapes: with each of these numbers of windows a length "
                  "(SearchParams::shape_windows; default: its default)")
