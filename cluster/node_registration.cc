@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "cluster/cluster_keys.h"
+#include "cluster/internal/lease_keeper.h"
 #include "util/status_macros.h"
 
 namespace motiondb::cluster {
@@ -32,6 +33,7 @@ NodeRegistration::NodeRegistration(const EtcdClient& etcd, const ClusterOptions&
       options_(options),
       key_(NodeKey(options.cluster, options.node.node_id)),
       on_change_(std::move(on_change)),
+      lease_(std::make_unique<LeaseKeeper>(etcd, options.lease_ttl)),
       info_(options.node) {}
 
 NodeRegistration::~NodeRegistration() {
@@ -41,7 +43,6 @@ NodeRegistration::~NodeRegistration() {
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
-  if (lease_ != 0) etcd_.RevokeLease(lease_).IgnoreError();  // else it expires within its TTL
 }
 
 void NodeRegistration::SetShards(std::vector<int> shards) {
@@ -73,16 +74,8 @@ absl::Status NodeRegistration::WriteKey(int64_t lease, const std::string& value)
 }
 
 absl::Status NodeRegistration::Step() {
-  if (lease_ != 0) {
-    const absl::StatusOr<absl::Duration> renewed = etcd_.KeepAlive(lease_);
-    if (absl::IsNotFound(renewed.status())) {
-      lease_ = 0;  // expired while etcd was away or this process was stopped: register afresh
-    } else if (!renewed.ok()) {
-      return renewed.status();
-    }
-  }
-  if (lease_ == 0) {
-    MOTIONDB_ASSIGN_OR_RETURN(lease_, etcd_.GrantLease(options_.lease_ttl));
+  MOTIONDB_ASSIGN_OR_RETURN(const bool new_lease, lease_->Renew());
+  if (new_lease) {
     std::lock_guard<std::mutex> lock(mutex_);
     dirty_ = true;
   }
@@ -93,15 +86,14 @@ absl::Status NodeRegistration::Step() {
     value = info_.ToJson();
     dirty_ = false;
   }
-  const absl::Status written = WriteKey(lease_, value);
+  const absl::Status written = WriteKey(lease_->id(), value);
   if (!written.ok()) {
     std::lock_guard<std::mutex> lock(mutex_);
     dirty_ = true;
   }
   if (absl::IsAlreadyExists(written)) {
     // Ours would keep the id from its holder once that one dies; take a new lease next time.
-    etcd_.RevokeLease(lease_).IgnoreError();
-    lease_ = 0;
+    lease_->Drop();
   }
   return written;
 }

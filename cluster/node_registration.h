@@ -20,6 +20,8 @@
 
 namespace motiondb::cluster {
 
+class LeaseKeeper;
+
 class NodeRegistration {
  public:
   // Registers once before returning. ALREADY_EXISTS, naming the holder, when a live node holds
@@ -52,6 +54,7 @@ class NodeRegistration {
   const ClusterOptions options_;
   const std::string key_;
   const std::function<void(bool)> on_change_;
+  const std::unique_ptr<LeaseKeeper> lease_;  // the thread's (and Start's, before it runs)
   std::atomic<bool> registered_{false};
   std::string last_problem_;  // the thread's alone: a problem is logged when it changes
 
@@ -60,7 +63,6 @@ class NodeRegistration {
   NodeInfo info_;          // guarded by mutex_
   bool dirty_ = true;      // guarded by mutex_: the key needs writing
   bool stopping_ = false;  // guarded by mutex_
-  int64_t lease_ = 0;      // the thread's (and Start's, before it runs)
   std::thread thread_;
 };
 
