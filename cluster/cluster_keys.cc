@@ -28,6 +28,10 @@ std::string ClipNameKey(const std::string& cluster, const std::string& name) {
   return absl::StrCat("/", cluster, "/clip_names/", name);
 }
 
+std::string ElectionKey(const std::string& cluster, const std::string& office) {
+  return absl::StrCat("/", cluster, "/elections/", office);
+}
+
 absl::StatusOr<int64_t> PositiveDecimalOf(const std::string& key, const std::string& value) {
   // std::from_chars, unlike absl::SimpleAtoi, takes neither a sign nor spaces: digits only.
   int64_t number = 0;

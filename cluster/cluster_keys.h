@@ -24,6 +24,8 @@ std::string NextClipIdKey(const std::string& cluster);
 // ranged over or watched by prefix, so a name holding '/' or beginning another has a key of its
 // own all the same.
 std::string ClipNameKey(const std::string& cluster, const std::string& name);
+// /CLUSTER/elections/OFFICE: the node id of the office's leader, under its lease (LeaderElection).
+std::string ElectionKey(const std::string& cluster, const std::string& office);
 
 // The positive decimal number (a clip id) that `key` holds as `value`; FAILED_PRECONDITION naming
 // the key otherwise, since only motiondb writes these keys.

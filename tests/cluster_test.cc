@@ -1,12 +1,16 @@
 // The cluster layer against real etcd processes on loopback (testing/etcd_processes.h): the
-// client, the shard map's compare-and-swap, membership under a lease, the map's watch, failover
-// between etcd members, and a real motiondb-server --cluster through etcd going away and back.
-// Every wait polls with a generous bound; nothing asserts how long something took.
+// client, the shard map's compare-and-swap, membership under a lease, the map's watch, the
+// election of a leader, failover between etcd members, and a real motiondb-server --cluster
+// through etcd going away and back. Every wait polls with a generous bound; nothing asserts how
+// long something took.
 #include <signal.h>
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -18,6 +22,7 @@
 #include "cluster/clip_names.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/etcd_client.h"
+#include "cluster/leader_election.h"
 #include "cluster/node_address.h"
 #include "cluster/node_info.h"
 #include "cluster/node_registration.h"
@@ -73,6 +78,41 @@ bool Listed(const EtcdClient& client, const std::string& cluster, const std::str
     if (node.node_id == node_id) return true;
   }
   return false;
+}
+
+// What a candidate's on_change said, in order.
+class Changes {
+ public:
+  std::function<void(bool)> Recorder() {
+    return [this](bool leading) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      said_.push_back(leading);
+    };
+  }
+  std::vector<bool> said() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return said_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<bool> said_;
+};
+
+// A candidate for the office "jobs" of the cluster "elect".
+std::unique_ptr<LeaderElection> Candidate(const EtcdClient& client, const std::string& node_id,
+                                          std::function<void(bool)> on_change = nullptr,
+                                          absl::Duration lease_ttl = absl::Seconds(2)) {
+  absl::StatusOr<std::unique_ptr<LeaderElection>> election =
+      LeaderElection::Start(client, "elect", "jobs", node_id, lease_ttl, std::move(on_change));
+  EXPECT_TRUE(election.ok()) << election.status();
+  return election.ok() ? std::move(*election) : nullptr;
+}
+
+std::optional<std::string> LeaderOf(const LeaderElection& election) {
+  const absl::StatusOr<std::optional<std::string>> leader = election.CurrentLeader();
+  EXPECT_TRUE(leader.ok()) << leader.status();
+  return leader.ok() ? *leader : std::nullopt;
 }
 
 TEST(ShardMapTest, ShardOfClipIsFixedForEver) {
@@ -399,6 +439,91 @@ TEST_F(ClusterEtcdTest, ClipNamesWithSlashesAndPrefixesAreEachTheirOwn) {
   EXPECT_EQ(*names.Lookup("run/"), std::nullopt);
 }
 
+TEST_F(ClusterEtcdTest, OneOfTwoCandidatesLeadsAndTheOtherTakesOverWhenItResigns) {
+  const std::unique_ptr<EtcdClient> other_client = ClientOf(etcd_);
+  std::unique_ptr<LeaderElection> a = Candidate(*client_, "a");
+  const std::unique_ptr<LeaderElection> b = Candidate(*other_client, "b");
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(PollUntil([&] { return a->leading(); }));  // first to try, it took the office
+  EXPECT_FALSE(b->leading());
+  EXPECT_EQ(LeaderOf(*b), "a");
+
+  a.reset();  // resigns
+  EXPECT_TRUE(PollUntil([&] { return b->leading(); }));
+  EXPECT_EQ(LeaderOf(*b), "b");
+}
+
+TEST_F(ClusterEtcdTest, ALaterCandidateWaitsItsTurn) {
+  const std::unique_ptr<EtcdClient> other_client = ClientOf(etcd_);
+  std::unique_ptr<LeaderElection> a = Candidate(*client_, "a");
+  std::unique_ptr<LeaderElection> b = Candidate(*other_client, "b");
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(PollUntil([&] { return a->leading(); }));
+  std::unique_ptr<LeaderElection> c = Candidate(*client_, "c");
+  ASSERT_TRUE(c);
+  EXPECT_FALSE(c->leading());
+  EXPECT_EQ(LeaderOf(*c), "a");
+
+  a.reset();
+  ASSERT_TRUE(PollUntil([&] { return b->leading() || c->leading(); }));
+  std::unique_ptr<LeaderElection>& next = b->leading() ? b : c;
+  std::unique_ptr<LeaderElection>& last = b->leading() ? c : b;
+  EXPECT_FALSE(last->leading());
+  next.reset();
+  EXPECT_TRUE(PollUntil([&] { return last->leading(); }));
+}
+
+TEST_F(ClusterEtcdTest, ALeaderWhoseLeaseIsRevokedStepsDown) {
+  const std::unique_ptr<EtcdClient> other_client = ClientOf(etcd_);
+  Changes a_changes;
+  const std::unique_ptr<LeaderElection> a = Candidate(*client_, "a", a_changes.Recorder());
+  const std::unique_ptr<LeaderElection> b = Candidate(*other_client, "b");
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(PollUntil([&] { return a->leading(); }));
+  const absl::StatusOr<std::optional<KeyValue>> held = client_->Get(ElectionKey("elect", "jobs"));
+  ASSERT_TRUE(held.ok() && held->has_value());
+  ASSERT_TRUE(client_->RevokeLease((*held)->lease).ok());  // behind a's back
+
+  EXPECT_TRUE(PollUntil([&] { return a_changes.said() == std::vector<bool>{true, false}; }));
+  EXPECT_TRUE(PollUntil([&] { return b->leading(); }));
+  EXPECT_FALSE(a->leading());
+  EXPECT_EQ(LeaderOf(*a), "b");
+}
+
+TEST_F(ClusterEtcdTest, ALeaderCutOffFromEtcdStepsDownAndLeadsAgainOnItsReturn) {
+  Changes a_changes;
+  const std::unique_ptr<LeaderElection> a = Candidate(*client_, "a", a_changes.Recorder());
+  ASSERT_TRUE(a);
+  ASSERT_TRUE(PollUntil([&] { return a->leading(); }));
+  etcd_.Stop(0, /*graceful=*/true);
+  // It cannot renew: once the lease may have expired, it says it no longer leads.
+  EXPECT_TRUE(PollUntil([&] { return a_changes.said() == std::vector<bool>{true, false}; }));
+  EXPECT_FALSE(a->leading());
+  std::string error;
+  ASSERT_TRUE(etcd_.Restart(0, &error)) << error;
+  EXPECT_TRUE(PollUntil([&] { return a->leading(); }));
+  EXPECT_EQ(a_changes.said(), (std::vector<bool>{true, false, true}));
+}
+
+TEST_F(ClusterEtcdTest, ElectionRefusesBadNames) {
+  for (const auto& [cluster, office, node_id] :
+       std::vector<std::array<std::string, 3>>{{"", "jobs", "a"},
+                                               {"elect", "", "a"},
+                                               {"elect", "jobs/x", "a"},
+                                               {"elect", "jobs", ""},
+                                               {"elect", "jobs", "a b"},
+                                               {"elect", std::string(65, 'o'), "a"}}) {
+    const absl::StatusOr<std::unique_ptr<LeaderElection>> election =
+        LeaderElection::Start(*client_, cluster, office, node_id, absl::Seconds(2), nullptr);
+    EXPECT_EQ(election.status().code(), absl::StatusCode::kInvalidArgument)
+        << cluster << " " << office << " " << node_id;
+  }
+  EXPECT_EQ(LeaderElection::Start(*client_, "elect", "jobs", "a", absl::Milliseconds(500), nullptr)
+                .status()
+                .code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
 // Three members, so that one can be killed.
 class ClusterFailoverTest : public ClusterEtcdTest {
  protected:
@@ -420,6 +545,29 @@ TEST_F(ClusterFailoverTest, ClientAndWatchGoOnWhenAMemberIsKilled) {
   next.owners[0] = "b";
   ASSERT_TRUE(store.Replace(*stored, next).ok());
   EXPECT_TRUE(PollUntil([&] { return watcher.map()->epoch == 2; }));
+}
+
+TEST_F(ClusterFailoverTest, ALeaderKeepsTheOfficeWhenAMemberIsKilled) {
+  // A lease long enough that etcd electing a new raft leader does not outlast it.
+  constexpr absl::Duration kTtl = absl::Seconds(6);
+  const std::unique_ptr<EtcdClient> other_client = ClientOf(etcd_);
+  Changes a_changes;
+  std::unique_ptr<LeaderElection> a = Candidate(*client_, "a", a_changes.Recorder(), kTtl);
+  const std::unique_ptr<LeaderElection> b = Candidate(*other_client, "b", nullptr, kTtl);
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(PollUntil([&] { return a->leading(); }));
+
+  etcd_.Stop(0, /*graceful=*/false);
+  // Two TTLs: the lease lives on only if renewed through the members left.
+  const auto until = std::chrono::steady_clock::now() + absl::ToChronoMilliseconds(2 * kTtl);
+  while (std::chrono::steady_clock::now() < until) {
+    ASSERT_TRUE(a->leading());
+    ASSERT_FALSE(b->leading());
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(a_changes.said(), std::vector<bool>{true});
+  a.reset();
+  EXPECT_TRUE(PollUntil([&] { return b->leading(); }));
 }
 
 // The standard health answer for the server as a whole ("" service): readiness.
