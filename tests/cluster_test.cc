@@ -466,8 +466,9 @@ TEST_F(ClusterEtcdTest, ALaterCandidateWaitsItsTurn) {
 
   a.reset();
   ASSERT_TRUE(PollUntil([&] { return b->leading() || c->leading(); }));
-  std::unique_ptr<LeaderElection>& next = b->leading() ? b : c;
-  std::unique_ptr<LeaderElection>& last = b->leading() ? c : b;
+  const bool b_leads = b->leading();
+  std::unique_ptr<LeaderElection>& next = b_leads ? b : c;
+  std::unique_ptr<LeaderElection>& last = b_leads ? c : b;
   EXPECT_FALSE(last->leading());
   next.reset();
   EXPECT_TRUE(PollUntil([&] { return last->leading(); }));
