@@ -1,5 +1,7 @@
 #include "cluster/shard_map_watcher.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "cluster/cluster_keys.h"
 
@@ -19,6 +21,7 @@ ShardMapWatcher::ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& o
                   const absl::StatusOr<ShardMap> map = ShardMap::FromJson(event.kv->value);
                   if (map.ok()) {
                     Offer(*map);
+                    SetCurrent(true);  // delivered by the open stream
                   } else if (options_.log) {
                     options_.log(absl::StrCat("cluster '", options_.cluster,
                                               "': ignored a shard map: ", map.status().message()));
@@ -28,7 +31,11 @@ ShardMapWatcher::ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& o
           .resync = [this] { Refresh(); },
           .connected =
               [this](bool connected) {
-                if (connected) Refresh();
+                if (connected) {
+                  Refresh();
+                } else {
+                  SetCurrent(false);
+                }
               }});
 }
 
@@ -39,10 +46,36 @@ std::shared_ptr<const ShardMap> ShardMapWatcher::map() const {
   return map_;
 }
 
+absl::StatusOr<std::shared_ptr<const ShardMap>> ShardMapWatcher::CurrentMap(
+    absl::Time deadline) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const absl::Duration wait = std::max(deadline - absl::Now(), absl::ZeroDuration());
+  if (!current_changed_.wait_for(lock, absl::ToChronoNanoseconds(wait),
+                                 [this] { return current_; })) {
+    return absl::UnavailableError(
+        absl::StrCat("cluster '", options_.cluster,
+                     "': the shard map cannot be confirmed, etcd is unreachable (",
+                     map_ == nullptr ? std::string("no map seen yet")
+                                     : absl::StrCat("the last map seen is epoch ", map_->epoch),
+                     ")"));
+  }
+  return map_;
+}
+
+void ShardMapWatcher::SetCurrent(bool current) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    current_ = current && map_ != nullptr;
+  }
+  current_changed_.notify_all();
+}
+
 void ShardMapWatcher::Refresh() {
   const absl::StatusOr<StoredShardMap> read = store_.Read();
+  SetCurrent(false);  // until the read is offered: a resync means the map held may be old
   if (read.ok()) {
     Offer(read->map);
+    SetCurrent(true);
   } else if (options_.log && map() == nullptr) {
     options_.log(std::string(read.status().message()));  // it names the cluster
   }

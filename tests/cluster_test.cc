@@ -311,6 +311,41 @@ TEST_F(ClusterEtcdTest, WatchDeliversMapChanges) {
   EXPECT_EQ(epochs.back(), 4);
 }
 
+// A write needs a map confirmed by a live watch: with etcd gone CurrentMap fails UNAVAILABLE
+// at its deadline, naming the last epoch, while map() still serves reads; etcd back, it answers.
+TEST_F(ClusterEtcdTest, CurrentMapWaitsForEtcdAndFailsAtItsDeadline) {
+  ShardMapWatcher watcher(*client_, NodeOptions(etcd_, "current", "a"), {});
+  const absl::StatusOr<std::shared_ptr<const ShardMap>> none =
+      watcher.CurrentMap(absl::Now() + absl::Milliseconds(50));
+  EXPECT_EQ(none.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(std::string(none.status().message()), HasSubstr("no map seen yet"));
+  ASSERT_TRUE(ShardMapStore(*client_, "current").Create(4, {"a"}).ok());
+  absl::StatusOr<std::shared_ptr<const ShardMap>> current =
+      watcher.CurrentMap(absl::Now() + absl::Seconds(60));
+  ASSERT_TRUE(current.ok()) << current.status();
+  EXPECT_EQ((*current)->epoch, 1);
+
+  etcd_.Stop(0, /*graceful=*/false);
+  ASSERT_TRUE(PollUntil([&] {
+    return watcher.CurrentMap(absl::Now() + absl::Milliseconds(100)).status().code() ==
+           absl::StatusCode::kUnavailable;
+  }));
+  const absl::StatusOr<std::shared_ptr<const ShardMap>> unconfirmed =
+      watcher.CurrentMap(absl::Now() + absl::Milliseconds(200));
+  EXPECT_EQ(unconfirmed.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(std::string(unconfirmed.status().message()),
+              HasSubstr("cluster 'current': the shard map cannot be confirmed, etcd is "
+                        "unreachable (the last map seen is epoch 1)"));
+  ASSERT_NE(watcher.map(), nullptr);  // reads go on from the last map
+  EXPECT_EQ(watcher.map()->epoch, 1);
+
+  std::string error;
+  ASSERT_TRUE(etcd_.Restart(0, &error)) << error;
+  current = watcher.CurrentMap(absl::Now() + absl::Seconds(60));
+  ASSERT_TRUE(current.ok()) << current.status();
+  EXPECT_EQ((*current)->epoch, 1);
+}
+
 TEST_F(ClusterEtcdTest, ClipIdBlocksHandOutUniqueIdsInWholeBlocks) {
   constexpr int64_t kBlock = 100;
   constexpr int kThreads = 4;
