@@ -26,6 +26,9 @@ std::string NextClipIdKey(const std::string& cluster);
 std::string ClipNameKey(const std::string& cluster, const std::string& name);
 // /CLUSTER/elections/OFFICE: the node id of the office's leader, under its lease (LeaderElection).
 std::string ElectionKey(const std::string& cluster, const std::string& office);
+// The office every router campaigns for: its leader, the job coordinator, is to run the
+// cluster's jobs (propagation), one at a time.
+inline constexpr char kJobsOffice[] = "jobs";
 
 // The positive decimal number (a clip id) that `key` holds as `value`; FAILED_PRECONDITION naming
 // the key otherwise, since only motiondb writes these keys.

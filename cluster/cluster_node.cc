@@ -24,11 +24,25 @@ absl::StatusOr<std::unique_ptr<ClusterNode>> ClusterNode::Start(
       *node->etcd_, options, [registration, node_id](const ShardMap& map) {
         registration->SetShards(map.ShardsOf(node_id));
       });
+  if (options.node.role == "router") {
+    const std::function<void(const std::string&)> log = options.log;
+    const std::string cluster = options.cluster;
+    MOTIONDB_ASSIGN_OR_RETURN(
+        node->election_, LeaderElection::Start(
+                             *node->etcd_, options.cluster, kJobsOffice, node_id, options.lease_ttl,
+                             [log, cluster](bool leading) {
+                               if (!log) return;
+                               log(absl::StrCat("cluster '", cluster, "': ",
+                                                leading ? "this node is" : "this node is no longer",
+                                                " the job coordinator"));
+                             }));
+  }
   return node;
 }
 
 ClusterNode::~ClusterNode() {
-  watcher_.reset();  // it writes to the registration
+  election_.reset();  // resigns, so that another router takes the office at once
+  watcher_.reset();   // it writes to the registration
   registration_.reset();
 }
 

@@ -1,5 +1,6 @@
-// A server's part in a cluster: its registration under a lease and the shard map it follows,
-// both kept up on threads of their own while the server serves. etcd going away stops neither
+// A server's part in a cluster: its registration under a lease, the shard map it follows and, on
+// a router, its campaign to be the job coordinator, each kept up on a thread of its own while
+// the server serves. etcd going away stops neither
 // the server nor this: the node keeps the last map it saw and registers again when etcd is
 // back. Thread-safe.
 #ifndef MOTIONDB_CLUSTER_CLUSTER_NODE_H_
@@ -11,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "cluster/cluster_options.h"
 #include "cluster/etcd_client.h"
+#include "cluster/leader_election.h"
 #include "cluster/node_registration.h"
 #include "cluster/shard_map.h"
 #include "cluster/shard_map_watcher.h"
@@ -37,6 +39,7 @@ class ClusterNode {
   std::unique_ptr<EtcdClient> etcd_;
   std::unique_ptr<NodeRegistration> registration_;
   std::unique_ptr<ShardMapWatcher> watcher_;
+  std::unique_ptr<LeaderElection> election_;  // a router's campaign for kJobsOffice
 };
 
 }  // namespace motiondb::cluster

@@ -728,6 +728,42 @@ TEST_F(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.
+// The routers elect one job coordinator, shown by `motiondb cluster status`; when it is killed
+// another router takes the office once its lease is gone.
+TEST_F(ClusterServerTest, TheRoutersElectOneJobCoordinator) {
+  std::string error;
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_routers");
+  std::map<std::string, testing::ServerProcess> routers;
+  for (const std::string id : {"r1", "r2"}) {
+    ASSERT_TRUE(routers[id].Start(
+        {"--db", (dir / (id + ".sqlite")).string(), "--http", "off", "--quiet", "--cluster",
+         etcd_.endpoints_flag(), "--node-id", id, "--role", "router", "--cluster-lease-s", "2"},
+        &error))
+        << error;
+  }
+  const auto coordinator = [&]() -> std::string {
+    const testing::CommandResult cli =
+        testing::RunCli({"cluster", "status", "--etcd", etcd_.endpoints_flag()});
+    EXPECT_EQ(cli.exit_code, 0) << cli.err;
+    for (const std::string id : {"r1", "r2"}) {
+      if (cli.out.find("job coordinator: " + id + "\n") != std::string::npos) return id;
+    }
+    return "";
+  };
+  std::string first;
+  ASSERT_TRUE(PollUntil([&] { return !(first = coordinator()).empty(); }))
+      << routers["r1"].Log() << routers["r2"].Log();
+  const std::string second = first == "r1" ? "r2" : "r1";
+  routers[first].Stop(SIGKILL);  // no resignation: the office goes with its lease
+  EXPECT_TRUE(PollUntil([&] { return coordinator() == second; })) << routers[second].Log();
+  routers[second].Stop(SIGTERM);  // a clean stop resigns
+  EXPECT_TRUE(PollUntil([&] {
+    const testing::CommandResult cli =
+        testing::RunCli({"cluster", "status", "--etcd", etcd_.endpoints_flag()});
+    return cli.out.find("job coordinator: none") != std::string::npos;
+  }));
+}
+
 TEST_F(ClusterServerTest, RegistersTheAdvertisedAddress) {
   std::string error;
   const std::filesystem::path dir = testing::MakeTempDir("cluster_advertise");
