@@ -228,6 +228,7 @@ struct VariantFlags {
   std::vector<int> threads;            // the default search on these many threads
   std::vector<int> shape_windows;      // their windows a length (empty: the default)
   std::vector<int> parts;              // the library split in these many shards (ShardOfClip)
+  std::vector<int> part_seeds;         // each part also searched with these many seeds
   bool baseline = true;                // the window-vector baseline beside (issue 39)
 };
 
@@ -320,11 +321,13 @@ absl::Status BaselineRun(const Bench& bench, const Run& exact, int count) {
 }
 
 // The library split in `count` parts by ShardOfClip, as a cluster's shards hold it, each part
-// searched alone with the defaults and the parts' answers merged (MergePartResults): latency of
-// the slowest part (shards on machines of their own) and of the parts one after another (one
-// machine), recall against the whole library's exact search, and the exact search over the parts
-// merged against the whole's.
-absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queries) {
+// searched alone and the parts' answers merged (MergePartResults): with each part's default
+// seeds and with each of `part_seeds` nearest-frame seeds a part, the latency of the slowest part
+// (shards on machines of their own) and of the parts one after another (one machine), and recall
+// against the whole library's exact search; then the exact search over the parts merged against
+// the whole's.
+absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queries,
+                      const std::vector<int>& part_seeds) {
   const LibraryIndex& whole = *bench.library;
   std::vector<std::vector<LibraryClip>> clips(count);
   for (int c = 0; c < whole.clip_count(); ++c) {
@@ -339,10 +342,11 @@ absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queri
                               LibraryIndex::Build(std::move(part), whole.rate(), {}));
     parts.push_back(std::move(index));
   }
-  const auto search_parts = [&](int q, bool exact_mode, std::vector<double>& slowest,
-                                std::vector<double>& serial,
+  const auto search_parts = [&](int q, bool exact_mode, int neighbours,
+                                std::vector<double>& slowest, std::vector<double>& serial,
                                 double& seeds) -> absl::StatusOr<SearchResponse> {
     SearchParams params;
+    params.neighbours = neighbours;
     params.characteristic_frame = bench.queries[q].characteristic_frame;
     const CoordinateView query = CoordinateView::Of(bench.queries[q].coordinates);
     std::vector<std::vector<SearchResult>> answers;
@@ -364,15 +368,29 @@ absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queri
     for (SearchResult& result : merged.results) result.clip_index = whole.FindClip(result.clip_id);
     return merged;
   };
-  Run fast;
-  std::vector<double> serial;
-  double seeds = 0;
-  for (int repeat = 0; repeat < 3; ++repeat) {
-    for (int q = 0; q < queries && q < static_cast<int>(bench.queries.size()); ++q) {
-      MOTIONDB_ASSIGN_OR_RETURN(SearchResponse merged,
-                                search_parts(q, false, fast.latencies, serial, seeds));
-      if (repeat == 0) fast.responses.push_back(std::move(merged));
+  std::vector<int> budgets = {0};  // 0: the default for each part's size
+  budgets.insert(budgets.end(), part_seeds.begin(), part_seeds.end());
+  for (const int neighbours : budgets) {
+    Run fast;
+    std::vector<double> serial;
+    double seeds = 0;
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      for (int q = 0; q < queries && q < static_cast<int>(bench.queries.size()); ++q) {
+        MOTIONDB_ASSIGN_OR_RETURN(
+            SearchResponse merged,
+            search_parts(q, false, neighbours, fast.latencies, serial, seeds));
+        if (repeat == 0) fast.responses.push_back(std::move(merged));
+      }
     }
+    const std::string budget =
+        neighbours == 0 ? "default seeds" : absl::StrCat(neighbours, " seeds a part");
+    std::printf(
+        "fast over %d parts (ShardOfClip), %s: p50 %.3f ms, p99 %.3f ms of the slowest part; "
+        "parts one after another p50 %.3f ms | %.0f seeds | recall@10 vs exact %.3f\n",
+        count, budget.c_str(), Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99),
+        Percentile(serial, 0.5), seeds / std::max<size_t>(1, serial.size()),
+        RecallAtTen(fast, exact));
+    std::fflush(stdout);
   }
   bool same = true;
   std::vector<double> exact_slowest, exact_serial;
@@ -380,7 +398,7 @@ absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queri
   for (size_t q = 0; q < exact.responses.size(); ++q) {
     MOTIONDB_ASSIGN_OR_RETURN(
         const SearchResponse merged,
-        search_parts(static_cast<int>(q), true, exact_slowest, exact_serial, exact_seeds));
+        search_parts(static_cast<int>(q), true, 0, exact_slowest, exact_serial, exact_seeds));
     const std::vector<SearchResult>& want = exact.responses[q].results;
     same = same && merged.results.size() == want.size();
     for (size_t i = 0; same && i < want.size(); ++i) {
@@ -390,12 +408,6 @@ absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queri
              merged.results[i].score == want[i].score;
     }
   }
-  std::printf(
-      "fast over %d parts (ShardOfClip): p50 %.3f ms, p99 %.3f ms of the slowest part; parts one "
-      "after another p50 %.3f ms | %.0f seeds | recall@10 vs exact %.3f\n",
-      count, Percentile(fast.latencies, 0.5), Percentile(fast.latencies, 0.99),
-      Percentile(serial, 0.5), seeds / std::max<size_t>(1, serial.size()),
-      RecallAtTen(fast, exact));
   std::printf("exact over %d parts, merged: p50 %.1f ms of the slowest part | results %s\n", count,
               Percentile(exact_slowest, 0.5), same ? "identical" : "DIFFER");
   std::fflush(stdout);
@@ -473,7 +485,7 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
   }
   if (variant_flags.baseline) MOTIONDB_RETURN_IF_ERROR(BaselineRun(bench, exact, queries));
   for (const int count : variant_flags.parts) {
-    MOTIONDB_RETURN_IF_ERROR(PartsRun(bench, count, exact, queries));
+    MOTIONDB_RETURN_IF_ERROR(PartsRun(bench, count, exact, queries, variant_flags.part_seeds));
   }
   std::printf("exact, 1 thread: p50 %.1f ms  p99 %.1f ms  (%zu queries) | %.1f results\n",
               Percentile(exact.latencies, 0.5), Percentile(exact.latencies, 0.99),
@@ -597,6 +609,10 @@ int main(int argc, char** argv) {
                  "cluster's shards hold it, each searched alone and the answers merged")
       ->type_name("N ...")
       ->check(motiondb::cli::WholeAtLeast(2));
+  app.add_option("--part-seeds", variants.part_seeds,
+                 "--parts: each part also searched with these many nearest-frame seeds")
+      ->type_name("N ...")
+      ->check(motiondb::cli::WholeAtLeast(1));
   app.add_flag("--baseline,!--no-baseline", variants.baseline,
                "the window-vector baseline beside (on by default)")
       ->capture_default_str();
