@@ -76,8 +76,9 @@ void EtcdChannels::Failed(size_t member) const {
 
 absl::Status EtcdChannels::Call(
     const std::function<grpc::Status(const std::shared_ptr<grpc::Channel>&, grpc::ClientContext&)>&
-        attempt) const {
-  const absl::Time deadline = absl::Now() + options_.call_timeout;
+        attempt,
+    absl::Time call_deadline) const {
+  const absl::Time deadline = std::min(call_deadline, absl::Now() + options_.call_timeout);
   absl::Status last = absl::UnavailableError("no etcd endpoint");
   const size_t first = current_.load();
   for (size_t tried = 0; tried < channels_.size() && absl::Now() < deadline; ++tried) {

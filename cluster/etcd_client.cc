@@ -21,13 +21,15 @@ KeyValue FromProto(const mvccpb::KeyValue& kv) {
 template <typename Stub, typename Request, typename Response>
 absl::Status Unary(const EtcdChannels& channels,
                    grpc::Status (Stub::*method)(grpc::ClientContext*, const Request&, Response*),
-                   const Request& request, Response* response) {
+                   const Request& request, Response* response,
+                   absl::Time deadline = absl::InfiniteFuture()) {
   return channels.Call(
       [&](const std::shared_ptr<grpc::Channel>& channel, grpc::ClientContext& context) {
         response->Clear();
         Stub stub(channel);
         return (stub.*method)(&context, request, response);
-      });
+      },
+      deadline);
 }
 
 // The transaction's condition: `key`'s mod_revision is `expected_revision`, or the key is absent
@@ -81,11 +83,13 @@ EtcdClient::~EtcdClient() = default;
 
 const EtcdOptions& EtcdClient::options() const { return channels_->options(); }
 
-absl::StatusOr<std::optional<KeyValue>> EtcdClient::Get(const std::string& key) const {
+absl::StatusOr<std::optional<KeyValue>> EtcdClient::Get(const std::string& key,
+                                                        absl::Time deadline) const {
   etcdserverpb::RangeRequest request;
   request.set_key(key);
   etcdserverpb::RangeResponse response;
-  const absl::Status status = Unary(*channels_, &etcdserverpb::KV::Stub::Range, request, &response);
+  const absl::Status status =
+      Unary(*channels_, &etcdserverpb::KV::Stub::Range, request, &response, deadline);
   if (!status.ok()) return status;
   if (response.kvs_size() == 0) return std::nullopt;
   return FromProto(response.kvs(0));

@@ -44,8 +44,10 @@ class EtcdClient {
   static absl::StatusOr<std::unique_ptr<EtcdClient>> Create(EtcdOptions options);
   ~EtcdClient();
 
-  // The key, or nullopt when it is absent.
-  absl::StatusOr<std::optional<KeyValue>> Get(const std::string& key) const;
+  // The key, or nullopt when it is absent; by `deadline` if that is sooner than the call's
+  // timeout. A linearizable read: what etcd holds at some instant during the call.
+  absl::StatusOr<std::optional<KeyValue>> Get(const std::string& key,
+                                              absl::Time deadline = absl::InfiniteFuture()) const;
   // Every key that begins with `prefix`, in key order.
   absl::StatusOr<std::vector<KeyValue>> Range(const std::string& prefix) const;
   // Writes `key` (under `lease` unless 0).

@@ -10,8 +10,9 @@ namespace motiondb::cluster {
 ShardMapStore::ShardMapStore(const EtcdClient& etcd, std::string cluster)
     : etcd_(etcd), cluster_(std::move(cluster)) {}
 
-absl::StatusOr<StoredShardMap> ShardMapStore::Read() const {
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<KeyValue> kv, etcd_.Get(ShardMapKey(cluster_)));
+absl::StatusOr<StoredShardMap> ShardMapStore::Read(absl::Time deadline) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<KeyValue> kv,
+                            etcd_.Get(ShardMapKey(cluster_), deadline));
   if (!kv) {
     return absl::NotFoundError(
         absl::StrCat("cluster '", cluster_, "' is not initialised (motiondb cluster init)"));

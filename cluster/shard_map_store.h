@@ -25,8 +25,9 @@ class ShardMapStore {
   // `etcd` must outlive the store.
   ShardMapStore(const EtcdClient& etcd, std::string cluster);
 
-  // NOT_FOUND, saying to run `motiondb cluster init`, when the cluster has no map.
-  absl::StatusOr<StoredShardMap> Read() const;
+  // NOT_FOUND, saying to run `motiondb cluster init`, when the cluster has no map; by
+  // `deadline` if that is sooner than the etcd call's timeout.
+  absl::StatusOr<StoredShardMap> Read(absl::Time deadline = absl::InfiniteFuture()) const;
   // Creates the map at epoch 1: `shard_count` shards dealt in turn to `node_ids`.
   // ALREADY_EXISTS when the cluster has a map (nothing changed); INVALID_ARGUMENT for a count
   // out of 1..kMaxShardCount or no node.

@@ -6,6 +6,12 @@
 #include "cluster/cluster_keys.h"
 
 namespace motiondb::cluster {
+namespace {
+
+// How often CurrentMap reads the map again while neither a read nor the stream confirms it.
+constexpr absl::Duration kConfirmRetry = absl::Milliseconds(250);
+
+}  // namespace
 
 ShardMapWatcher::ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& options,
                                  std::function<void(const ShardMap&)> on_change)
@@ -48,18 +54,35 @@ std::shared_ptr<const ShardMap> ShardMapWatcher::map() const {
 
 absl::StatusOr<std::shared_ptr<const ShardMap>> ShardMapWatcher::CurrentMap(
     absl::Time deadline) const {
-  std::unique_lock<std::mutex> lock(mutex_);
-  const absl::Duration wait = std::max(deadline - absl::Now(), absl::ZeroDuration());
-  if (!current_changed_.wait_for(lock, absl::ToChronoNanoseconds(wait),
-                                 [this] { return current_; })) {
-    return absl::UnavailableError(
-        absl::StrCat("cluster '", options_.cluster,
-                     "': the shard map cannot be confirmed, etcd is unreachable (",
-                     map_ == nullptr ? std::string("no map seen yet")
-                                     : absl::StrCat("the last map seen is epoch ", map_->epoch),
-                     ")"));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (current_) return map_;
   }
-  return map_;
+  // Not confirmed by the stream (none open, or its first read failed): a read of the map
+  // confirms it as of that read, tried again until the deadline.
+  for (;;) {
+    const absl::StatusOr<StoredShardMap> read = store_.Read(deadline);
+    if (absl::IsNotFound(read.status())) return read.status();  // no cluster: no waiting helps
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (read.ok() || current_) {
+      if (read.ok() && (map_ == nullptr || read->map.epoch > map_->epoch)) {
+        return std::make_shared<const ShardMap>(read->map);  // the watch will offer it too
+      }
+      return map_;  // as new as the read, or confirmed by the stream meanwhile
+    }
+    const absl::Duration left = deadline - absl::Now();
+    if (left <= absl::ZeroDuration()) {
+      return absl::UnavailableError(
+          absl::StrCat("cluster '", options_.cluster, "': the shard map cannot be confirmed (",
+                       map_ == nullptr ? std::string("no map seen yet")
+                                       : absl::StrCat("the last map seen is epoch ", map_->epoch),
+                       "): ", read.status().message()));
+    }
+    // Woken early when the stream confirms the map; else read again.
+    current_changed_.wait_for(lock, absl::ToChronoNanoseconds(std::min(left, kConfirmRetry)),
+                              [this] { return current_; });
+    if (current_) return map_;
+  }
 }
 
 void ShardMapWatcher::SetCurrent(bool current) {

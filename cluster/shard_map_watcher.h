@@ -34,11 +34,11 @@ class ShardMapWatcher {
   // The newest map seen; nullptr before the first (the cluster not initialised yet, or etcd
   // unreachable since the start).
   std::shared_ptr<const ShardMap> map() const;
-  // The newest map, once it is known to be current: read from etcd, or delivered, since the watch
-  // stream last opened, and that stream still open (its member has a leader: a member cut off
-  // from the others ends it). Waits for that until `deadline`, then UNAVAILABLE naming the last
-  // epoch seen: what a write needs, so that it never goes to a shard's old node after a move it
-  // could not hear of.
+  // The newest map, known to be current: held since the watch stream opened and still open (its
+  // member has a leader: a member cut off from the others ends it), or else read from etcd now
+  // (a linearizable read), again until `deadline`, then UNAVAILABLE naming the last epoch seen;
+  // NOT_FOUND when the cluster has no map. What a write needs, so that it never goes to a
+  // shard's old node after a move it could not hear of.
   absl::StatusOr<std::shared_ptr<const ShardMap>> CurrentMap(absl::Time deadline) const;
 
  private:

@@ -318,8 +318,8 @@ TEST_F(ClusterEtcdTest, CurrentMapWaitsForEtcdAndFailsAtItsDeadline) {
   ShardMapWatcher watcher(*client_, NodeOptions(etcd_, "current", "a"), {});
   const absl::StatusOr<std::shared_ptr<const ShardMap>> none =
       watcher.CurrentMap(absl::Now() + absl::Milliseconds(50));
-  EXPECT_EQ(none.status().code(), absl::StatusCode::kUnavailable);
-  EXPECT_THAT(std::string(none.status().message()), HasSubstr("no map seen yet"));
+  EXPECT_EQ(none.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(none.status().message()), HasSubstr("motiondb cluster init"));
   ASSERT_TRUE(ShardMapStore(*client_, "current").Create(4, {"a"}).ok());
   absl::StatusOr<std::shared_ptr<const ShardMap>> current =
       watcher.CurrentMap(absl::Now() + absl::Seconds(60));
@@ -335,8 +335,8 @@ TEST_F(ClusterEtcdTest, CurrentMapWaitsForEtcdAndFailsAtItsDeadline) {
       watcher.CurrentMap(absl::Now() + absl::Milliseconds(200));
   EXPECT_EQ(unconfirmed.status().code(), absl::StatusCode::kUnavailable);
   EXPECT_THAT(std::string(unconfirmed.status().message()),
-              HasSubstr("cluster 'current': the shard map cannot be confirmed, etcd is "
-                        "unreachable (the last map seen is epoch 1)"));
+              HasSubstr("cluster 'current': the shard map cannot be confirmed (the last map "
+                        "seen is epoch 1): etcd is unreachable"));
   ASSERT_NE(watcher.map(), nullptr);  // reads go on from the last map
   EXPECT_EQ(watcher.map()->epoch, 1);
 
