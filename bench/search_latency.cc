@@ -298,6 +298,14 @@ std::vector<std::pair<std::string, SearchParams>> Variants(const VariantFlags& f
   return variants;
 }
 
+// Whether two answers hold the same results in the same order: clips (by id), frames and scores.
+bool SameResults(const std::vector<SearchResult>& a, const std::vector<SearchResult>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+    return x.clip_id == y.clip_id && x.first_frame == y.first_frame &&
+           x.last_frame == y.last_frame && x.score == y.score;
+  });
+}
+
 // The window-vector baseline over the whole library, on the fast search's queries.
 absl::Status BaselineRun(const Bench& bench, const Run& exact, int count) {
   const Clock::time_point start = Clock::now();
@@ -399,14 +407,7 @@ absl::Status PartsRun(const Bench& bench, int count, const Run& exact, int queri
     MOTIONDB_ASSIGN_OR_RETURN(
         const SearchResponse merged,
         search_parts(static_cast<int>(q), true, 0, exact_slowest, exact_serial, exact_seeds));
-    const std::vector<SearchResult>& want = exact.responses[q].results;
-    same = same && merged.results.size() == want.size();
-    for (size_t i = 0; same && i < want.size(); ++i) {
-      same = merged.results[i].clip_id == want[i].clip_id &&
-             merged.results[i].first_frame == want[i].first_frame &&
-             merged.results[i].last_frame == want[i].last_frame &&
-             merged.results[i].score == want[i].score;
-    }
+    same = same && SameResults(merged.results, exact.responses[q].results);
   }
   std::printf("exact over %d parts, merged: p50 %.1f ms of the slowest part | results %s\n", count,
               Percentile(exact_slowest, 0.5), same ? "identical" : "DIFFER");
@@ -441,13 +442,7 @@ absl::Status Scenario(const std::string& name, double duration_s, double rate, i
                             RunQueries(bench, two_threads, true, exact_queries, 1));
   bool same = exact.responses.size() == exact2.responses.size();
   for (size_t q = 0; same && q < exact.responses.size(); ++q) {
-    const std::vector<SearchResult>&a = exact.responses[q].results,
-          &b = exact2.responses[q].results;
-    same = a.size() == b.size();
-    for (size_t i = 0; same && i < a.size(); ++i) {
-      same = a[i].clip_index == b[i].clip_index && a[i].first_frame == b[i].first_frame &&
-             a[i].last_frame == b[i].last_frame && a[i].score == b[i].score;
-    }
+    same = SameResults(exact.responses[q].results, exact2.responses[q].results);
   }
   if (!variant_flags.windows.empty()) {
     // The first window search builds the window index; the variants' times are without it.

@@ -86,10 +86,12 @@ absl::Status ClusterStatus(const ClusterCommandFlags& flags) {
   } else {
     absl::PrintF("%s\n", stored.status().message());
   }
-  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<cluster::KeyValue> coordinator,
-                            etcd->Get(cluster::ElectionKey(flags.cluster, cluster::kJobsOffice)));
+  const absl::StatusOr<std::optional<cluster::KeyValue>> coordinator =
+      etcd->Get(cluster::ElectionKey(flags.cluster, cluster::kJobsOffice));
   absl::PrintF("job coordinator: %s\n",
-               coordinator ? coordinator->value : "none (no live router holds the office)");
+               !coordinator.ok() ? std::string(coordinator.status().message())
+               : *coordinator    ? (*coordinator)->value
+                                 : std::string("none (no live router holds the office)"));
   absl::PrintF("%d live nodes\n", nodes.size());
   absl::PrintF("  %-16s %-7s %-22s %-10s %s\n", "NODE", "ROLE", "ADDRESS", "LEASE LEFT",
                "SHARDS IN THE MAP");

@@ -33,7 +33,8 @@ std::string ElectionKey(const std::string& cluster, const std::string& office) {
 }
 
 absl::StatusOr<int64_t> PositiveDecimalOf(const std::string& key, const std::string& value) {
-  // std::from_chars, unlike absl::SimpleAtoi, takes neither a sign nor spaces: digits only.
+  // std::from_chars, unlike absl::SimpleAtoi, takes neither '+' nor spaces; a '-' it takes is
+  // refused below with every number under 1.
   int64_t number = 0;
   const char* end = value.data() + value.size();
   const std::from_chars_result parsed = std::from_chars(value.data(), end, number);

@@ -79,7 +79,14 @@ absl::Status EtcdChannels::Call(
         attempt,
     absl::Time call_deadline) const {
   const absl::Time deadline = std::min(call_deadline, absl::Now() + options_.call_timeout);
-  absl::Status last = absl::UnavailableError("no etcd endpoint");
+  // The caller's own deadline ending an attempt says nothing of the member: it is not failed
+  // over, and the caller is told its deadline passed.
+  const auto caller_deadline_passed = [&] {
+    return absl::DeadlineExceededError(absl::StrCat("the call's deadline passed before etcd (",
+                                                    absl::StrJoin(options_.endpoints, ","),
+                                                    ") answered"));
+  };
+  absl::Status last = absl::UnavailableError("no member tried within the call's timeout");
   const size_t first = current_.load();
   for (size_t tried = 0; tried < channels_.size() && absl::Now() < deadline; ++tried) {
     const size_t member = (first + tried) % channels_.size();
@@ -88,9 +95,11 @@ absl::Status EtcdChannels::Call(
         absl::ToChronoTime(std::min(deadline, absl::Now() + options_.attempt_timeout)));
     const grpc::Status status = attempt(channels_[member], context);
     if (!MemberUnreachable(status)) return FromGrpc(status, options_.endpoints[member]);
+    if (absl::Now() >= call_deadline) return caller_deadline_passed();
     last = FromGrpc(status, options_.endpoints[member]);
     Failed(member);
   }
+  if (absl::Now() >= call_deadline) return caller_deadline_passed();
   return absl::UnavailableError(absl::StrCat(
       "etcd is unreachable (", absl::StrJoin(options_.endpoints, ","), "): ", last.message()));
 }

@@ -149,6 +149,10 @@ absl::StatusOr<SwapOutcome> EtcdClient::CompareAndSwap(const std::string& key,
 
 absl::StatusOr<bool> EtcdClient::DeleteIfRevision(const std::string& key,
                                                   int64_t expected_revision) const {
+  if (expected_revision < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a delete of '", key, "' by revision needs a revision, not ", expected_revision));
+  }
   etcdserverpb::TxnRequest request;
   CompareRevision(key, expected_revision, &request);
   request.add_success()->mutable_request_delete_range()->set_key(key);

@@ -45,7 +45,8 @@ class EtcdClient {
   ~EtcdClient();
 
   // The key, or nullopt when it is absent; by `deadline` if that is sooner than the call's
-  // timeout. A linearizable read: what etcd holds at some instant during the call.
+  // timeout (DEADLINE_EXCEEDED once it passes). A linearizable read: what etcd holds at some
+  // instant during the call.
   absl::StatusOr<std::optional<KeyValue>> Get(const std::string& key,
                                               absl::Time deadline = absl::InfiniteFuture()) const;
   // Every key that begins with `prefix`, in key order.

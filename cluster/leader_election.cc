@@ -28,8 +28,8 @@ absl::StatusOr<std::unique_ptr<LeaderElection>> LeaderElection::Start(
   }
   std::unique_ptr<LeaderElection> election(new LeaderElection(
       etcd, ElectionKey(cluster, office), node_id, lease_ttl, std::move(on_change)));
-  const bool ok = election->Step().ok();
-  election->thread_ = std::thread([raw = election.get(), ok] { raw->Run(ok); });
+  // The first attempt too is the thread's: a server starts without waiting on etcd.
+  election->thread_ = std::thread([raw = election.get()] { raw->Run(); });
   return election;
 }
 
@@ -51,8 +51,9 @@ LeaderElection::~LeaderElection() {
   if (thread_.joinable()) thread_.join();
   // Revoking the lease deletes the key too; deleted first, the office is free at once even when
   // the revocation fails (the lease then lives out its TTL). By revision, so that a key another
-  // candidate holds by now stays.
-  if (revision_ != 0) etcd_.DeleteIfRevision(key_, revision_).IgnoreError();
+  // candidate holds by now stays. Not when etcd did not answer the last step: the call would
+  // only wait out its timeout, and the key goes with the lease anyway.
+  if (revision_ != 0 && last_step_ok_) etcd_.DeleteIfRevision(key_, revision_).IgnoreError();
 }
 
 bool LeaderElection::leading() const {
@@ -76,8 +77,11 @@ void LeaderElection::SetLeading(bool leading) {
   if (on_change_) on_change_(leading);
 }
 
-void LeaderElection::Lose() {
+void LeaderElection::Lose(bool drop_lease) {
   revision_ = 0;
+  // A renewal that may have come too late may still have kept the key: dropped with the lease,
+  // the office is free now rather than held by no one who knows it.
+  if (drop_lease) lease_->Drop();
   // Standing back a TTL before trying again lets a candidate that has been waiting (trying every
   // third of it) take the office, rather than a leader cut off from etcd racing it on its return.
   stand_back_until_ = Clock::now() + absl::ToChronoMilliseconds(lease_ttl_);
@@ -85,7 +89,7 @@ void LeaderElection::Lose() {
 }
 
 void LeaderElection::CheckLease() {
-  if (revision_ != 0 && Clock::now() >= lease_->surely_until()) Lose();
+  if (revision_ != 0 && Clock::now() >= lease_->surely_until()) Lose(/*drop_lease=*/true);
 }
 
 absl::Status LeaderElection::Step() {
@@ -95,12 +99,13 @@ absl::Status LeaderElection::Step() {
     CheckLease();
     return new_lease.status();
   }
-  if (*new_lease && revision_ != 0) Lose();  // the old lease expired, and the key with it
+  if (*new_lease && revision_ != 0) Lose(false);  // the old lease expired, and the key with it
+  if (Stopping()) return absl::OkStatus();
   if (revision_ != 0) {
     // The key must be the one written: deleted or rewritten, another may have led meanwhile.
     MOTIONDB_ASSIGN_OR_RETURN(const std::optional<KeyValue> held, etcd_.Get(key_));
     if (!held || held->mod_revision != revision_) {
-      Lose();
+      Lose(false);
       return absl::OkStatus();
     }
   } else {
@@ -115,21 +120,29 @@ absl::Status LeaderElection::Step() {
       return absl::OkStatus();  // another leads
     }
   }
+  // The calls took longer than the lease surely lives: not a leader to report.
+  if (Clock::now() >= lease_->surely_until()) {
+    Lose(/*drop_lease=*/true);
+    return absl::OkStatus();
+  }
   SetLeading(true);
   return absl::OkStatus();
 }
 
-void LeaderElection::Run(bool last_ok) {
+bool LeaderElection::Stopping() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stopping_;
+}
+
+void LeaderElection::Run() {
   for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      Clock::time_point next =
-          Clock::now() + absl::ToChronoMilliseconds(last_ok ? lease_ttl_ / 3 : kRetryPause);
-      // Leading, wake when the lease may run out, to say so then rather than after a retry.
-      if (revision_ != 0) next = std::min(next, lease_->surely_until());
-      if (wake_.wait_until(lock, next, [this] { return stopping_; })) return;
-    }
-    last_ok = Step().ok();
+    last_step_ok_ = Step().ok();
+    std::unique_lock<std::mutex> lock(mutex_);
+    Clock::time_point next =
+        Clock::now() + absl::ToChronoMilliseconds(last_step_ok_ ? lease_ttl_ / 3 : kRetryPause);
+    // Leading, wake when the lease may run out, to say so then rather than after a retry.
+    if (revision_ != 0) next = std::min(next, lease_->surely_until());
+    if (wake_.wait_until(lock, next, [this] { return stopping_; })) return;
   }
 }
 

@@ -39,9 +39,10 @@ class LeaseKeeper;
 class LeaderElection {
  public:
   // Campaigns for `office` of `cluster` as `node_id` (INVALID_ARGUMENT for a name CheckClusterName
-  // refuses, or a TTL under a second, etcd's unit), trying once before returning; etcd unreachable
-  // is no error: the campaign goes on until it answers. `on_change` runs whenever leading()
-  // changes (the first time possibly within Start). `etcd` must outlive the election.
+  // refuses, or a TTL under a second, etcd's unit); its thread tries at once, so the server
+  // starting it never waits on etcd, and etcd unreachable is no error: the campaign goes on
+  // until it answers. `on_change` runs whenever leading() changes, on its thread. `etcd` must
+  // outlive the election.
   static absl::StatusOr<std::unique_ptr<LeaderElection>> Start(
       const EtcdClient& etcd, const std::string& cluster, const std::string& office,
       const std::string& node_id, absl::Duration lease_ttl,
@@ -64,10 +65,12 @@ class LeaderElection {
                  absl::Duration lease_ttl, std::function<void(bool)> on_change);
   // Renews the lease, then tries for the office or checks that it still holds it.
   absl::Status Step();
-  void Run(bool last_ok);
+  void Run();
+  bool Stopping() const;
   // Leading no longer once the lease may have expired.
   void CheckLease();
-  void Lose();
+  // `drop_lease` when the key may still be held under the lease (a renewal late, not lost).
+  void Lose(bool drop_lease);
   void SetLeading(bool leading);
 
   const EtcdClient& etcd_;
@@ -79,7 +82,8 @@ class LeaderElection {
   const std::unique_ptr<LeaseKeeper> lease_;
   int64_t revision_ = 0;  // the key's mod_revision while leading; 0 otherwise
   Clock::time_point stand_back_until_;
-  bool reported_ = false;  // what on_change was last told
+  bool reported_ = false;      // what on_change was last told
+  bool last_step_ok_ = false;  // whether etcd answered the last step
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -28,6 +28,7 @@ absl::StatusOr<bool> LeaseKeeper::Renew() {
 void LeaseKeeper::Drop() {
   if (id_ != 0) etcd_.RevokeLease(id_).IgnoreError();  // else it expires within its TTL
   id_ = 0;
+  surely_until_ = {};
 }
 
 }  // namespace motiondb::cluster

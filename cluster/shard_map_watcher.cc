@@ -8,8 +8,8 @@
 namespace motiondb::cluster {
 namespace {
 
-// How often CurrentMap reads the map again while neither a read nor the stream confirms it.
-constexpr absl::Duration kConfirmRetry = absl::Milliseconds(250);
+// Between CurrentMap's reads while etcd is unreachable.
+constexpr absl::Duration kReadRetry = absl::Milliseconds(250);
 
 }  // namespace
 
@@ -27,7 +27,6 @@ ShardMapWatcher::ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& o
                   const absl::StatusOr<ShardMap> map = ShardMap::FromJson(event.kv->value);
                   if (map.ok()) {
                     Offer(*map);
-                    SetCurrent(true);  // delivered by the open stream
                   } else if (options_.log) {
                     options_.log(absl::StrCat("cluster '", options_.cluster,
                                               "': ignored a shard map: ", map.status().message()));
@@ -37,11 +36,7 @@ ShardMapWatcher::ShardMapWatcher(const EtcdClient& etcd, const ClusterOptions& o
           .resync = [this] { Refresh(); },
           .connected =
               [this](bool connected) {
-                if (connected) {
-                  Refresh();
-                } else {
-                  SetCurrent(false);
-                }
+                if (connected) Refresh();
               }});
 }
 
@@ -52,53 +47,30 @@ std::shared_ptr<const ShardMap> ShardMapWatcher::map() const {
   return map_;
 }
 
-absl::StatusOr<std::shared_ptr<const ShardMap>> ShardMapWatcher::CurrentMap(
-    absl::Time deadline) const {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (current_) return map_;
-  }
-  // Not confirmed by the stream (none open, or its first read failed): a read of the map
-  // confirms it as of that read, tried again until the deadline.
+absl::StatusOr<ShardMap> ShardMapWatcher::CurrentMap(absl::Time deadline) const {
   for (;;) {
     const absl::StatusOr<StoredShardMap> read = store_.Read(deadline);
-    if (absl::IsNotFound(read.status())) return read.status();  // no cluster: no waiting helps
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (read.ok() || current_) {
-      if (read.ok() && (map_ == nullptr || read->map.epoch > map_->epoch)) {
-        return std::make_shared<const ShardMap>(read->map);  // the watch will offer it too
-      }
-      return map_;  // as new as the read, or confirmed by the stream meanwhile
-    }
+    if (read.ok()) return read->map;
+    const bool unreachable =
+        absl::IsUnavailable(read.status()) || absl::IsDeadlineExceeded(read.status());
     const absl::Duration left = deadline - absl::Now();
+    if (!unreachable) return read.status();  // no cluster, or a map that is not one
     if (left <= absl::ZeroDuration()) {
+      const std::shared_ptr<const ShardMap> last = map();
       return absl::UnavailableError(
-          absl::StrCat("cluster '", options_.cluster, "': the shard map cannot be confirmed (",
-                       map_ == nullptr ? std::string("no map seen yet")
-                                       : absl::StrCat("the last map seen is epoch ", map_->epoch),
+          absl::StrCat("cluster '", options_.cluster, "': the shard map cannot be read (",
+                       last == nullptr ? std::string("no map seen yet")
+                                       : absl::StrCat("the last map seen is epoch ", last->epoch),
                        "): ", read.status().message()));
     }
-    // Woken early when the stream confirms the map; else read again.
-    current_changed_.wait_for(lock, absl::ToChronoNanoseconds(std::min(left, kConfirmRetry)),
-                              [this] { return current_; });
-    if (current_) return map_;
+    absl::SleepFor(std::min(left, kReadRetry));
   }
-}
-
-void ShardMapWatcher::SetCurrent(bool current) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    current_ = current && map_ != nullptr;
-  }
-  current_changed_.notify_all();
 }
 
 void ShardMapWatcher::Refresh() {
   const absl::StatusOr<StoredShardMap> read = store_.Read();
-  SetCurrent(false);  // until the read is offered: a resync means the map held may be old
   if (read.ok()) {
     Offer(read->map);
-    SetCurrent(true);
   } else if (options_.log && map() == nullptr) {
     options_.log(std::string(read.status().message()));  // it names the cluster
   }

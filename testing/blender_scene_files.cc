@@ -14,7 +14,8 @@ std::string Quoted(const std::string& text) {
   return quoted + "'";
 }
 
-// Blender's log, shown when it failed: its last lines say why, and a runaway log is cut.
+// Blender's log, shown when it failed: its last lines say why. A runaway log (over 1 MiB) is
+// not shown; the error in its place says how large it is.
 std::string BlenderLog(const std::filesystem::path& path) {
   const absl::StatusOr<std::string> log = ReadFileBytes(path.string(), int64_t{1} << 20);
   return log.ok() ? *log : log.status().ToString();

@@ -981,11 +981,16 @@ TEST(StreamingTopResults, KeepsWhatOneOrderedListKeeps) {
   for (int round = 0; round < 100; ++round) {
     const int k = 1 + static_cast<int>(random() % 40);
     const int clips = 1 + static_cast<int>(random() % 6);
+    // Clip ids in another order than the indices: ties go by id.
+    std::vector<int64_t> ids(clips);
+    for (int c = 0; c < clips; ++c) ids[c] = 100 + c;
+    std::shuffle(ids.begin(), ids.end(), random);
     std::vector<SearchResult> offers;
     StreamingTopResults top(k, 0.5, 10);
     for (int i = 0; i < 200; ++i) {
       SearchResult& offer = offers.emplace_back();
       offer.clip_index = static_cast<int>(random() % clips);
+      offer.clip_id = ids[offer.clip_index];
       offer.first_frame = static_cast<int64_t>(random() % 400);
       offer.last_frame = offer.first_frame + 5 + static_cast<int64_t>(random() % 30);
       offer.score = static_cast<double>(random() % 50) / 8;  // many ties

@@ -21,8 +21,8 @@ class EtcdChannels {
 
   // Runs `attempt` on the member last known good, then on the next ones while it fails as a
   // member that is down or cut off fails (UNAVAILABLE, or its attempt's deadline), each member
-  // at most once and all within the call's timeout, or by `deadline` when that is sooner. The
-  // context carries the deadline.
+  // at most once and all within the call's timeout, or by `deadline` when that is sooner
+  // (passed, it is DEADLINE_EXCEEDED and no member is blamed). The context carries the deadline.
   // A write retried this way may have been applied by the member that did not answer: callers
   // keep their writes idempotent or compare-and-swap.
   absl::Status Call(const std::function<grpc::Status(const std::shared_ptr<grpc::Channel>& channel,

@@ -30,8 +30,9 @@ class LeaseKeeper {
   void Drop();
 
   int64_t id() const { return id_; }
-  // Until when the lease surely lives: the start of the last successful Renew plus the TTL etcd
-  // gave. etcd counts the TTL from when it received the renewal, later than its start here.
+  // Until when the lease surely lives: the start of the last successful Renew plus the TTL (the
+  // TTL asked for at a grant, which etcd may only raise; the TTL etcd gives at a renewal). etcd
+  // counts it from when it received the call, later than its start here. The epoch once dropped.
   std::chrono::steady_clock::time_point surely_until() const { return surely_until_; }
 
  private:

@@ -14,7 +14,9 @@ namespace motiondb {
 // part: results of different clips never overlap, so the whole library's best are the best of
 // the parts' best, and nothing more is dropped. Exact for the exact search. The results' clip
 // ids must be set and unique across parts (ties go by them); their clip_index stays each part's
-// own, so the merged list must not be ranked again with Overlaps, which compares indices.
+// own, so the merged list must not be ranked again with Overlaps, which compares indices. A
+// search filtered to clips (SearchParams::clip_ids) gives each part only its own clips: a part
+// refuses a clip it does not hold.
 std::vector<SearchResult> MergePartResults(std::vector<std::vector<SearchResult>> parts,
                                            int max_results);
 

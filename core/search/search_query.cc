@@ -88,7 +88,6 @@ std::vector<SearchResult> FinishResults(const LibraryIndex& library, const Searc
       RankResults(std::move(candidates), params.max_overlap, params.max_results);
   for (SearchResult& result : results) {
     const LibraryIndex::ClipEntry& clip = library.clip(result.clip_index);
-    result.clip_id = clip.clip_id;
     result.clip_name = clip.name;
     result.start_s = result.first_frame / library.rate();
     result.end_s = result.last_frame / library.rate();
