@@ -25,8 +25,11 @@ class ClipIdBlocks {
                int64_t block_size = kDefaultBlockSize);
 
   // The next id of the block held, reserving a new block first when it is used up (or none is
-  // held yet). ABORTED when other routers changed the counter under every attempt of a
-  // reservation; FAILED_PRECONDITION, naming the key, when the counter holds no positive number.
+  // held yet). UNAVAILABLE while etcd is unreachable; ABORTED when other routers changed the
+  // counter under every attempt of a reservation; FAILED_PRECONDITION, naming the key, when the
+  // counter holds no positive number; RESOURCE_EXHAUSTED past int64's ids; INVALID_ARGUMENT for a
+  // block size under 1. A counter deleted by hand starts again at 1: ids then repeat, so the key
+  // is never to be touched but by this class.
   absl::StatusOr<int64_t> Next();
 
  private:
