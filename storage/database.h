@@ -95,6 +95,9 @@ struct InsertClipOptions {
   // insert's transaction, so that a crash leaves the old clip or the new one, never neither.
   // 0: none.
   int64_t replace_clip_id = 0;
+  // The new clip's id; 0: the database assigns the next. A cluster's shards take the ids their
+  // router hands out (cluster/clip_id_blocks.h), so that an id names one clip cluster-wide.
+  int64_t clip_id = 0;
 };
 
 // What UpdateClip changes; what is left unset or empty stays.
@@ -221,7 +224,8 @@ class Database {
   // Stores a clip, finding or creating its skeleton and computing its content hash, together
   // with its projection into every space of that skeleton (`projections`: one per space, keyed
   // by space id), in one transaction; first deletes options.replace_clip_id, when given. Returns
-  // the new clip id. ALREADY_EXISTS when another clip of that name exists; NOT_FOUND for an
+  // the new clip id. ALREADY_EXISTS when another clip of that name, or options.clip_id, exists
+  // (INVALID_ARGUMENT when that is negative); NOT_FOUND for an
   // unknown space or clip to replace; FAILED_PRECONDITION when `projections` misses a space of
   // the skeleton or names one of another; INVALID_ARGUMENT for a name that breaks
   // ClipRecord::name's rules, a tag of 0 or over 128 bytes or of text util/name_text.h refuses,

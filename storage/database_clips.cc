@@ -244,6 +244,10 @@ absl::StatusOr<int64_t> Database::InsertClip(
       CheckName("source file name", record.source_file, kMaxNameBytes, /*may_be_empty=*/true));
   MOTIONDB_ASSIGN_OR_RETURN(const std::vector<std::string> tags, CanonicalTags(record.tags));
   MOTIONDB_RETURN_IF_ERROR(CheckFloat32Range(clip.positions(), "clip position"));
+  if (options.clip_id < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("clip id ", options.clip_id, ": a clip's id is positive"));
+  }
   absl::flat_hash_set<int64_t> space_ids;
   for (const auto& [space_id, projection] : projections) {
     if (!space_ids.insert(space_id).second) {
@@ -271,27 +275,37 @@ absl::StatusOr<int64_t> Database::InsertClip(
                         absl::StrCat("clip ", options.replace_clip_id, " to replace not found")));
     }
     MOTIONDB_RETURN_IF_ERROR(CheckNameFree(db, "clips", "clip", record.name));
+    if (options.clip_id != 0) {
+      MOTIONDB_ASSIGN_OR_RETURN(
+          const bool taken, Exists(db, "SELECT 1 FROM clips WHERE clip_id = ?", options.clip_id));
+      if (taken) {
+        return absl::AlreadyExistsError(
+            absl::StrCat("clip id ", options.clip_id, " is another clip's"));
+      }
+    }
     MOTIONDB_ASSIGN_OR_RETURN(const int64_t skeleton_id,
                               FindOrCreateSkeleton(db, clip.skeleton(), key, now));
     MOTIONDB_ASSIGN_OR_RETURN(
         SqliteStatement insert,
-        db.Prepare("INSERT INTO clips (name, source_file, skeleton_id, frame_time, frame_count, "
-                   "joint_count, position_joint_count, layout, rotations, positions, "
+        db.Prepare("INSERT INTO clips (clip_id, name, source_file, skeleton_id, frame_time, "
+                   "frame_count, joint_count, position_joint_count, layout, rotations, positions, "
                    "created_unix_ms, content_hash, provenance) "
-                   "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
-    MOTIONDB_RETURN_IF_ERROR(insert.BindText(1, record.name)
-                                 .BindText(2, record.source_file)
-                                 .BindInt64(3, skeleton_id)
-                                 .BindDouble(4, clip.frame_time())
-                                 .BindInt64(5, clip.frame_count())
-                                 .BindInt64(6, clip.skeleton().joint_count())
-                                 .BindInt64(7, clip.skeleton().position_joint_count())
-                                 .BindBlob(8, layout)
-                                 .BindZeroBlob(9, clip.rotations().size() * sizeof(float))
-                                 .BindBlob(10, positions)
-                                 .BindInt64(11, now)
-                                 .BindText(12, content_hash)
-                                 .BindText(13, record.provenance)
+                   "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+    // Left unbound, the id is NULL: SQLite's next.
+    if (options.clip_id != 0) insert.BindInt64(1, options.clip_id);
+    MOTIONDB_RETURN_IF_ERROR(insert.BindText(2, record.name)
+                                 .BindText(3, record.source_file)
+                                 .BindInt64(4, skeleton_id)
+                                 .BindDouble(5, clip.frame_time())
+                                 .BindInt64(6, clip.frame_count())
+                                 .BindInt64(7, clip.skeleton().joint_count())
+                                 .BindInt64(8, clip.skeleton().position_joint_count())
+                                 .BindBlob(9, layout)
+                                 .BindZeroBlob(10, clip.rotations().size() * sizeof(float))
+                                 .BindBlob(11, positions)
+                                 .BindInt64(12, now)
+                                 .BindText(13, content_hash)
+                                 .BindText(14, record.provenance)
                                  .Run());
     clip_id = db.last_insert_rowid();
     if (!record.source_facts.format.empty()) {

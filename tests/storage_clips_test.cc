@@ -296,6 +296,32 @@ TEST_F(StorageTest, ClipNamesMayBeRelativePaths) {
   EXPECT_EQ(taken.status().code(), absl::StatusCode::kAlreadyExists);
 }
 
+// A cluster's shard stores clips under the ids its router hands out.
+TEST_F(StorageTest, AClipMayBeGivenItsId) {
+  const Clip clip = Motion(testing::ChainSkeleton(), 4);
+  const InsertClipOptions given{.replace_clip_id = 0, .clip_id = 5001};
+  const absl::StatusOr<int64_t> stored = Db().InsertClip(Named("routed"), clip, {}, given);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  EXPECT_EQ(*stored, 5001);
+  EXPECT_EQ(Db().GetClipRecordByName("routed")->clip_id, 5001);
+  ExpectSameFrames(clip, Db().GetClip(5001)->clip);
+
+  // An id held, or not positive, is refused and stores nothing.
+  const Counts before = CountsNow();
+  const absl::StatusOr<int64_t> taken = Db().InsertClip(Named("other"), clip, {}, given);
+  EXPECT_EQ(taken.status().code(), absl::StatusCode::kAlreadyExists);
+  EXPECT_THAT(taken.status().message(), HasSubstr("5001"));
+  const absl::StatusOr<int64_t> negative =
+      Db().InsertClip(Named("other"), clip, {}, {.replace_clip_id = 0, .clip_id = -3});
+  EXPECT_EQ(negative.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
+  EXPECT_EQ(Db().GetClipRecordByName("other").status().code(), absl::StatusCode::kNotFound);
+
+  // An id below the highest is free to be given; the database's own come after the highest.
+  EXPECT_EQ(*Db().InsertClip(Named("lower"), clip, {}, {.replace_clip_id = 0, .clip_id = 7}), 7);
+  EXPECT_EQ(Insert(Named("next"), clip), 5002);
+}
+
 TEST_F(StorageTest, MalformedNamesAndTagsAreRefused) {
   const Clip clip = Motion(testing::ChainSkeleton(), 4);
   Insert(Named("kept", {"tag"}), clip);
@@ -400,26 +426,29 @@ TEST_F(StorageSpaceTest, ReplaceSwapsTheClipInOneTransaction) {
   // A replace whose insert fails after the delete leaves the old clip, its label and projection.
   Projection projection;
   projection.coordinates = RowMatrixXf::Ones(3, 2);
-  EXPECT_EQ(Db().InsertClip(Named("take_001"), run, {{999, projection}}, {.replace_clip_id = walk})
+  EXPECT_EQ(Db().InsertClip(Named("take_001"), run, {{999, projection}},
+                            {.replace_clip_id = walk, .clip_id = 0})
                 .status()
                 .code(),
             absl::StatusCode::kNotFound);
   // So does one whose name belongs to a clip other than the replaced one.
   EXPECT_EQ(Db().InsertClip(Named("take_002"), run, {{space_id, ProjectionOf(0, run)}},
-                            {.replace_clip_id = walk})
+                            {.replace_clip_id = walk, .clip_id = 0})
                 .status()
                 .code(),
             absl::StatusCode::kAlreadyExists);
-  const absl::StatusOr<int64_t> unknown = Db().InsertClip(
-      Named("take_009"), run, {{space_id, ProjectionOf(0, run)}}, {.replace_clip_id = 4242});
+  const absl::StatusOr<int64_t> unknown =
+      Db().InsertClip(Named("take_009"), run, {{space_id, ProjectionOf(0, run)}},
+                      {.replace_clip_id = 4242, .clip_id = 0});
   EXPECT_EQ(unknown.status().code(), absl::StatusCode::kNotFound);
   EXPECT_THAT(unknown.status().message(), HasSubstr("4242"));
   EXPECT_EQ(AsTuple(CountsNow()), AsTuple(before));
   EXPECT_EQ(Db().GetClipRecord(walk)->content_hash, old_hash);
 
   const Projection run_projection = ProjectionOf(0, run);
-  const absl::StatusOr<int64_t> replaced = Db().InsertClip(
-      Named("take_001", {"new"}), run, {{space_id, run_projection}}, {.replace_clip_id = walk});
+  const absl::StatusOr<int64_t> replaced =
+      Db().InsertClip(Named("take_001", {"new"}), run, {{space_id, run_projection}},
+                      {.replace_clip_id = walk, .clip_id = 0});
   ASSERT_TRUE(replaced.ok()) << replaced.status();
   EXPECT_GT(*replaced, other);
   EXPECT_EQ(Db().GetClip(walk).status().code(), absl::StatusCode::kNotFound);

@@ -250,7 +250,8 @@ TEST_F(StorageSpaceTest, WritesStoppedBeforeTheCommitChangeNothing) {
       {Db().GetSpaceRecord("body")->space_id, ProjectionOf(0, walk_)}};
   const std::vector<absl::Status> stopped = {
       Db().InsertClip(Named("walk2"), walk_, walk_projection, {}, stop).status(),
-      Db().InsertClip(Named("walk"), walk_, walk_projection, {.replace_clip_id = walk}, stop)
+      Db().InsertClip(Named("walk"), walk_, walk_projection,
+                      {.replace_clip_id = walk, .clip_id = 0}, stop)
           .status(),
       Db().UpdateClip(walk, {.name = "renamed", .add_tags = {"b"}}, stop).status(),
       Db().DeleteClip(walk, stop),
