@@ -14,7 +14,7 @@ absl::StatusOr<std::unique_ptr<ClusterNode>> ClusterNode::Start(
     return absl::InvalidArgumentError(
         absl::StrCat("--role '", options.node.role, "': want shard or router"));
   }
-  std::unique_ptr<ClusterNode> node(new ClusterNode());
+  std::unique_ptr<ClusterNode> node(new ClusterNode(options.node.node_id));
   MOTIONDB_ASSIGN_OR_RETURN(node->etcd_, EtcdClient::Create(options.etcd));
   MOTIONDB_ASSIGN_OR_RETURN(node->registration_, NodeRegistration::Start(*node->etcd_, options,
                                                                          std::move(on_registered)));
@@ -38,6 +38,16 @@ absl::StatusOr<std::unique_ptr<ClusterNode>> ClusterNode::Start(
                              }));
   }
   return node;
+}
+
+absl::Status ClusterNode::CheckClipOwner(int64_t clip_id, absl::Time deadline) const {
+  MOTIONDB_ASSIGN_OR_RETURN(const ShardMap map, watcher_->CurrentMap(deadline));
+  const int shard = ShardOfClip(clip_id, map.shard_count());
+  const std::string& owner = map.owners[shard];
+  if (owner == node_id_) return absl::OkStatus();
+  return absl::FailedPreconditionError(absl::StrCat(
+      "clip ", clip_id, "'s shard ", shard, " is node '", owner, "''s in the map of epoch ",
+      map.epoch, ", not this node's ('", node_id_, "'): route the write by the newest map"));
 }
 
 ClusterNode::~ClusterNode() {

@@ -8,8 +8,12 @@
 
 #include <functional>
 #include <memory>
+#include <string>
+#include <utility>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "cluster/cluster_options.h"
 #include "cluster/etcd_client.h"
 #include "cluster/leader_election.h"
@@ -32,9 +36,16 @@ class ClusterNode {
   bool registered() const { return registration_->registered(); }
   // The newest map seen, nullptr before the first.
   std::shared_ptr<const ShardMap> map() const { return watcher_->map(); }
+  // A shard node's check before it stores a write on clip `clip_id`: OK when the map as etcd holds
+  // it now (ShardMapWatcher::CurrentMap, by `deadline`) gives the clip's shard to this node;
+  // FAILED_PRECONDITION naming the shard, its node and the map's epoch when it gives it another
+  // (the write was routed by an older map); UNAVAILABLE or NOT_FOUND as CurrentMap.
+  absl::Status CheckClipOwner(int64_t clip_id, absl::Time deadline) const;
 
  private:
-  ClusterNode() = default;
+  explicit ClusterNode(std::string node_id) : node_id_(std::move(node_id)) {}
+
+  const std::string node_id_;
 
   std::unique_ptr<EtcdClient> etcd_;
   std::unique_ptr<NodeRegistration> registration_;

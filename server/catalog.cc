@@ -116,7 +116,7 @@ absl::Status Catalog::IndexIngested(
 }
 
 absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& record,
-                                                 const Clip& clip, OnConflict on_conflict,
+                                                 const Clip& clip, const IngestClipOptions& options,
                                                  const std::function<bool()>& should_stop) {
   std::lock_guard<std::mutex> lock(write_mutex_);
   // Decided before the projections are computed, which a skip or a refusal does not need. The
@@ -125,7 +125,7 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
   absl::StatusOr<storage::ClipRecord> existing = database_.GetClipRecordByName(record.name);
   if (existing.ok()) {
     MOTIONDB_ASSIGN_OR_RETURN(std::optional<IngestedClip> kept,
-                              ResolveConflict(*existing, clip, on_conflict));
+                              ResolveConflict(*existing, clip, options.on_conflict));
     if (kept) return *std::move(kept);
     replaced = *std::move(existing);
   } else if (!absl::IsNotFound(existing.status())) {
@@ -146,11 +146,11 @@ absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& reco
         SearchCoordinates(*space->space, clip, -1, space->space->canonical() ? &*map : nullptr));
     projections.push_back({space->record.space_id, storage::Projection{0, std::move(coordinates)}});
   }
-  storage::InsertClipOptions options;
-  if (replaced) options.replace_clip_id = replaced->clip_id;
+  const storage::InsertClipOptions insert{.replace_clip_id = replaced ? replaced->clip_id : 0,
+                                          .clip_id = options.clip_id};
   MOTIONDB_ASSIGN_OR_RETURN(
       const int64_t clip_id,
-      database_.InsertClip(record, clip, projections, options, {.should_stop = should_stop}));
+      database_.InsertClip(record, clip, projections, insert, {.should_stop = should_stop}));
   IngestedClip ingested;
   MOTIONDB_ASSIGN_OR_RETURN(ingested.record, database_.GetClipRecord(clip_id));
   if (replaced) {

@@ -59,6 +59,13 @@ struct IngestedClip {
 
 inline constexpr int kMaxDuplicatesReported = 10;
 
+struct IngestClipOptions {
+  OnConflict on_conflict = OnConflict::kSkipIdentical;  // when a clip of its name exists
+  // The new clip's id; 0: the database's next. A cluster's shard stores the ids its router hands
+  // out (cluster/clip_id_blocks.h); a replacement may keep the replaced clip's.
+  int64_t clip_id = 0;
+};
+
 class Catalog {
  public:
   Catalog(storage::Database& database, IndexRegistry& registry)
@@ -69,12 +76,12 @@ class Catalog {
   absl::Status LoadIndices();
 
   // Stores the clip with its projection into every space of its skeleton, or, when a clip of
-  // its name exists, does what `on_conflict` says: ALREADY_EXISTS (whose message, for
+  // its name exists, does what `options.on_conflict` says: ALREADY_EXISTS (whose message, for
   // kSkipIdentical, says how to skip or replace), skip, or replace the existing clip in the
-  // database and in every resident index. The database assigns the clip's id, skeleton,
-  // creation time and content hash.
+  // database and in every resident index. The database assigns the clip's skeleton, creation
+  // time and content hash, and its id unless `options` gives it (ALREADY_EXISTS when held).
   absl::StatusOr<IngestedClip> IngestClip(const storage::ClipRecord& record, const Clip& clip,
-                                          OnConflict on_conflict = OnConflict::kSkipIdentical,
+                                          const IngestClipOptions& options = {},
                                           const std::function<bool()>& should_stop = {});
   absl::Status DeleteClip(int64_t clip_id, const std::function<bool()>& should_stop = {});
   // Renames and re-tags a clip (storage::Database::UpdateClip's rules and errors), and gives

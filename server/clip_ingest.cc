@@ -35,7 +35,10 @@ absl::StatusOr<IngestOutcome> IngestTake(Catalog& catalog, const IngestRequest& 
   record.source_facts = facts;
   MOTIONDB_ASSIGN_OR_RETURN(
       IngestedClip ingested,
-      catalog.IngestClip(record, take.clip, request.on_conflict, should_stop));
+      catalog.IngestClip(record, take.clip,
+                         {.on_conflict = request.on_conflict,
+                          .clip_id = request.routed ? request.routed->clip_id : 0},
+                         should_stop));
   IngestOutcome outcome;
   outcome.clip = std::move(ingested.record);
   outcome.result = ingested.result;
@@ -92,8 +95,16 @@ absl::StatusOr<IngestedFile> IngestParsedUpload(Catalog& catalog, const IngestRe
   ingested.generator = std::move(file.generator);
   const bool several = file.takes.size() > 1;
   const storage::SourceFacts facts = FactsOf(file);
+  if (request.routed && (request.routed->take < 0 ||
+                         static_cast<size_t>(request.routed->take) >= file.takes.size())) {
+    return absl::InvalidArgumentError(absl::StrCat("take ", request.routed->take, ": '",
+                                                   request.file_name, "' has ", file.takes.size(),
+                                                   " takes"));
+  }
   std::vector<std::string> stored;
-  for (UploadedTake& take : file.takes) {
+  for (size_t t = 0; t < file.takes.size(); ++t) {
+    if (request.routed && static_cast<size_t>(request.routed->take) != t) continue;
+    UploadedTake& take = file.takes[t];
     const std::string take_name = several ? absl::StrCat(name, "/", take.name) : name;
     // The file's warnings go with its first clip.
     absl::StatusOr<IngestOutcome> outcome =

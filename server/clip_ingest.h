@@ -4,6 +4,7 @@
 #define MOTIONDB_SERVER_CLIP_INGEST_H_
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,13 @@ struct IngestRequest {
   std::vector<std::string> tags;
   // When a clip of that name exists.
   OnConflict on_conflict = OnConflict::kSkipIdentical;
+  // A cluster shard's part of an ingest its router spread over the shards: only the take of this
+  // index (in the file's order) is stored, under this id. Unset: every take, the database's ids.
+  struct Routed {
+    int take = 0;
+    int64_t clip_id = 0;
+  };
+  std::optional<Routed> routed;
 };
 
 struct IngestOutcome {

@@ -17,14 +17,18 @@
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/cluster_node.h"
 #include "cluster/node_address.h"
@@ -119,6 +123,29 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
   cluster->options.log = [](const std::string& line) { motiondb::server::LogLine(line); };
   return absl::OkStatus();
 }
+
+// The cluster node once it has joined, for the shard service's checks: the server starts serving
+// first, since the node advertises the port it listens on.
+class JoinedNode {
+ public:
+  void Set(std::shared_ptr<motiondb::cluster::ClusterNode> node) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    node_ = std::move(node);
+  }
+  absl::Status CheckClipOwner(int64_t clip_id, absl::Time deadline) const {
+    std::shared_ptr<motiondb::cluster::ClusterNode> node;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      node = node_;
+    }
+    if (node == nullptr) return absl::UnavailableError("this node is not in its cluster yet");
+    return node->CheckClipOwner(clip_id, deadline);
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::shared_ptr<motiondb::cluster::ClusterNode> node_;
+};
 
 // Joins the cluster as the node at `server`'s port: ready (health, /readyz) only while
 // registered.
@@ -376,6 +403,12 @@ int main(int argc, char** argv) {
   http_options.connections.max_per_peer = options.connections.max_per_peer;
   FitConnectionsToDescriptors(app, options.connections,
                               http_options.listen != "off" ? &http_options.connections : nullptr);
+  const auto joined_node = std::make_shared<JoinedNode>();
+  if (!cluster.etcd.empty() && cluster.options.node.role == "shard") {
+    options.check_shard_owner = [joined_node](int64_t clip_id, absl::Time deadline) {
+      return joined_node->CheckClipOwner(clip_id, deadline);
+    };
+  }
   absl::StatusOr<std::unique_ptr<motiondb::server::MotionDbServer>> server =
       motiondb::server::MotionDbServer::Start(options);
   if (!server.ok()) {
@@ -392,7 +425,6 @@ int main(int argc, char** argv) {
     }
     http = *std::move(started);
   }
-  std::unique_ptr<motiondb::cluster::ClusterNode> cluster_node;
   if (!cluster.etcd.empty()) {
     absl::StatusOr<std::unique_ptr<motiondb::cluster::ClusterNode>> joined =
         JoinCluster(cluster, options.listen, **server);
@@ -400,7 +432,7 @@ int main(int argc, char** argv) {
       std::cerr << "motiondb-server: " << joined.status().message() << "\n";
       return 1;
     }
-    cluster_node = *std::move(joined);
+    joined_node->Set(*std::move(joined));
   }
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);
@@ -412,7 +444,7 @@ int main(int argc, char** argv) {
   const auto steady_deadline = std::chrono::steady_clock::now() + kShutdownGrace;
   // Leaving the cluster first (its lease revoked) tells the others at once, and ends the
   // registration's readiness changes before Shutdown() turns the health NOT_SERVING.
-  cluster_node.reset();
+  joined_node->Set(nullptr);  // a shard service call under way may hold it a moment longer
   if (http) http->BeginStop();
   (*server)->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
   if (http) http->Stop(steady_deadline);

@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 
+#include "motiondb/shard/v1/shard_service.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/grpc/auth_failure_limiter.h"
 #include "server/grpc/method_scopes.h"
@@ -131,15 +132,18 @@ TEST(AccessControlTest, PeersAreCountedByAddress) {
   EXPECT_EQ(AddressOfPeer("ipv6:[::ffff:10.1.2.3]:5555"), "10.1.2.3");
 }
 
-// Every motiondb.v1 method has its scope written down: a new one is not silently admin.
+// Every motiondb.v1 and motiondb.shard.v1 method has its scope written down: a new one is not
+// silently admin.
 TEST(MethodScopesTest, EveryMethodIsInTheTable) {
-  (void)v1::Clip::descriptor();  // the generated pool holds the linked files
+  // The generated pool holds the linked files.
+  (void)v1::Clip::descriptor();
+  (void)motiondb::shard::v1::StoreTakeRequest::descriptor();
   const auto* pool = google::protobuf::DescriptorPool::generated_pool();
   int methods = 0;
   for (const char* service :
        {"motiondb.v1.ClipService", "motiondb.v1.EditService", "motiondb.v1.JobService",
         "motiondb.v1.LabelService", "motiondb.v1.SearchService", "motiondb.v1.ServerService",
-        "motiondb.v1.SpaceService"}) {
+        "motiondb.v1.SpaceService", "motiondb.shard.v1.ShardService"}) {
     const google::protobuf::ServiceDescriptor* descriptor = pool->FindServiceByName(service);
     ASSERT_NE(descriptor, nullptr) << service;
     for (int i = 0; i < descriptor->method_count(); ++i) {

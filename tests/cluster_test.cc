@@ -31,9 +31,12 @@
 #include "cluster/shard_map_store.h"
 #include "cluster/shard_map_watcher.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "motiondb/shard/v1/shard_service.grpc.pb.h"
+#include "motiondb/v1/clip_service.grpc.pb.h"
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "testing/etcd_processes.h"
 #include "testing/server_process.h"
+#include "tests/server_fixture.h"
 #include "tests/test_data.h"
 
 namespace motiondb::cluster {
@@ -784,6 +787,98 @@ TEST_F(ClusterServerTest, TheRoutersElectOneJobCoordinator) {
   const testing::CommandResult cli =
       testing::RunCli({"cluster", "status", "--etcd", etcd_.endpoints_flag()});
   EXPECT_THAT(cli.out, HasSubstr("job coordinator: none"));
+}
+
+// A shard node stores a routed take only when the map, read from etcd for the write, gives
+// the clip's shard to it: a router routing by an older map stores nothing on the wrong node.
+TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
+  std::string error;
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_store");
+  std::map<std::string, testing::ServerProcess> shards;
+  for (const std::string id : {"s1", "s2"}) {
+    ASSERT_TRUE(shards[id].Start({"--db", (dir / (id + ".sqlite")).string(), "--http", "off",
+                                  "--quiet", "--cluster", etcd_.endpoints_flag(), "--node-id", id},
+                                 &error))
+        << error;
+  }
+  ASSERT_TRUE(PollUntil(
+      [&] { return Listed(*client_, "motiondb", "s1") && Listed(*client_, "motiondb", "s2"); }));
+  const ShardMapStore store(*client_, "motiondb");
+  ASSERT_TRUE(store.Create(4, {"s1", "s2"}).ok());
+  // The first ids whose shards s1 and s2 hold.
+  const ShardMap map = store.Read()->map;
+  std::map<std::string, int64_t> id_of;
+  for (int64_t id = 1; id_of.size() < 2; ++id) {
+    id_of.try_emplace(map.owners[ShardOfClip(id, map.shard_count())], id);
+  }
+
+  auto s1 = shard::v1::ShardService::NewStub(testing::InsecureChannel(shards["s1"].address()));
+  const auto store_take = [&](int64_t clip_id, const std::string& name, int take,
+                              v1::IngestClipResponse* response) {
+    shard::v1::StoreTakeRequest request;
+    request.mutable_ingest()->set_file_name(name + ".bvh");
+    request.mutable_ingest()->set_bvh(BvhText(ChainClip()));
+    request.set_take(take);
+    request.set_clip_id(clip_id);
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kBound);
+    return s1->StoreTake(&context, request, response);
+  };
+  const auto clips_on_s1 = [&] {
+    auto clips = v1::ClipService::NewStub(testing::InsecureChannel(shards["s1"].address()));
+    grpc::ClientContext context;
+    v1::ListClipsResponse listed;
+    EXPECT_TRUE(clips->ListClips(&context, {}, &listed).ok());
+    std::vector<int64_t> ids;
+    for (const v1::Clip& clip : listed.clips()) ids.push_back(clip.clip_id());
+    return ids;
+  };
+
+  v1::IngestClipResponse stored;
+  grpc::Status status = store_take(id_of["s1"], "own", 0, &stored);
+  ASSERT_TRUE(status.ok()) << status.error_message() << shards["s1"].Log();
+  EXPECT_EQ(stored.clip().clip_id(), id_of["s1"]);
+  EXPECT_EQ(stored.clip().name(), "own");
+
+  // Another node's shard, an id held, a take the file lacks, no id: refused, nothing stored.
+  status = store_take(id_of["s2"], "theirs", 0, &stored);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(status.error_message(),
+              HasSubstr(absl::StrCat("clip ", id_of["s2"], "'s shard ", ShardOfClip(id_of["s2"], 4),
+                                     " is node 's2''s in the map "
+                                     "of epoch 1, not this node's ('s1')")));
+  EXPECT_EQ(store_take(id_of["s1"], "again", 0, &stored).error_code(),
+            grpc::StatusCode::ALREADY_EXISTS);
+  status = store_take(id_of["s1"], "take", 1, &stored);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("take 1: 'take.bvh' has 1 takes"));
+  EXPECT_EQ(store_take(0, "none", 0, &stored).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(clips_on_s1(), ::testing::ElementsAre(id_of["s1"]));
+
+  // Once the map gives the shard to s1, s1 stores its clips at once: the map is read for the
+  // write, not waited for from the watch.
+  const testing::CommandResult moved =
+      testing::RunCli({"cluster", "move-shard", absl::StrCat(ShardOfClip(id_of["s2"], 4)), "s1",
+                       "--etcd", etcd_.endpoints_flag()});
+  ASSERT_EQ(moved.exit_code, 0) << moved.err;
+  status = store_take(id_of["s2"], "theirs", 0, &stored);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(stored.clip().clip_id(), id_of["s2"]);
+  EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
+
+  // Without etcd the map cannot be read: the write fails UNAVAILABLE at its deadline.
+  etcd_.Stop(0, /*graceful=*/true);
+  shard::v1::StoreTakeRequest request;
+  request.mutable_ingest()->set_file_name("late.bvh");
+  request.mutable_ingest()->set_bvh(BvhText(ChainClip()));
+  request.set_clip_id(id_of["s1"] + 4);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(3));
+  status = s1->StoreTake(&context, request, &stored);
+  EXPECT_TRUE(status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+              status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED)
+      << status.error_code() << " " << status.error_message();
+  EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.

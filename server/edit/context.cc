@@ -129,8 +129,8 @@ absl::StatusOr<EditResult> FinishEdit(const EditContext& context, const MotionSp
   record.tags = output.store_tags;
   provenance.parameters_json = output.parameters_json;
   record.provenance = ProvenanceJson(provenance);
-  absl::StatusOr<IngestedClip> stored =
-      context.catalog.IngestClip(record, clip, OnConflict::kError, should_stop);
+  absl::StatusOr<IngestedClip> stored = context.catalog.IngestClip(
+      record, clip, {.on_conflict = OnConflict::kError, .clip_id = 0}, should_stop);
   if (!stored.ok()) {
     // The catalogue names a bad tag "tags[i]" ("tags[0] must not be empty"); whatever else it
     // refuses is about the name.

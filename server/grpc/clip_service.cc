@@ -9,6 +9,7 @@
 #include "server/clip_poses.h"
 #include "server/grpc/call_context.h"
 #include "server/grpc/clip_conversion.h"
+#include "server/grpc/internal/upload_ingest.h"
 #include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
@@ -23,13 +24,8 @@ grpc::Status ClipServiceImpl::IngestClip(grpc::ServerContext* context,
                                          v1::IngestClipResponse* response) {
   return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(const IngestRequest ingest, FromProto(*request));
-    MOTIONDB_ASSIGN_OR_RETURN(UploadBudget::Ticket ticket, budget_.Admit());
-    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(request->bvh().size())));
-    MOTIONDB_ASSIGN_OR_RETURN(const IngestedFile ingested,
-                              IngestUpload(catalog_, ingest, request->bvh(), limits_, should_stop));
-    for (const IngestOutcome& outcome : ingested.clips) metrics_.CountIngest(outcome);
-    ToProto(ingested, response);
-    return absl::OkStatus();
+    return IngestUploadedFile({catalog_, limits_, budget_, metrics_}, ingest, request->bvh(),
+                              should_stop, response);
   });
 }
 

@@ -51,6 +51,8 @@ const absl::flat_hash_map<absl::string_view, TokenScope>& Table() {
       {"/motiondb.v1.SpaceService/GetSpace", S::kRead},
       {"/motiondb.v1.SpaceService/DeleteSpace", S::kAdmin},
       {"/motiondb.v1.SpaceService/GetCurve", S::kRead},
+      // A router passes its caller's token on: storing a take is that caller's ingest.
+      {"/motiondb.shard.v1.ShardService/StoreTake", S::kWrite},
   };
   return *table;
 }
@@ -58,7 +60,8 @@ const absl::flat_hash_map<absl::string_view, TokenScope>& Table() {
 }  // namespace
 
 bool IsMotionDbMethod(absl::string_view method) {
-  return absl::StartsWith(method, "/motiondb.v1.");
+  return absl::StartsWith(method, "/motiondb.v1.") ||
+         absl::StartsWith(method, "/motiondb.shard.v1.");
 }
 
 TokenScope RequiredScope(absl::string_view method) {

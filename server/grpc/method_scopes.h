@@ -1,4 +1,4 @@
-// The scope (util/token_file.h) each motiondb.v1 method needs: read for what only reads
+// The scope (util/token_file.h) each motiondb method needs: read for what only reads
 // (search, lists, exports, curves), write for what adds or changes (ingest, labels, jobs,
 // spaces, edits), admin for deletes and backups. The HTTP face asks the same table for the
 // route's method.
@@ -10,7 +10,8 @@
 
 namespace motiondb::server {
 
-// Whether `method` ("/pkg.Service/Method") is one of motiondb.v1's, which the service-side
+// Whether `method` ("/pkg.Service/Method") is one of motiondb.v1's or motiondb.shard.v1's
+// (a cluster's router calls those on its shard nodes), which the service-side
 // check guards (server/grpc/access_control.h); gRPC's own services (health, reflection) are
 // guarded by the port's credentials.
 bool IsMotionDbMethod(absl::string_view method);

@@ -18,6 +18,7 @@
 #include "server/grpc/request_logger.h"
 #include "server/grpc/search_service.h"
 #include "server/grpc/server_info_service.h"
+#include "server/grpc/shard_service.h"
 #include "server/grpc/space_service.h"
 #include "server/index_registry.h"
 #include "server/jobs/job_runner.h"
@@ -52,6 +53,7 @@ struct MotionDbServer::State {
   std::unique_ptr<JobServiceImpl> job_service;
   std::unique_ptr<ServerInfoServiceImpl> info;
   std::unique_ptr<EditServiceImpl> edits;
+  std::unique_ptr<ShardServiceImpl> shard;  // on a cluster's shard node only
   // The port: accepted here, handed to gRPC (see StartListening).
   std::unique_ptr<Listener> listener;
   HandedOffSockets handed_off;
@@ -128,6 +130,10 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
                                                    *s.gate);
   s.edits = std::make_unique<EditServiceImpl>(
       EditContext{*s.database, *s.catalog, s.registry, options.max_query_frames, answers}, *s.gate);
+  if (options.check_shard_owner) {
+    s.shard = std::make_unique<ShardServiceImpl>(*s.catalog, options.uploads, *s.uploads,
+                                                 *s.metrics, *s.gate, options.check_shard_owner);
+  }
 
   MOTIONDB_ASSIGN_OR_RETURN(
       const std::shared_ptr<grpc::ServerCredentials> credentials,
@@ -164,6 +170,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   builder.RegisterService(s.job_service.get());
   builder.RegisterService(s.info.get());
   builder.RegisterService(s.edits.get());
+  if (s.shard) builder.RegisterService(s.shard.get());
   builder.SetMaxReceiveMessageSize(options.max_message_mb << 20);
   // Always: the metrics count every call, whether or not lines are written.
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> loggers;

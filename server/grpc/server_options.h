@@ -3,9 +3,12 @@
 #define MOTIONDB_SERVER_GRPC_SERVER_OPTIONS_H_
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
+#include "absl/time/time.h"
 #include "server/answer_limit.h"
 #include "server/net/connection_counter.h"
 #include "server/search_runner.h"
@@ -67,6 +70,10 @@ struct ServerOptions {
   std::string tls_key_pem;
   // One line per call on stderr (server/grpc/request_logger.h).
   bool log_requests = true;
+  // Set on a cluster's shard node (server/main.cc): the node also serves
+  // motiondb.shard.v1.ShardService (server/grpc/shard_service.h), storing what this check
+  // finds its own. Unset: one node, or a router; no shard service.
+  std::function<absl::Status(int64_t clip_id, absl::Time deadline)> check_shard_owner;
 };
 
 }  // namespace motiondb::server
