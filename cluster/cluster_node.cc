@@ -25,6 +25,11 @@ absl::StatusOr<std::unique_ptr<ClusterNode>> ClusterNode::Start(
         registration->SetShards(map.ShardsOf(node_id));
       });
   if (options.node.role == "router") {
+    if (options.max_clip_name_bytes == 0) {
+      return absl::InvalidArgumentError("a router needs the longest clip name's length");
+    }
+    node->router_ = std::make_unique<ClipRouter>(*node->etcd_, *node->watcher_, options.cluster,
+                                                 options.max_clip_name_bytes);
     const std::function<void(const std::string&)> log = options.log;
     const std::string cluster = options.cluster;
     MOTIONDB_ASSIGN_OR_RETURN(
@@ -50,7 +55,17 @@ absl::Status ClusterNode::CheckClipOwner(int64_t clip_id, absl::Time deadline) c
       map.epoch, ", not this node's ('", node_id_, "'): route the write by the newest map"));
 }
 
+absl::StatusOr<ClipRoute> ClusterNode::RouteClip(const std::string& name,
+                                                 absl::Time deadline) const {
+  if (router_ == nullptr) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("node '", node_id_, "' is a shard node; a router routes writes"));
+  }
+  return router_->Route(name, deadline);
+}
+
 ClusterNode::~ClusterNode() {
+  router_.reset();    // it reads the watcher
   election_.reset();  // resigns, so that another router takes the office at once
   watcher_.reset();   // it writes to the registration
   registration_.reset();

@@ -14,6 +14,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "cluster/clip_router.h"
 #include "cluster/cluster_options.h"
 #include "cluster/etcd_client.h"
 #include "cluster/leader_election.h"
@@ -41,6 +42,9 @@ class ClusterNode {
   // FAILED_PRECONDITION naming the shard, its node and the map's epoch when it gives it another
   // (the write was routed by an older map); UNAVAILABLE or NOT_FOUND as CurrentMap.
   absl::Status CheckClipOwner(int64_t clip_id, absl::Time deadline) const;
+  // A router's route for the write of the clip named `name` (ClipRouter::Route);
+  // FAILED_PRECONDITION on a shard node, which routes nothing.
+  absl::StatusOr<ClipRoute> RouteClip(const std::string& name, absl::Time deadline) const;
 
  private:
   explicit ClusterNode(std::string node_id) : node_id_(std::move(node_id)) {}
@@ -51,6 +55,7 @@ class ClusterNode {
   std::unique_ptr<NodeRegistration> registration_;
   std::unique_ptr<ShardMapWatcher> watcher_;
   std::unique_ptr<LeaderElection> election_;  // a router's campaign for kJobsOffice
+  std::unique_ptr<ClipRouter> router_;        // a router's
 };
 
 }  // namespace motiondb::cluster

@@ -21,6 +21,9 @@ struct ClusterOptions {
   // How long a node that stopped renewing stays listed: a dead node disappears within it
   // (--cluster-lease-s). Renewed every third of it.
   absl::Duration lease_ttl = absl::Seconds(5);
+  // The longest clip name (storage::kMaxNameBytes, given by the server: this layer may not use
+  // storage); a router bounds the names it reserves by it.
+  size_t max_clip_name_bytes = 0;
   // Where changes of state go (registered, lost, the map's new epoch); none by default.
   std::function<void(const std::string& line)> log;
 };

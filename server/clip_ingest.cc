@@ -84,6 +84,18 @@ absl::StatusOr<IngestedFile> IngestUpload(Catalog& catalog, const IngestRequest&
   return IngestParsedUpload(catalog, request, std::move(file), should_stop);
 }
 
+std::string TakeClipName(const std::string& name, const UploadedFile& file, size_t take) {
+  return file.takes.size() > 1 ? absl::StrCat(name, "/", file.takes[take].name) : name;
+}
+
+absl::Status TakeFailure(const absl::Status& status, const std::string& take_name,
+                         const std::vector<std::string>& stored) {
+  if (stored.empty()) return status;
+  return absl::Status(status.code(), absl::StrCat("take '", take_name, "': ", status.message(),
+                                                  " (the takes before it were stored: ",
+                                                  absl::StrJoin(stored, ", "), ")"));
+}
+
 absl::StatusOr<IngestedFile> IngestParsedUpload(Catalog& catalog, const IngestRequest& request,
                                                 UploadedFile file,
                                                 const std::function<bool()>& should_stop) {
@@ -93,7 +105,6 @@ absl::StatusOr<IngestedFile> IngestParsedUpload(Catalog& catalog, const IngestRe
   ingested.unit_m = file.unit_m;
   ingested.up_axis = file.up_axis;
   ingested.generator = std::move(file.generator);
-  const bool several = file.takes.size() > 1;
   const storage::SourceFacts facts = FactsOf(file);
   if (request.routed && (request.routed->take < 0 ||
                          static_cast<size_t>(request.routed->take) >= file.takes.size())) {
@@ -104,20 +115,14 @@ absl::StatusOr<IngestedFile> IngestParsedUpload(Catalog& catalog, const IngestRe
   std::vector<std::string> stored;
   for (size_t t = 0; t < file.takes.size(); ++t) {
     if (request.routed && static_cast<size_t>(request.routed->take) != t) continue;
+    const std::string take_name = TakeClipName(name, file, t);
     UploadedTake& take = file.takes[t];
-    const std::string take_name = several ? absl::StrCat(name, "/", take.name) : name;
-    // The file's warnings go with its first clip.
+    // The file's warnings go with its first clip (a routed file's, with its first take).
+    const bool first = ingested.clips.empty() && (!request.routed || t == 0);
     absl::StatusOr<IngestOutcome> outcome =
         IngestTake(catalog, request, take_name, std::move(take), facts,
-                   ingested.clips.empty() ? std::move(file.warnings) : std::vector<std::string>(),
-                   should_stop);
-    if (!outcome.ok()) {
-      if (stored.empty()) return outcome.status();
-      return absl::Status(
-          outcome.status().code(),
-          absl::StrCat("take '", take_name, "': ", outcome.status().message(),
-                       " (the takes before it were stored: ", absl::StrJoin(stored, ", "), ")"));
-    }
+                   first ? std::move(file.warnings) : std::vector<std::string>(), should_stop);
+    if (!outcome.ok()) return TakeFailure(outcome.status(), take_name, stored);
     stored.push_back(take_name);
     ingested.clips.push_back(*std::move(outcome));
   }

@@ -59,6 +59,14 @@ struct IngestedFile {
 // leaves no name. Lengths and characters of names and tags are the database's to check.
 absl::StatusOr<std::string> ClipName(const IngestRequest& request);
 
+// The name of the clip holding take `take` of `file` for a request whose clip name is `name`:
+// `name` for a file of one take, "name/TAKE" for one of several.
+std::string TakeClipName(const std::string& name, const UploadedFile& file, size_t take);
+// A take's failure to be stored, after those named in `stored` were: the error, naming the take
+// and the takes stored before it.
+absl::Status TakeFailure(const absl::Status& status, const std::string& take_name,
+                         const std::vector<std::string>& stored);
+
 // Parses, stores and indexes one uploaded file, a clip a take, or skips them. `should_stop` is
 // asked while the file is parsed (ReadUpload) and before the catalogue commits each take
 // (Catalog::IngestClip). Every take is parsed before the first is stored; a take that fails

@@ -37,6 +37,7 @@
 #include "server/grpc/server_options.h"
 #include "server/http/http_server.h"
 #include "server/net/descriptor_limit.h"
+#include "storage/record_limits.h"
 #include "util/cli_conventions.h"
 #include "util/file_io.h"
 #include "util/status_macros.h"
@@ -124,8 +125,8 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
   return absl::OkStatus();
 }
 
-// The cluster node once it has joined, for the shard service's checks: the server starts serving
-// first, since the node advertises the port it listens on.
+// The cluster node once it has joined, for a shard's checks and a router's routes: the server
+// starts serving first, since the node advertises the port it listens on.
 class JoinedNode {
  public:
   void Set(std::shared_ptr<motiondb::cluster::ClusterNode> node) {
@@ -133,16 +134,26 @@ class JoinedNode {
     node_ = std::move(node);
   }
   absl::Status CheckClipOwner(int64_t clip_id, absl::Time deadline) const {
-    std::shared_ptr<motiondb::cluster::ClusterNode> node;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      node = node_;
-    }
-    if (node == nullptr) return absl::UnavailableError("this node is not in its cluster yet");
+    const std::shared_ptr<motiondb::cluster::ClusterNode> node = Get();
+    if (node == nullptr) return NotJoined();
     return node->CheckClipOwner(clip_id, deadline);
+  }
+  absl::StatusOr<motiondb::cluster::ClipRoute> RouteClip(const std::string& name,
+                                                         absl::Time deadline) const {
+    const std::shared_ptr<motiondb::cluster::ClusterNode> node = Get();
+    if (node == nullptr) return NotJoined();
+    return node->RouteClip(name, deadline);
   }
 
  private:
+  std::shared_ptr<motiondb::cluster::ClusterNode> Get() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return node_;
+  }
+  static absl::Status NotJoined() {
+    return absl::UnavailableError("this node is not in its cluster yet");
+  }
+
   mutable std::mutex mutex_;
   std::shared_ptr<motiondb::cluster::ClusterNode> node_;
 };
@@ -404,9 +415,15 @@ int main(int argc, char** argv) {
   FitConnectionsToDescriptors(app, options.connections,
                               http_options.listen != "off" ? &http_options.connections : nullptr);
   const auto joined_node = std::make_shared<JoinedNode>();
+  cluster.options.max_clip_name_bytes = motiondb::storage::kMaxNameBytes;
   if (!cluster.etcd.empty() && cluster.options.node.role == "shard") {
     options.check_shard_owner = [joined_node](int64_t clip_id, absl::Time deadline) {
       return joined_node->CheckClipOwner(clip_id, deadline);
+    };
+  }
+  if (!cluster.etcd.empty() && cluster.options.node.role == "router") {
+    options.route_clip = [joined_node](const std::string& name, absl::Time deadline) {
+      return joined_node->RouteClip(name, deadline);
     };
   }
   absl::StatusOr<std::unique_ptr<motiondb::server::MotionDbServer>> server =

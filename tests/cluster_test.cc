@@ -881,6 +881,109 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
   EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
 }
 
+// A router stores each take on the shard node its clip id belongs to, the ids and names unique
+// cluster-wide; a name stored already goes to its clip's shard, which decides the conflict as one
+// node does; a shard node that is gone makes the ingest UNAVAILABLE naming it.
+TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
+  std::string error;
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_route");
+  std::map<std::string, testing::ServerProcess> nodes;
+  for (const std::string id : {"s1", "s2", "r1"}) {
+    ASSERT_TRUE(
+        nodes[id].Start({"--db", (dir / (id + ".sqlite")).string(), "--http", "off", "--quiet",
+                         "--cluster", etcd_.endpoints_flag(), "--node-id", id, "--role",
+                         id == "r1" ? "router" : "shard", "--cluster-lease-s", "2"},
+                        &error))
+        << error;
+  }
+  ASSERT_TRUE(PollUntil([&] {
+    return Listed(*client_, "motiondb", "s1") && Listed(*client_, "motiondb", "s2") &&
+           Listed(*client_, "motiondb", "r1");
+  }));
+  const ShardMapStore store(*client_, "motiondb");
+  ASSERT_TRUE(store.Create(4, {"s1", "s2"}).ok());
+  const ShardMap map = store.Read()->map;
+
+  auto router = v1::ClipService::NewStub(testing::InsecureChannel(nodes["r1"].address()));
+  const auto ingest = [&](const std::string& name, double speed, v1::OnConflict on_conflict,
+                          v1::IngestClipResponse* response) {
+    v1::IngestClipRequest request;
+    request.set_file_name("take.bvh");
+    request.set_name(name);
+    request.set_bvh(BvhText(ChainClip(speed)));
+    request.set_on_conflict(on_conflict);
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kBound);
+    return router->IngestClip(&context, request, response);
+  };
+  const auto clips_on = [&](const std::string& node) {
+    auto clips = v1::ClipService::NewStub(testing::InsecureChannel(nodes[node].address()));
+    grpc::ClientContext context;
+    v1::ListClipsResponse listed;
+    EXPECT_TRUE(clips->ListClips(&context, {}, &listed).ok()) << node;
+    std::map<int64_t, std::string> names;
+    for (const v1::Clip& clip : listed.clips()) names[clip.clip_id()] = clip.name();
+    return names;
+  };
+
+  std::map<int64_t, std::string> routed;  // id -> name
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = absl::StrCat("take_", i);
+    v1::IngestClipResponse response;
+    const grpc::Status status =
+        ingest(name, 0.01 * (i + 1), v1::ON_CONFLICT_UNSPECIFIED, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message() << nodes["r1"].Log();
+    EXPECT_EQ(response.result(), v1::INGEST_RESULT_STORED);
+    EXPECT_EQ(response.clip().name(), name);
+    EXPECT_TRUE(routed.emplace(response.clip().clip_id(), name).second) << "a repeated id";
+  }
+  std::map<int64_t, std::string> stored;
+  for (const std::string node : {"s1", "s2"}) {
+    const std::map<int64_t, std::string> on_node = clips_on(node);
+    EXPECT_FALSE(on_node.empty()) << node;  // ids 1 to 6 fall on both nodes' shards
+    for (const auto& [id, name] : on_node) {
+      EXPECT_EQ(map.owners[ShardOfClip(id, map.shard_count())], node) << id;
+      stored.emplace(id, name);
+    }
+  }
+  EXPECT_EQ(stored, routed);
+
+  // The same name again: skipped when identical, refused when not, replaced when asked, on the
+  // clip's own shard and under its id.
+  const int64_t first = routed.begin()->first;
+  const std::string first_name = routed.begin()->second;
+  const double first_speed = 0.01 * (first_name.back() - '0' + 1);
+  v1::IngestClipResponse again;
+  ASSERT_TRUE(ingest(first_name, first_speed, v1::ON_CONFLICT_UNSPECIFIED, &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_SKIPPED);
+  EXPECT_EQ(again.clip().clip_id(), first);
+  const grpc::Status conflict = ingest(first_name, 0.5, v1::ON_CONFLICT_UNSPECIFIED, &again);
+  EXPECT_EQ(conflict.error_code(), grpc::StatusCode::ALREADY_EXISTS) << conflict.error_message();
+  ASSERT_TRUE(ingest(first_name, 0.5, v1::ON_CONFLICT_REPLACE, &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_REPLACED);
+  EXPECT_EQ(again.clip().clip_id(), first);
+  const std::string first_node = map.owners[ShardOfClip(first, map.shard_count())];
+  EXPECT_EQ(clips_on(first_node).count(first), 1u);
+  EXPECT_EQ(clips_on(first_node == "s1" ? "s2" : "s1").count(first), 0u);
+
+  // A bad name is refused before anything is reserved or stored.
+  v1::IngestClipResponse bad;
+  EXPECT_EQ(ingest("a//b", 0.1, v1::ON_CONFLICT_UNSPECIFIED, &bad).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(*ClipNames(*client_, "motiondb", 512).Lookup("a//b"), std::nullopt);
+
+  // s2 killed: the next ingest whose id falls on its shards fails, naming it.
+  nodes["s2"].Stop(SIGKILL);
+  grpc::Status failed;
+  for (int i = 6; i < 40 && failed.ok(); ++i) {
+    v1::IngestClipResponse response;
+    failed =
+        ingest(absl::StrCat("take_", i), 0.01 * (i + 1), v1::ON_CONFLICT_UNSPECIFIED, &response);
+  }
+  EXPECT_EQ(failed.error_code(), grpc::StatusCode::UNAVAILABLE) << failed.error_message();
+  EXPECT_THAT(failed.error_message(), HasSubstr("node 's2'"));
+}
+
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.
 TEST_F(ClusterServerTest, RegistersTheAdvertisedAddress) {
   std::string error;

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
 
 namespace motiondb::server {
 namespace {
@@ -26,6 +27,12 @@ absl::Status ExplainStop(absl::Status status, const grpc::ServerContext* context
     return absl::DeadlineExceededError(absl::StrCat("deadline exceeded (", status.message(), ")"));
   }
   return absl::CancelledError(absl::StrCat("cancelled by the client (", status.message(), ")"));
+}
+
+absl::Time DeadlineOf(const grpc::ServerContext& context, absl::Duration otherwise) {
+  const auto deadline = context.deadline();
+  if (deadline == std::chrono::system_clock::time_point::max()) return absl::Now() + otherwise;
+  return absl::FromChrono(deadline);
 }
 
 }  // namespace motiondb::server

@@ -7,6 +7,7 @@
 #include <grpcpp/server_context.h>
 
 #include "absl/status/status.h"
+#include "absl/time/time.h"
 
 namespace motiondb::server {
 
@@ -17,6 +18,11 @@ std::function<bool()> StopWhenCallEnds(const grpc::ServerContext* context);
 // The engine reports a stop as CANCELLED; when the deadline is what ended the call, the client
 // is told DEADLINE_EXCEEDED. Other statuses pass through.
 absl::Status ExplainStop(absl::Status status, const grpc::ServerContext* context);
+
+// The call's deadline, for what waits on another service (a cluster node's etcd reads); a call
+// without one is given `otherwise` from now.
+absl::Time DeadlineOf(const grpc::ServerContext& context,
+                      absl::Duration otherwise = absl::Seconds(10));
 
 }  // namespace motiondb::server
 

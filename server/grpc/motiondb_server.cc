@@ -16,6 +16,7 @@
 #include "server/grpc/job_service.h"
 #include "server/grpc/label_service.h"
 #include "server/grpc/request_logger.h"
+#include "server/grpc/routed_clip_service.h"
 #include "server/grpc/search_service.h"
 #include "server/grpc/server_info_service.h"
 #include "server/grpc/shard_service.h"
@@ -46,7 +47,7 @@ struct MotionDbServer::State {
   std::unique_ptr<AccessControl> access;
   std::unique_ptr<CallGate> gate;
   std::unique_ptr<StreamWatchdog> watchdog;
-  std::unique_ptr<ClipServiceImpl> clips;
+  std::unique_ptr<v1::ClipService::Service> clips;  // routed on a cluster's router
   std::unique_ptr<SpaceServiceImpl> spaces;
   std::unique_ptr<SearchServiceImpl> search;
   std::unique_ptr<LabelServiceImpl> labels;
@@ -119,8 +120,13 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
                    .min_bytes_per_s = options.uploads.min_bytes_per_s,
                    .rate_grace = options.uploads.rate_grace});
   const AnswerLimit answers(int64_t{options.max_answer_mb} << 20);
-  s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
-                                              *s.uploads, *s.watchdog, *s.metrics, *s.gate);
+  if (options.route_clip) {
+    s.clips = std::make_unique<RoutedClipServiceImpl>(options.uploads, *s.uploads, *s.gate,
+                                                      options.route_clip);
+  } else {
+    s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
+                                                *s.uploads, *s.watchdog, *s.metrics, *s.gate);
+  }
   s.spaces =
       std::make_unique<SpaceServiceImpl>(*s.database, *s.catalog, s.registry, answers, *s.gate);
   s.search = std::make_unique<SearchServiceImpl>(*s.runner, answers, *s.metrics, *s.gate);

@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "cluster/clip_router.h"
 #include "server/answer_limit.h"
 #include "server/net/connection_counter.h"
 #include "server/search_runner.h"
@@ -16,6 +18,11 @@
 #include "util/token_file.h"
 
 namespace motiondb::server {
+
+// Where a cluster's router sends the write of the clip of this name, by the deadline
+// (cluster::ClusterNode::RouteClip).
+using ClipRouteLookup = std::function<absl::StatusOr<cluster::ClipRoute>(
+    const std::string& clip_name, absl::Time deadline)>;
 
 struct ServerOptions {
   // The SQLite file; created when missing (--db).
@@ -74,6 +81,9 @@ struct ServerOptions {
   // motiondb.shard.v1.ShardService (server/grpc/shard_service.h), storing what this check
   // finds its own. Unset: one node, or a router; no shard service.
   std::function<absl::Status(int64_t clip_id, absl::Time deadline)> check_shard_owner;
+  // Set on a cluster's router (server/main.cc): ClipService's ingests go to their clips' shard
+  // nodes (server/grpc/routed_clip_service.h) instead of this node's database.
+  ClipRouteLookup route_clip;
 };
 
 }  // namespace motiondb::server

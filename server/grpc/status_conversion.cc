@@ -15,6 +15,15 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
   return grpc::Status(grpc_code, std::string(status.message()));
 }
 
+absl::Status FromGrpcStatus(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  const int code = static_cast<int>(status.error_code());
+  const absl::StatusCode absl_code = code > 0 && code <= grpc::StatusCode::UNAUTHENTICATED
+                                         ? static_cast<absl::StatusCode>(code)
+                                         : absl::StatusCode::kUnknown;
+  return absl::Status(absl_code, status.error_message());
+}
+
 std::string StatusCodeName(grpc::StatusCode code) {
   // gRPC's and Abseil's codes are the same numbers with the same names.
   const std::string name = absl::StatusCodeToString(static_cast<absl::StatusCode>(code));

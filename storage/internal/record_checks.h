@@ -13,6 +13,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/motion/matrix.h"
+#include "storage/clip_name_check.h"
 #include "storage/label_record.h"
 #include "storage/record_limits.h"
 
@@ -25,12 +26,6 @@ namespace motiondb::storage {
 // follows it, NUL would cut the name short in C strings, and protobuf carries UTF-8 only.
 absl::Status CheckName(absl::string_view what, absl::string_view name, size_t max_bytes,
                        bool may_be_empty = false);
-
-// CheckName's rules for a clip name, and those of a relative path: '/' separates segments
-// (studios name takes "session1/take_001"), none of which may be empty, "." or "..", so no
-// leading, trailing or doubled '/'. A clip name then maps to a path under an export folder that
-// cannot leave it, and one clip has one spelling ("a//b" and "a/./b" are not a second "a/b").
-absl::Status CheckClipName(absl::string_view name);
 
 // Tags are a set: checked, sorted and without repeats, as ListClips and GetClip return them.
 // Errors name the tag as `field`[i].
