@@ -10,7 +10,7 @@ namespace {
 
 // A failed delete means the key was deleted since it was read (a release racing this one), and
 // perhaps reserved again: a few attempts settle it.
-constexpr int kMaxReleaseAttempts = 5;
+constexpr int kMaxChangeAttempts = 5;
 
 }  // namespace
 
@@ -44,20 +44,40 @@ absl::Status ClipNames::Reserve(const std::string& name, int64_t clip_id) const 
       absl::StrCat("clip name ", QuotedNameText(name), " is taken by clip ", holder));
 }
 
-absl::StatusOr<bool> ClipNames::Release(const std::string& name, int64_t clip_id) const {
+absl::StatusOr<bool> ClipNames::ChangeIfHeld(
+    const std::string& name, int64_t clip_id, absl::string_view what,
+    const std::function<absl::StatusOr<bool>(const std::string& key, int64_t revision)>& change)
+    const {
   MOTIONDB_RETURN_IF_ERROR(CheckName(name));
   const std::string key = ClipNameKey(cluster_, name);
-  for (int attempt = 0; attempt < kMaxReleaseAttempts; ++attempt) {
+  for (int attempt = 0; attempt < kMaxChangeAttempts; ++attempt) {
     MOTIONDB_ASSIGN_OR_RETURN(const std::optional<KeyValue> kv, etcd_.Get(key));
     if (!kv) return false;
     MOTIONDB_ASSIGN_OR_RETURN(const int64_t holder, PositiveDecimalOf(key, kv->value));
     if (holder != clip_id) return false;
-    MOTIONDB_ASSIGN_OR_RETURN(const bool deleted, etcd_.DeleteIfRevision(key, kv->mod_revision));
-    if (deleted) return true;
+    MOTIONDB_ASSIGN_OR_RETURN(const bool changed, change(key, kv->mod_revision));
+    if (changed) return true;
   }
   return absl::AbortedError(absl::StrCat("clip name ", QuotedNameText(name),
-                                         " changed under each of ", kMaxReleaseAttempts,
-                                         " attempts to release it"));
+                                         " changed under each of ", kMaxChangeAttempts,
+                                         " attempts to ", what, " it"));
+}
+
+absl::StatusOr<bool> ClipNames::Release(const std::string& name, int64_t clip_id) const {
+  return ChangeIfHeld(name, clip_id, "release", [&](const std::string& key, int64_t revision) {
+    return etcd_.DeleteIfRevision(key, revision);
+  });
+}
+
+absl::StatusOr<bool> ClipNames::Reassign(const std::string& name, int64_t from, int64_t to) const {
+  if (to < 1) return absl::InvalidArgumentError(absl::StrCat("clip id ", to));
+  return ChangeIfHeld(name, from, "reassign",
+                      [&](const std::string& key, int64_t revision) -> absl::StatusOr<bool> {
+                        MOTIONDB_ASSIGN_OR_RETURN(
+                            const SwapOutcome outcome,
+                            etcd_.CompareAndSwap(key, revision, absl::StrCat(to)));
+                        return outcome.written;
+                      });
 }
 
 absl::StatusOr<std::optional<int64_t>> ClipNames::Lookup(const std::string& name) const {

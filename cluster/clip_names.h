@@ -8,10 +8,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "cluster/etcd_client.h"
 
 namespace motiondb::cluster {
@@ -30,11 +32,21 @@ class ClipNames {
   // Frees `name` if clip `clip_id` holds it: whether it did. A name free or held by another clip
   // is left as it is (false).
   absl::StatusOr<bool> Release(const std::string& name, int64_t clip_id) const;
+  // Moves `name` from clip `from` to clip `to` (a replacement stored under a new id), only if
+  // `from` holds it: whether it did. A name free or held by another clip is left as it is.
+  // INVALID_ARGUMENT for a bad name or an id below 1.
+  absl::StatusOr<bool> Reassign(const std::string& name, int64_t from, int64_t to) const;
   // The clip holding `name`, or nullopt when it is free.
   absl::StatusOr<std::optional<int64_t>> Lookup(const std::string& name) const;
 
  private:
   absl::Status CheckName(const std::string& name) const;
+  // Runs `change` on the name's key at its revision while clip `clip_id` holds it, again when
+  // the key changed meanwhile (up to a few times: ABORTED naming `what` then): whether it took.
+  absl::StatusOr<bool> ChangeIfHeld(
+      const std::string& name, int64_t clip_id, absl::string_view what,
+      const std::function<absl::StatusOr<bool>(const std::string& key, int64_t revision)>& change)
+      const;
 
   const EtcdClient& etcd_;
   const std::string cluster_;

@@ -18,32 +18,38 @@ ClipRouter::ClipRouter(const EtcdClient& etcd, const ShardMapWatcher& watcher,
       ids_(etcd, cluster),
       names_(etcd, cluster, max_name_bytes) {}
 
-absl::StatusOr<ClipRoute> ClipRouter::ReserveName(const std::string& name) {
-  ClipRoute route;
-  MOTIONDB_ASSIGN_OR_RETURN(std::optional<int64_t> held, names_.Lookup(name));
-  if (!held) {
+absl::StatusOr<int64_t> ClipRouter::NextIdOnShard(int shard, int shard_count) {
+  // About shard_count draws; a bound far beyond, so that a broken hash cannot spin for ever.
+  const int64_t most = int64_t{shard_count} * 1000;
+  for (int64_t draw = 0; draw < most; ++draw) {
     MOTIONDB_ASSIGN_OR_RETURN(const int64_t id, ids_.Next());
-    const absl::Status reserved = names_.Reserve(name, id);
-    if (reserved.ok()) {
-      route.clip_id = id;
-      return route;
-    }
-    if (!absl::IsAlreadyExists(reserved)) return reserved;
-    // Another router reserved it since the lookup: the id it was given is the clip's.
-    MOTIONDB_ASSIGN_OR_RETURN(held, names_.Lookup(name));
-    if (!held) {
-      return absl::AbortedError(
-          absl::StrCat("clip name '", name, "' was reserved and freed meanwhile; try again"));
-    }
+    if (ShardOfClip(id, shard_count) == shard) return id;
   }
-  route.clip_id = *held;
-  route.name_was_held = true;
-  return route;
+  return absl::InternalError(absl::StrCat("no id of shard ", shard, " in ", most, " ids"));
 }
 
 absl::StatusOr<ClipRoute> ClipRouter::Route(const std::string& name, absl::Time deadline) {
-  MOTIONDB_ASSIGN_OR_RETURN(ClipRoute route, ReserveName(name));
   MOTIONDB_ASSIGN_OR_RETURN(const ShardMap map, watcher_.CurrentMap(deadline));
+  ClipRoute route;
+  MOTIONDB_ASSIGN_OR_RETURN(std::optional<int64_t> held, names_.Lookup(name));
+  if (!held) {
+    MOTIONDB_ASSIGN_OR_RETURN(route.clip_id, ids_.Next());
+    const absl::Status reserved = names_.Reserve(name, route.clip_id);
+    if (!reserved.ok()) {
+      if (!absl::IsAlreadyExists(reserved)) return reserved;
+      // Reserved by another router since the lookup: that clip's name, as though held before.
+      MOTIONDB_ASSIGN_OR_RETURN(held, names_.Lookup(name));
+      if (!held) {
+        return absl::AbortedError(
+            absl::StrCat("clip name '", name, "' was reserved and freed meanwhile; try again"));
+      }
+    }
+  }
+  if (held) {
+    route.held_by = *held;
+    MOTIONDB_ASSIGN_OR_RETURN(
+        route.clip_id, NextIdOnShard(ShardOfClip(*held, map.shard_count()), map.shard_count()));
+  }
   route.shard = ShardOfClip(route.clip_id, map.shard_count());
   route.epoch = map.epoch;
   route.node_id = map.owners[route.shard];
@@ -56,6 +62,18 @@ absl::StatusOr<ClipRoute> ClipRouter::Route(const std::string& name, absl::Time 
   }
   return absl::UnavailableError(absl::StrCat("shard ", route.shard, "'s node '", route.node_id,
                                              "' is not live (map epoch ", map.epoch, ")"));
+}
+
+absl::Status ClipRouter::Settle(const std::string& name, const ClipRoute& route,
+                                std::optional<int64_t> stored_clip_id) {
+  if (!stored_clip_id) {
+    if (route.held_by == 0) return names_.Release(name, route.clip_id).status();
+    return absl::OkStatus();
+  }
+  if (route.held_by != 0 && *stored_clip_id == route.clip_id) {
+    return names_.Reassign(name, route.held_by, route.clip_id).status();
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace motiondb::cluster

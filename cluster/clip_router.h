@@ -5,6 +5,7 @@
 #define MOTIONDB_CLUSTER_CLIP_ROUTER_H_
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -17,8 +18,10 @@
 namespace motiondb::cluster {
 
 struct ClipRoute {
-  int64_t clip_id = 0;
-  bool name_was_held = false;  // the id is the clip's the name was reserved for already
+  int64_t clip_id = 0;  // the id to store the clip under: never held by a clip before
+  // The clip the name was reserved for already (its clip's shard is then the new id's, so that
+  // the shard decides the conflict); 0: the name was free and is now reserved for clip_id.
+  int64_t held_by = 0;
   int shard = 0;
   int64_t epoch = 0;    // of the map routed by
   std::string node_id;  // holding the shard
@@ -31,17 +34,23 @@ class ClipRouter {
   ClipRouter(const EtcdClient& etcd, const ShardMapWatcher& watcher, const std::string& cluster,
              size_t max_name_bytes);
 
-  // Routes the clip named `name`. A name reserved already routes to the clip it was reserved
-  // for, whose shard then decides the conflict as one node does (skip, refuse, or replace under
-  // the same id): so a name is stored on one shard only, and a name whose store failed after its
-  // reservation is stored there on the next try. A free name is reserved for a new id. Errors:
+  // Routes the clip named `name` to a new id. A free name is reserved for it. A name reserved
+  // already keeps its clip's shard: the new id is the block's next on that shard, whose node
+  // then decides the conflict as one node does (skip, refuse, or replace by the new id), so that a
+  // name is stored on one shard only; Settle then moves the name to the id stored. Errors:
   // ClipIdBlocks::Next's and ClipNames::Reserve's; UNAVAILABLE when etcd cannot be read by
   // `deadline` or the node holding the shard is not live (naming both).
   absl::StatusOr<ClipRoute> Route(const std::string& name, absl::Time deadline);
+  // After the shard's answer: the name follows a clip stored under the route's new id
+  // (`stored_clip_id`, the answer's clip: a skip answers with the clip kept), or is freed when the
+  // shard refused a clip whose name Route reserved (nullopt: only for a refusal that is sure, so
+  // never for an answer lost on the way).
+  absl::Status Settle(const std::string& name, const ClipRoute& route,
+                      std::optional<int64_t> stored_clip_id);
 
  private:
-  // The id `name` is reserved for, reserving it for a new id when it is free.
-  absl::StatusOr<ClipRoute> ReserveName(const std::string& name);
+  // The next id of the block on `shard` of `shard_count`; the ids passed over are never used.
+  absl::StatusOr<int64_t> NextIdOnShard(int shard, int shard_count);
 
   const EtcdClient& etcd_;
   const ShardMapWatcher& watcher_;

@@ -57,11 +57,20 @@ absl::Status ClusterNode::CheckClipOwner(int64_t clip_id, absl::Time deadline) c
 
 absl::StatusOr<ClipRoute> ClusterNode::RouteClip(const std::string& name,
                                                  absl::Time deadline) const {
-  if (router_ == nullptr) {
-    return absl::FailedPreconditionError(
-        absl::StrCat("node '", node_id_, "' is a shard node; a router routes writes"));
-  }
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
   return router_->Route(name, deadline);
+}
+
+absl::Status ClusterNode::SettleClip(const std::string& name, const ClipRoute& route,
+                                     std::optional<int64_t> stored_clip_id) const {
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
+  return router_->Settle(name, route, stored_clip_id);
+}
+
+absl::Status ClusterNode::CheckRouter() const {
+  if (router_ != nullptr) return absl::OkStatus();
+  return absl::FailedPreconditionError(
+      absl::StrCat("node '", node_id_, "' is a shard node; a router routes writes"));
 }
 
 ClusterNode::~ClusterNode() {

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -45,9 +46,13 @@ class ClusterNode {
   // A router's route for the write of the clip named `name` (ClipRouter::Route);
   // FAILED_PRECONDITION on a shard node, which routes nothing.
   absl::StatusOr<ClipRoute> RouteClip(const std::string& name, absl::Time deadline) const;
+  // ClipRouter::Settle on a router; FAILED_PRECONDITION on a shard node.
+  absl::Status SettleClip(const std::string& name, const ClipRoute& route,
+                          std::optional<int64_t> stored_clip_id) const;
 
  private:
   explicit ClusterNode(std::string node_id) : node_id_(std::move(node_id)) {}
+  absl::Status CheckRouter() const;  // FAILED_PRECONDITION on a shard node
 
   const std::string node_id_;
 

@@ -118,6 +118,11 @@ absl::Status Catalog::IndexIngested(
 absl::StatusOr<IngestedClip> Catalog::IngestClip(const storage::ClipRecord& record,
                                                  const Clip& clip, const IngestClipOptions& options,
                                                  const std::function<bool()>& should_stop) {
+  if (cluster_shard_ && options.clip_id == 0) {
+    return absl::FailedPreconditionError(
+        "this node is a cluster's shard node: clips are stored through a router, which gives "
+        "them ids and names unique in the cluster");
+  }
   std::lock_guard<std::mutex> lock(write_mutex_);
   // Decided before the projections are computed, which a skip or a refusal does not need. The
   // database checks the name again in the insert's transaction.
@@ -184,6 +189,11 @@ absl::Status Catalog::DeleteClip(int64_t clip_id, const std::function<bool()>& s
 absl::StatusOr<storage::ClipRecord> Catalog::UpdateClip(int64_t clip_id,
                                                         const storage::ClipUpdate& update,
                                                         const std::function<bool()>& should_stop) {
+  if (cluster_shard_ && update.name) {
+    return absl::FailedPreconditionError(
+        "this node is a cluster's shard node: a clip's name is reserved in the cluster, and "
+        "renamed through a router");
+  }
   std::lock_guard<std::mutex> lock(write_mutex_);
   MOTIONDB_ASSIGN_OR_RETURN(storage::ClipRecord record,
                             database_.UpdateClip(clip_id, update, {.should_stop = should_stop}));

@@ -68,8 +68,11 @@ struct IngestClipOptions {
 
 class Catalog {
  public:
-  Catalog(storage::Database& database, IndexRegistry& registry)
-      : database_(database), registry_(registry) {}
+  // `cluster_shard`: the database is a cluster's shard node's, whose clips come through a router
+  // with ids unique cluster-wide (IngestClipOptions::clip_id) and names reserved cluster-wide: an
+  // ingest without an id, and a rename, are refused (FAILED_PRECONDITION).
+  Catalog(storage::Database& database, IndexRegistry& registry, bool cluster_shard = false)
+      : database_(database), registry_(registry), cluster_shard_(cluster_shard) {}
 
   // Loads every stored space and its cached projections into the registry (at start; nothing
   // is recomputed).
@@ -129,6 +132,7 @@ class Catalog {
 
   storage::Database& database_;
   IndexRegistry& registry_;
+  const bool cluster_shard_;
   std::mutex write_mutex_;
 };
 

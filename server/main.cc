@@ -19,6 +19,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -80,8 +81,8 @@ void AddClusterFlags(CLI::App& app, ClusterFlags* cluster) {
       ->type_name("ID")
       ->needs(etcd);
   motiondb::cli::OneOf(app.add_option("--role", cluster->options.node.role,
-                                      "with --cluster: hold shards, or route (the router does "
-                                      "not route yet: it registers)"),
+                                      "with --cluster: hold shards, or route (a router routes "
+                                      "ingests so far: ARCHITECTURE.md)"),
                        {"shard", "router"})
       ->capture_default_str()
       ->needs(etcd);
@@ -127,35 +128,44 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
 
 // The cluster node once it has joined, for a shard's checks and a router's routes: the server
 // starts serving first, since the node advertises the port it listens on.
-class JoinedNode {
+class JoinedNode final : public motiondb::server::ClipRouting {
  public:
-  void Set(std::shared_ptr<motiondb::cluster::ClusterNode> node) {
+  void Join(std::shared_ptr<motiondb::cluster::ClusterNode> node) {
     std::lock_guard<std::mutex> lock(mutex_);
     node_ = std::move(node);
   }
+  // A call under way may hold the node a moment longer; it leaves the cluster when that ends.
+  void Leave() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    node_.reset();
+    left_ = true;
+  }
   absl::Status CheckClipOwner(int64_t clip_id, absl::Time deadline) const {
-    const std::shared_ptr<motiondb::cluster::ClusterNode> node = Get();
-    if (node == nullptr) return NotJoined();
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
     return node->CheckClipOwner(clip_id, deadline);
   }
-  absl::StatusOr<motiondb::cluster::ClipRoute> RouteClip(const std::string& name,
-                                                         absl::Time deadline) const {
-    const std::shared_ptr<motiondb::cluster::ClusterNode> node = Get();
-    if (node == nullptr) return NotJoined();
-    return node->RouteClip(name, deadline);
+  absl::StatusOr<motiondb::cluster::ClipRoute> Route(const std::string& clip_name,
+                                                     absl::Time deadline) override {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
+    return node->RouteClip(clip_name, deadline);
+  }
+  absl::Status Settle(const std::string& clip_name, const motiondb::cluster::ClipRoute& route,
+                      std::optional<int64_t> stored_clip_id) override {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
+    return node->SettleClip(clip_name, route, stored_clip_id);
   }
 
  private:
-  std::shared_ptr<motiondb::cluster::ClusterNode> Get() const {
+  absl::StatusOr<std::shared_ptr<motiondb::cluster::ClusterNode>> Get() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    return node_;
-  }
-  static absl::Status NotJoined() {
-    return absl::UnavailableError("this node is not in its cluster yet");
+    if (node_ != nullptr) return node_;
+    return absl::UnavailableError(left_ ? "this node has left its cluster (it is stopping)"
+                                        : "this node is not in its cluster yet");
   }
 
   mutable std::mutex mutex_;
   std::shared_ptr<motiondb::cluster::ClusterNode> node_;
+  bool left_ = false;
 };
 
 // Joins the cluster as the node at `server`'s port: ready (health, /readyz) only while
@@ -409,6 +419,12 @@ int main(int argc, char** argv) {
   if (const absl::Status status = ReadClusterFlags(&cluster); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
   }
+  if (!cluster.etcd.empty() && !flags.tls_cert.empty()) {
+    return motiondb::cli::UsageError(
+        app,
+        "--cluster with --tls-cert: a cluster's nodes call each other in plain text (TLS "
+        "between them is to come); run the cluster on a private network");
+  }
   http_options.loop.head_timeout = std::chrono::seconds(flags.http_request_timeout_s);
   http_options.loop.min_body_rate = options.uploads.min_bytes_per_s;
   http_options.connections.max_per_peer = options.connections.max_per_peer;
@@ -422,9 +438,7 @@ int main(int argc, char** argv) {
     };
   }
   if (!cluster.etcd.empty() && cluster.options.node.role == "router") {
-    options.route_clip = [joined_node](const std::string& name, absl::Time deadline) {
-      return joined_node->RouteClip(name, deadline);
-    };
+    options.clip_routing = joined_node;
   }
   absl::StatusOr<std::unique_ptr<motiondb::server::MotionDbServer>> server =
       motiondb::server::MotionDbServer::Start(options);
@@ -449,7 +463,7 @@ int main(int argc, char** argv) {
       std::cerr << "motiondb-server: " << joined.status().message() << "\n";
       return 1;
     }
-    joined_node->Set(*std::move(joined));
+    joined_node->Join(*std::move(joined));
   }
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);
@@ -460,8 +474,9 @@ int main(int argc, char** argv) {
   // face still writes then is cut at the same deadline.
   const auto steady_deadline = std::chrono::steady_clock::now() + kShutdownGrace;
   // Leaving the cluster first (its lease revoked) tells the others at once, and ends the
-  // registration's readiness changes before Shutdown() turns the health NOT_SERVING.
-  joined_node->Set(nullptr);  // a shard service call under way may hold it a moment longer
+  // registration's readiness changes before Shutdown() turns the health NOT_SERVING (unless a
+  // call under way holds the node: it leaves when that call ends).
+  joined_node->Leave();
   if (http) http->BeginStop();
   (*server)->Shutdown(std::chrono::system_clock::now() + kShutdownGrace);
   if (http) http->Stop(steady_deadline);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -451,6 +452,14 @@ TEST_F(ClusterEtcdTest, ClipNamesHaveOneHolderAtATime) {
   ASSERT_TRUE(names.Reserve("walk", 8).ok());
   EXPECT_EQ(*names.Lookup("walk"), 8);
 
+  // A replacement's new id takes the name over from its holder only.
+  EXPECT_FALSE(*names.Reassign("walk", 7, 9));  // not its holder
+  EXPECT_TRUE(*names.Reassign("walk", 8, 9));
+  EXPECT_EQ(*names.Lookup("walk"), 9);
+  EXPECT_FALSE(*names.Reassign("run", 8, 9));  // free: left free
+  EXPECT_EQ(*names.Lookup("run"), std::nullopt);
+  EXPECT_EQ(names.Reassign("walk", 9, 0).status().code(), absl::StatusCode::kInvalidArgument);
+
   EXPECT_EQ(names.Reserve("", 1).code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(names.Reserve(std::string(17, 'x'), 1).code(), absl::StatusCode::kInvalidArgument);
   EXPECT_TRUE(names.Reserve(std::string(16, 'x'), 1).ok());
@@ -853,6 +862,17 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("take 1: 'take.bvh' has 1 takes"));
   EXPECT_EQ(store_take(0, "none", 0, &stored).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  // Nor does the node store a clip sent to it directly: its id and name would be no router's.
+  {
+    auto clips = v1::ClipService::NewStub(testing::InsecureChannel(shards["s1"].address()));
+    v1::IngestClipRequest direct;
+    direct.set_file_name("direct.bvh");
+    direct.set_bvh(BvhText(ChainClip()));
+    grpc::ClientContext context;
+    status = clips->IngestClip(&context, direct, &stored);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    EXPECT_THAT(status.error_message(), HasSubstr("clips are stored through a router"));
+  }
   EXPECT_THAT(clips_on_s1(), ::testing::ElementsAre(id_of["s1"]));
 
   // Once the map gives the shard to s1, s1 stores its clips at once: the map is read for the
@@ -948,8 +968,8 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   }
   EXPECT_EQ(stored, routed);
 
-  // The same name again: skipped when identical, refused when not, replaced when asked, on the
-  // clip's own shard and under its id.
+  // The same name again: skipped when identical, refused when not, replaced when asked: on the
+  // clip's own shard, under a new id there, which the name then follows.
   const int64_t first = routed.begin()->first;
   const std::string first_name = routed.begin()->second;
   const double first_speed = 0.01 * (first_name.back() - '0' + 1);
@@ -961,16 +981,36 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   EXPECT_EQ(conflict.error_code(), grpc::StatusCode::ALREADY_EXISTS) << conflict.error_message();
   ASSERT_TRUE(ingest(first_name, 0.5, v1::ON_CONFLICT_REPLACE, &again).ok());
   EXPECT_EQ(again.result(), v1::INGEST_RESULT_REPLACED);
-  EXPECT_EQ(again.clip().clip_id(), first);
+  EXPECT_EQ(again.replaced_clip_id(), first);
+  const int64_t replacement = again.clip().clip_id();
+  EXPECT_EQ(routed.count(replacement), 0u);  // a new id, never another clip's
+  EXPECT_EQ(ShardOfClip(replacement, 4), ShardOfClip(first, 4));
   const std::string first_node = map.owners[ShardOfClip(first, map.shard_count())];
-  EXPECT_EQ(clips_on(first_node).count(first), 1u);
-  EXPECT_EQ(clips_on(first_node == "s1" ? "s2" : "s1").count(first), 0u);
+  EXPECT_EQ(clips_on(first_node).count(first), 0u);
+  EXPECT_EQ(clips_on(first_node).at(replacement), first_name);
+  const ClipNames names(*client_, "motiondb", 512);
+  EXPECT_EQ(*names.Lookup(first_name), replacement);
+  ASSERT_TRUE(ingest(first_name, 0.5, v1::ON_CONFLICT_UNSPECIFIED, &again).ok());
+  EXPECT_EQ(again.result(), v1::INGEST_RESULT_SKIPPED);
+  EXPECT_EQ(again.clip().clip_id(), replacement);
 
   // A bad name is refused before anything is reserved or stored.
   v1::IngestClipResponse bad;
   EXPECT_EQ(ingest("a//b", 0.1, v1::ON_CONFLICT_UNSPECIFIED, &bad).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_EQ(*ClipNames(*client_, "motiondb", 512).Lookup("a//b"), std::nullopt);
+  EXPECT_EQ(*names.Lookup("a//b"), std::nullopt);
+  // A name the shard refuses to store (its tag is empty) is free again.
+  {
+    v1::IngestClipRequest request;
+    request.set_file_name("tagged.bvh");
+    request.set_bvh(BvhText(ChainClip(0.2)));
+    request.add_tags("");
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kBound);
+    const grpc::Status refused = router->IngestClip(&context, request, &bad);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << refused.error_message();
+    EXPECT_EQ(*names.Lookup("tagged"), std::nullopt);
+  }
 
   // s2 killed: the next ingest whose id falls on its shards fails, naming it.
   nodes["s2"].Stop(SIGKILL);
@@ -998,6 +1038,16 @@ TEST_F(ClusterServerTest, RegistersTheAdvertisedAddress) {
     const absl::StatusOr<std::vector<NodeInfo>> nodes = ListNodes(*client_, "motiondb");
     return nodes.ok() && nodes->size() == 1 && (*nodes)[0].address == "shard-0.motiondb-shard:7000";
   })) << server.Log();
+
+  // TLS between the nodes is not built: refused rather than left to fail on the first call.
+  std::ofstream(dir / "cert.pem") << "";
+  std::ofstream(dir / "key.pem") << "";
+  testing::ServerProcess tls;
+  EXPECT_FALSE(tls.Start({"--db", (dir / "c.sqlite").string(), "--http", "off", "--cluster",
+                          etcd_.endpoints_flag(), "--node-id", "c", "--tls-cert",
+                          (dir / "cert.pem").string(), "--tls-key", (dir / "key.pem").string()},
+                         &error));
+  EXPECT_THAT(error, HasSubstr("--cluster with --tls-cert"));
 
   testing::ServerProcess wildcard;
   EXPECT_FALSE(wildcard.Start({"--db", (dir / "b.sqlite").string(), "--http", "off", "--cluster",

@@ -92,7 +92,8 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   State& s = *state;
   s.options = options;
   MOTIONDB_ASSIGN_OR_RETURN(s.database, storage::Database::Open(options.db_path));
-  s.catalog = std::make_unique<Catalog>(*s.database, s.registry);
+  s.catalog = std::make_unique<Catalog>(*s.database, s.registry,
+                                        /*cluster_shard=*/bool(options.check_shard_owner));
   const auto load_start = std::chrono::steady_clock::now();
   MOTIONDB_RETURN_IF_ERROR(s.catalog->LoadIndices());
   const auto spaces = s.registry.All();
@@ -120,9 +121,9 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
                    .min_bytes_per_s = options.uploads.min_bytes_per_s,
                    .rate_grace = options.uploads.rate_grace});
   const AnswerLimit answers(int64_t{options.max_answer_mb} << 20);
-  if (options.route_clip) {
+  if (options.clip_routing) {
     s.clips = std::make_unique<RoutedClipServiceImpl>(options.uploads, *s.uploads, *s.gate,
-                                                      options.route_clip);
+                                                      options.clip_routing);
   } else {
     s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
                                                 *s.uploads, *s.watchdog, *s.metrics, *s.gate);

@@ -1,6 +1,6 @@
 // motiondb.v1.ClipService on a cluster's router: an ingest's takes each stored on the shard node
 // its clip id belongs to (motiondb.shard.v1.ShardService.StoreTake), the ids and the names
-// reserved cluster-wide first (`route`, cluster::ClusterNode::RouteClip). The rest of the
+// reserved cluster-wide first and settled after (`routing`, cluster::ClipRouter). The rest of the
 // service is not routed yet: UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
 #ifndef MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
@@ -22,20 +22,24 @@ namespace motiondb::server {
 class RoutedClipServiceImpl final : public v1::ClipService::Service {
  public:
   RoutedClipServiceImpl(const UploadLimits& limits, UploadBudget& budget, CallGate& gate,
-                        ClipRouteLookup route)
-      : limits_(limits), budget_(budget), gate_(gate), route_(std::move(route)) {}
+                        std::shared_ptr<ClipRouting> routing)
+      : limits_(limits), budget_(budget), gate_(gate), routing_(std::move(routing)) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
 
  private:
+  // Take `take` of the file stored under its route: the shard's answer, the name settled.
+  absl::Status StoreTake(grpc::ServerContext& context, const v1::IngestClipRequest& request,
+                         size_t take, const std::string& take_name,
+                         v1::IngestClipResponse* response);
   // One channel a shard node, kept for the router's life.
   shard::v1::ShardService::Stub& ShardAt(const std::string& address);
 
   UploadLimits limits_;
   UploadBudget& budget_;
   CallGate& gate_;
-  ClipRouteLookup route_;
+  std::shared_ptr<ClipRouting> routing_;
   std::mutex mutex_;
   std::map<std::string, std::unique_ptr<shard::v1::ShardService::Stub>> shards_;  // by address
 };

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,10 +21,16 @@
 
 namespace motiondb::server {
 
-// Where a cluster's router sends the write of the clip of this name, by the deadline
-// (cluster::ClusterNode::RouteClip).
-using ClipRouteLookup = std::function<absl::StatusOr<cluster::ClipRoute>(
-    const std::string& clip_name, absl::Time deadline)>;
+// A cluster router's routing of clip writes (cluster::ClipRouter; server/main.cc's holds the
+// cluster node, which joins after the server starts). Thread-safe.
+class ClipRouting {
+ public:
+  virtual ~ClipRouting() = default;
+  virtual absl::StatusOr<cluster::ClipRoute> Route(const std::string& clip_name,
+                                                   absl::Time deadline) = 0;
+  virtual absl::Status Settle(const std::string& clip_name, const cluster::ClipRoute& route,
+                              std::optional<int64_t> stored_clip_id) = 0;
+};
 
 struct ServerOptions {
   // The SQLite file; created when missing (--db).
@@ -83,7 +91,7 @@ struct ServerOptions {
   std::function<absl::Status(int64_t clip_id, absl::Time deadline)> check_shard_owner;
   // Set on a cluster's router (server/main.cc): ClipService's ingests go to their clips' shard
   // nodes (server/grpc/routed_clip_service.h) instead of this node's database.
-  ClipRouteLookup route_clip;
+  std::shared_ptr<ClipRouting> clip_routing;
 };
 
 }  // namespace motiondb::server
