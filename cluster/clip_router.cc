@@ -1,5 +1,6 @@
 #include "cluster/clip_router.h"
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -53,15 +54,51 @@ absl::StatusOr<ClipRoute> ClipRouter::Route(const std::string& name, absl::Time 
   route.shard = ShardOfClip(route.clip_id, map.shard_count());
   route.epoch = map.epoch;
   route.node_id = map.owners[route.shard];
-  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<NodeInfo> nodes, ListNodes(etcd_, cluster_));
-  for (const NodeInfo& node : nodes) {
-    if (node.node_id == route.node_id) {
-      route.address = node.address;
-      return route;
-    }
+  // A write is routed to a node live now, not to an address remembered.
+  MOTIONDB_ASSIGN_OR_RETURN(route.address,
+                            AddressOf(route.node_id, route.shard, map.epoch, /*refresh=*/true));
+  return route;
+}
+
+absl::StatusOr<std::string> ClipRouter::AddressOf(const std::string& node_id, int shard,
+                                                  int64_t epoch, bool refresh) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto known = addresses_.find(node_id);
+    if (!refresh && known != addresses_.end()) return known->second;
   }
-  return absl::UnavailableError(absl::StrCat("shard ", route.shard, "'s node '", route.node_id,
-                                             "' is not live (map epoch ", map.epoch, ")"));
+  MOTIONDB_ASSIGN_OR_RETURN(const std::vector<NodeInfo> nodes, ListNodes(etcd_, cluster_));
+  std::lock_guard<std::mutex> lock(mutex_);
+  addresses_.clear();
+  for (const NodeInfo& node : nodes) addresses_[node.node_id] = node.address;
+  const auto live = addresses_.find(node_id);
+  if (live != addresses_.end()) return live->second;
+  return absl::UnavailableError(
+      absl::StrCat("shard ", shard, "'s node '", node_id, "' is not live (map epoch ", epoch, ")"));
+}
+
+absl::StatusOr<ClipRoute> ClipRouter::Locate(int64_t clip_id, bool refresh) {
+  if (clip_id < 1) {
+    return absl::InvalidArgumentError(absl::StrCat("clip_id: ", clip_id, "; ids are positive"));
+  }
+  const std::shared_ptr<const ShardMap> map = watcher_.map();
+  if (map == nullptr) {
+    return absl::UnavailableError(
+        "the cluster's shard map has not been read yet (is the cluster initialised, and etcd "
+        "reachable?)");
+  }
+  ClipRoute route;
+  route.clip_id = clip_id;
+  route.shard = ShardOfClip(clip_id, map->shard_count());
+  route.epoch = map->epoch;
+  route.node_id = map->owners[route.shard];
+  MOTIONDB_ASSIGN_OR_RETURN(route.address,
+                            AddressOf(route.node_id, route.shard, map->epoch, refresh));
+  return route;
+}
+
+absl::Status ClipRouter::ReleaseName(const std::string& name, int64_t clip_id) {
+  return names_.Release(name, clip_id).status();
 }
 
 absl::Status ClipRouter::Settle(const std::string& name, const ClipRoute& route,

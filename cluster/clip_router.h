@@ -5,6 +5,8 @@
 #define MOTIONDB_CLUSTER_CLIP_ROUTER_H_
 
 #include <cstdint>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -48,7 +50,20 @@ class ClipRouter {
   absl::Status Settle(const std::string& name, const ClipRoute& route,
                       std::optional<int64_t> stored_clip_id);
 
+  // Where clip `clip_id` is read: the node of its shard in the last map seen (so reads go on
+  // while etcd is unreachable), at the address last listed for it (listed afresh from etcd when
+  // the node is not among those known, or with `refresh`: after a call to it failed).
+  // UNAVAILABLE before the first map, or when the node is not live; INVALID_ARGUMENT for an id
+  // below 1.
+  absl::StatusOr<ClipRoute> Locate(int64_t clip_id, bool refresh = false);
+  // Frees `name` if clip `clip_id` holds it (a deleted clip's), as ClipNames::Release.
+  absl::Status ReleaseName(const std::string& name, int64_t clip_id);
+
  private:
+  // The address of live node `node_id` (ListNodes into addresses_ when unknown or `refresh`).
+  absl::StatusOr<std::string> AddressOf(const std::string& node_id, int shard, int64_t epoch,
+                                        bool refresh);
+
   // The next id of the block on `shard` of `shard_count`; the ids passed over are never used.
   absl::StatusOr<int64_t> NextIdOnShard(int shard, int shard_count);
 
@@ -57,6 +72,8 @@ class ClipRouter {
   const std::string cluster_;
   ClipIdBlocks ids_;
   const ClipNames names_;
+  std::mutex mutex_;
+  std::map<std::string, std::string> addresses_;  // guarded by mutex_: node id -> address
 };
 
 }  // namespace motiondb::cluster

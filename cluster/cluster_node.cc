@@ -67,6 +67,16 @@ absl::Status ClusterNode::SettleClip(const std::string& name, const ClipRoute& r
   return router_->Settle(name, route, stored_clip_id);
 }
 
+absl::StatusOr<ClipRoute> ClusterNode::LocateClip(int64_t clip_id, bool refresh) const {
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
+  return router_->Locate(clip_id, refresh);
+}
+
+absl::Status ClusterNode::ReleaseClipName(const std::string& name, int64_t clip_id) const {
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
+  return router_->ReleaseName(name, clip_id);
+}
+
 absl::Status ClusterNode::CheckRouter() const {
   if (router_ != nullptr) return absl::OkStatus();
   return absl::FailedPreconditionError(

@@ -49,6 +49,9 @@ class ClusterNode {
   // ClipRouter::Settle on a router; FAILED_PRECONDITION on a shard node.
   absl::Status SettleClip(const std::string& name, const ClipRoute& route,
                           std::optional<int64_t> stored_clip_id) const;
+  // ClipRouter::Locate and ReleaseName on a router; FAILED_PRECONDITION on a shard node.
+  absl::StatusOr<ClipRoute> LocateClip(int64_t clip_id, bool refresh) const;
+  absl::Status ReleaseClipName(const std::string& name, int64_t clip_id) const;
 
  private:
   explicit ClusterNode(std::string node_id) : node_id_(std::move(node_id)) {}

@@ -154,6 +154,14 @@ class JoinedNode final : public motiondb::server::ClipRouting {
     MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
     return node->SettleClip(clip_name, route, stored_clip_id);
   }
+  absl::StatusOr<motiondb::cluster::ClipRoute> Locate(int64_t clip_id, bool refresh) override {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
+    return node->LocateClip(clip_id, refresh);
+  }
+  absl::Status ReleaseName(const std::string& clip_name, int64_t clip_id) override {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
+    return node->ReleaseClipName(clip_name, clip_id);
+  }
 
  private:
   absl::StatusOr<std::shared_ptr<motiondb::cluster::ClusterNode>> Get() const {

@@ -1012,6 +1012,67 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
     EXPECT_EQ(*names.Lookup("tagged"), std::nullopt);
   }
 
+  // A call on one clip goes to its node: get, export (whole and streamed), poses, delete (which
+  // frees the name).
+  auto stub_of = [&](const std::string& node) {
+    return v1::ClipService::NewStub(testing::InsecureChannel(nodes[node].address()));
+  };
+  const auto context = [] {
+    auto made = std::make_unique<grpc::ClientContext>();
+    made->set_deadline(std::chrono::system_clock::now() + kBound);
+    return made;
+  };
+  std::map<int64_t, std::string> now;
+  for (const std::string node : {"s1", "s2"}) now.merge(clips_on(node));
+  for (const auto& [id, name] : now) {
+    v1::GetClipRequest get;
+    get.set_clip_id(id);
+    v1::Clip clip;
+    const grpc::Status got = router->GetClip(context().get(), get, &clip);
+    ASSERT_TRUE(got.ok()) << got.error_message() << nodes["r1"].Log();
+    EXPECT_EQ(clip.name(), name);
+  }
+  const int64_t second = std::next(routed.begin())->first;
+  v1::ExportClipRequest export_request;
+  export_request.mutable_clip()->set_clip_id(second);
+  v1::ExportClipResponse exported;
+  ASSERT_TRUE(router->ExportClip(context().get(), export_request, &exported).ok());
+  {
+    v1::ExportClipResponse direct;
+    const std::string node = map.owners[ShardOfClip(second, map.shard_count())];
+    ASSERT_TRUE(stub_of(node)->ExportClip(context().get(), export_request, &direct).ok());
+    EXPECT_EQ(exported.bvh(), direct.bvh());
+  }
+  {
+    const auto streamed_context = context();
+    auto reader = router->ExportClipStream(streamed_context.get(), export_request);
+    std::string streamed;
+    v1::ExportClipResponse piece;
+    while (reader->Read(&piece)) streamed += piece.bvh();
+    ASSERT_TRUE(reader->Finish().ok());
+    EXPECT_EQ(streamed, exported.bvh());
+  }
+  v1::GetClipPosesRequest poses_request;
+  poses_request.mutable_clip()->set_clip_id(second);
+  v1::ClipPoses poses;
+  EXPECT_TRUE(router->GetClipPoses(context().get(), poses_request, &poses).ok());
+  v1::GetClipRequest nothing;
+  v1::Clip none;
+  EXPECT_EQ(router->GetClip(context().get(), nothing, &none).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::DeleteClipRequest delete_request;
+  delete_request.set_clip_id(second);
+  v1::DeleteClipResponse deleted;
+  const grpc::Status gone = router->DeleteClip(context().get(), delete_request, &deleted);
+  ASSERT_TRUE(gone.ok()) << gone.error_message();
+  v1::GetClipRequest get_second;
+  get_second.set_clip_id(second);
+  EXPECT_EQ(router->GetClip(context().get(), get_second, &none).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(*names.Lookup(routed.at(second)), std::nullopt);
+  EXPECT_EQ(router->DeleteClip(context().get(), delete_request, &deleted).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
   // s2 killed: the next ingest whose id falls on its shards fails, naming it.
   nodes["s2"].Stop(SIGKILL);
   grpc::Status failed;
@@ -1022,6 +1083,17 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   }
   EXPECT_EQ(failed.error_code(), grpc::StatusCode::UNAVAILABLE) << failed.error_message();
   EXPECT_THAT(failed.error_message(), HasSubstr("node 's2'"));
+
+  // etcd gone: reads go on from the last map and the addresses known.
+  etcd_.Stop(0, /*graceful=*/true);
+  for (const auto& [id, name] : clips_on("s1")) {
+    v1::GetClipRequest get;
+    get.set_clip_id(id);
+    v1::Clip clip;
+    const grpc::Status got = router->GetClip(context().get(), get, &clip);
+    EXPECT_TRUE(got.ok()) << got.error_message();
+    EXPECT_EQ(clip.name(), name);
+  }
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.

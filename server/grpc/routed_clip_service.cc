@@ -26,15 +26,6 @@ void PassTokenOn(const grpc::ServerContext& from, grpc::ClientContext* to) {
   }
 }
 
-// A shard's error as the client sees it: the node it came from named when the node did not
-// answer; the shard's own refusal (a bad file, a conflict) as one node would give it.
-absl::Status ShardError(const grpc::Status& status, const cluster::ClipRoute& route) {
-  absl::Status error = FromGrpcStatus(status);
-  if (!absl::IsUnavailable(error)) return error;
-  return absl::UnavailableError(absl::StrCat("shard ", route.shard, " (node '", route.node_id,
-                                             "' at ", route.address, "): ", error.message()));
-}
-
 // Whether a failed call may have stored the clip all the same: its answer lost on the way.
 bool IsOutcomeUnknown(const absl::Status& status) {
   return absl::IsUnavailable(status) || absl::IsDeadlineExceeded(status) ||
@@ -43,14 +34,112 @@ bool IsOutcomeUnknown(const absl::Status& status) {
 
 }  // namespace
 
-shard::v1::ShardService::Stub& RoutedClipServiceImpl::ShardAt(const std::string& address) {
+RoutedClipServiceImpl::NodeStubs& RoutedClipServiceImpl::NodeAt(const std::string& address) {
   std::lock_guard<std::mutex> lock(mutex_);
-  std::unique_ptr<shard::v1::ShardService::Stub>& stub = shards_[address];
-  if (stub == nullptr) {
-    stub = shard::v1::ShardService::NewStub(
-        grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  NodeStubs& stubs = nodes_[address];
+  if (stubs.shard == nullptr) {
+    const std::shared_ptr<grpc::Channel> channel =
+        grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
+    stubs.shard = shard::v1::ShardService::NewStub(channel);
+    stubs.clips = v1::ClipService::NewStub(channel);
   }
-  return *stub;
+  return stubs;
+}
+
+absl::Status RoutedClipServiceImpl::NodeFailed(const grpc::Status& status,
+                                               const cluster::ClipRoute& route) {
+  absl::Status error = FromGrpcStatus(status);
+  // The node's own refusal (a bad file, a conflict, no such clip) is told as one node tells it.
+  if (!absl::IsUnavailable(error)) return error;
+  (void)routing_->Locate(route.clip_id, /*refresh=*/true);  // its address may have changed
+  return absl::UnavailableError(absl::StrCat("shard ", route.shard, " (node '", route.node_id,
+                                             "' at ", route.address, "): ", error.message()));
+}
+
+absl::StatusOr<RoutedClipServiceImpl::NodeCall> RoutedClipServiceImpl::CallClipNode(
+    const grpc::ServerContext& context, int64_t clip_id) {
+  NodeCall call;
+  MOTIONDB_ASSIGN_OR_RETURN(call.route, routing_->Locate(clip_id, /*refresh=*/false));
+  call.clips = NodeAt(call.route.address).clips.get();
+  call.context = grpc::ClientContext::FromServerContext(context);
+  PassTokenOn(context, call.context.get());
+  return call;
+}
+
+template <typename Request, typename Response>
+grpc::Status RoutedClipServiceImpl::Pass(grpc::ServerContext* context, int64_t clip_id,
+                                         const Request& request, Response* response,
+                                         grpc::Status (v1::ClipService::Stub::*method)(
+                                             grpc::ClientContext*, const Request&, Response*)) {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, clip_id));
+    const grpc::Status status = (call.clips->*method)(call.context.get(), request, response);
+    return status.ok() ? absl::OkStatus() : NodeFailed(status, call.route);
+  });
+}
+
+grpc::Status RoutedClipServiceImpl::GetClip(grpc::ServerContext* context,
+                                            const v1::GetClipRequest* request, v1::Clip* response) {
+  return Pass(context, request->clip_id(), *request, response, &v1::ClipService::Stub::GetClip);
+}
+
+grpc::Status RoutedClipServiceImpl::ExportClip(grpc::ServerContext* context,
+                                               const v1::ExportClipRequest* request,
+                                               v1::ExportClipResponse* response) {
+  return Pass(context, request->clip().clip_id(), *request, response,
+              &v1::ClipService::Stub::ExportClip);
+}
+
+grpc::Status RoutedClipServiceImpl::GetClipPoses(grpc::ServerContext* context,
+                                                 const v1::GetClipPosesRequest* request,
+                                                 v1::ClipPoses* response) {
+  return Pass(context, request->clip().clip_id(), *request, response,
+              &v1::ClipService::Stub::GetClipPoses);
+}
+
+grpc::Status RoutedClipServiceImpl::ExportClipStream(
+    grpc::ServerContext* context, const v1::ExportClipRequest* request,
+    grpc::ServerWriter<v1::ExportClipResponse>* writer) {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, request->clip().clip_id()));
+    const std::unique_ptr<grpc::ClientReader<v1::ExportClipResponse>> pieces =
+        call.clips->ExportClipStream(call.context.get(), *request);
+    v1::ExportClipResponse piece;
+    while (pieces->Read(&piece)) {
+      if (!writer->Write(piece)) {
+        call.context->TryCancel();
+        (void)pieces->Finish();
+        return absl::CancelledError("the client stopped reading the export");
+      }
+    }
+    const grpc::Status status = pieces->Finish();
+    return status.ok() ? absl::OkStatus() : NodeFailed(status, call.route);
+  });
+}
+
+grpc::Status RoutedClipServiceImpl::DeleteClip(grpc::ServerContext* context,
+                                               const v1::DeleteClipRequest* request,
+                                               v1::DeleteClipResponse* response) {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    // The name, to free once the clip is gone.
+    MOTIONDB_ASSIGN_OR_RETURN(NodeCall get, CallClipNode(*context, request->clip_id()));
+    v1::GetClipRequest which;
+    which.set_clip_id(request->clip_id());
+    v1::Clip clip;
+    grpc::Status status = get.clips->GetClip(get.context.get(), which, &clip);
+    if (!status.ok()) return NodeFailed(status, get.route);
+    MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, request->clip_id()));
+    status = call.clips->DeleteClip(call.context.get(), *request, response);
+    if (!status.ok()) return NodeFailed(status, call.route);
+    if (const absl::Status freed = routing_->ReleaseName(clip.name(), request->clip_id());
+        !freed.ok()) {
+      return absl::Status(
+          freed.code(),
+          absl::StrCat("clip ", request->clip_id(), " was deleted, but its name '", clip.name(),
+                       "' is still reserved in the cluster: ", freed.message()));
+    }
+    return absl::OkStatus();
+  });
 }
 
 absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
@@ -68,12 +157,12 @@ absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
   // The caller's deadline and cancellation, and its token.
   const std::unique_ptr<grpc::ClientContext> call = grpc::ClientContext::FromServerContext(context);
   PassTokenOn(context, call.get());
-  const grpc::Status stored = ShardAt(route.address).StoreTake(call.get(), store, response);
+  const grpc::Status stored = NodeAt(route.address).shard->StoreTake(call.get(), store, response);
   if (stored.ok()) {
     MOTIONDB_RETURN_IF_ERROR(routing_->Settle(take_name, route, response->clip().clip_id()));
     return absl::OkStatus();
   }
-  const absl::Status error = ShardError(stored, route);
+  const absl::Status error = NodeFailed(stored, route);
   // A refusal frees the name it reserved; an answer lost on the way (the clip may be stored)
   // leaves it to the next try, which finds the clip on its shard.
   if (!IsOutcomeUnknown(error)) {

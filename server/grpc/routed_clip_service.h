@@ -1,7 +1,8 @@
 // motiondb.v1.ClipService on a cluster's router: an ingest's takes each stored on the shard node
 // its clip id belongs to (motiondb.shard.v1.ShardService.StoreTake), the ids and the names
-// reserved cluster-wide first and settled after (`routing`, cluster::ClipRouter). The rest of the
-// service is not routed yet: UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
+// reserved cluster-wide first and settled after (`routing`, cluster::ClipRouter); a call on one
+// clip (get, export, poses, delete) passed to its shard's node. The rest of the service is not
+// routed yet: UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
 #ifndef MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 
@@ -27,21 +28,55 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
+  grpc::Status GetClip(grpc::ServerContext* context, const v1::GetClipRequest* request,
+                       v1::Clip* response) override;
+  grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
+                          v1::ExportClipResponse* response) override;
+  grpc::Status ExportClipStream(grpc::ServerContext* context, const v1::ExportClipRequest* request,
+                                grpc::ServerWriter<v1::ExportClipResponse>* writer) override;
+  grpc::Status GetClipPoses(grpc::ServerContext* context, const v1::GetClipPosesRequest* request,
+                            v1::ClipPoses* response) override;
+  // Frees the clip's name in the cluster once its shard has deleted it.
+  grpc::Status DeleteClip(grpc::ServerContext* context, const v1::DeleteClipRequest* request,
+                          v1::DeleteClipResponse* response) override;
 
  private:
+  // A shard node's services, over one channel.
+  struct NodeStubs {
+    std::unique_ptr<shard::v1::ShardService::Stub> shard;
+    std::unique_ptr<v1::ClipService::Stub> clips;
+  };
+  // A call to the node holding clip `clip_id`, in `context`'s name (its deadline, cancellation
+  // and token).
+  struct NodeCall {
+    cluster::ClipRoute route;
+    v1::ClipService::Stub* clips = nullptr;
+    std::unique_ptr<grpc::ClientContext> context;
+  };
+  absl::StatusOr<NodeCall> CallClipNode(const grpc::ServerContext& context, int64_t clip_id);
+  // What a node's failure tells the caller; the clip's node is looked up afresh next time when
+  // it did not answer.
+  absl::Status NodeFailed(const grpc::Status& status, const cluster::ClipRoute& route);
+  // A unary call on one clip, passed to its node.
+  template <typename Request, typename Response>
+  grpc::Status Pass(grpc::ServerContext* context, int64_t clip_id, const Request& request,
+                    Response* response,
+                    grpc::Status (v1::ClipService::Stub::*method)(grpc::ClientContext*,
+                                                                  const Request&, Response*));
+
   // Take `take` of the file stored under its route: the shard's answer, the name settled.
   absl::Status StoreTake(grpc::ServerContext& context, const v1::IngestClipRequest& request,
                          size_t take, const std::string& take_name,
                          v1::IngestClipResponse* response);
   // One channel a shard node, kept for the router's life.
-  shard::v1::ShardService::Stub& ShardAt(const std::string& address);
+  NodeStubs& NodeAt(const std::string& address);
 
   UploadLimits limits_;
   UploadBudget& budget_;
   CallGate& gate_;
   std::shared_ptr<ClipRouting> routing_;
   std::mutex mutex_;
-  std::map<std::string, std::unique_ptr<shard::v1::ShardService::Stub>> shards_;  // by address
+  std::map<std::string, NodeStubs> nodes_;  // guarded by mutex_; by address
 };
 
 }  // namespace motiondb::server

@@ -30,6 +30,8 @@ class ClipRouting {
                                                    absl::Time deadline) = 0;
   virtual absl::Status Settle(const std::string& clip_name, const cluster::ClipRoute& route,
                               std::optional<int64_t> stored_clip_id) = 0;
+  virtual absl::StatusOr<cluster::ClipRoute> Locate(int64_t clip_id, bool refresh) = 0;
+  virtual absl::Status ReleaseName(const std::string& clip_name, int64_t clip_id) = 0;
 };
 
 struct ServerOptions {
