@@ -6,14 +6,16 @@
 #                                                    of S logical shards (default 64)
 #   scripts/cluster.sh status                        the nodes, their leases and the shard map
 #   scripts/cluster.sh etcd                          the etcd endpoints (for --etcd, --cluster)
+#   scripts/cluster.sh router                        the router's gRPC address (for --server)
 #   scripts/cluster.sh down                          stop everything, remove the cluster's folder
 #
 # Everything lives in $MOTIONDB_CLUSTER_DIR (default ./motiondb-cluster): etcd's data, each
 # node's database and log, the pids and the ports (free loopback ports picked at `up`). Needs
 # etcd (Debian's etcd-server, scripts/install-deps.sh) and a build of motiondb-server and the
 # CLI in $BUILD_DIR (default build/; scripts/start.sh or scripts/build.sh make it). What works
-# today: nodes register, follow the shard map and survive etcd going away; the router does not
-# route yet, and each node serves its own database only.
+# today (README.md, "A local cluster"): nodes register, follow the shard map and survive etcd
+# going away; the router stores each ingested clip on its shard's node and passes a call on one
+# clip to it; searches and listings are not routed yet.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build}"
@@ -89,6 +91,7 @@ up() {
       --role "$role" --quiet >"$dir/$node.log" 2>&1 &
     echo $! >"$dir/$node.pid"
     echo "$node: gRPC 127.0.0.1:${ports[6 + 2 * i]}, HTTP 127.0.0.1:${ports[7 + 2 * i]}" >>"$dir/nodes"
+    if [[ "$node" == router ]]; then echo "127.0.0.1:${ports[6 + 2 * i]}" >"$dir/router"; fi
   done
   # shellcheck disable=SC2317  # called through wait_for
   all_live() { [[ "$(live_nodes)" == "$((nodes + 1))" ]]; }
@@ -119,8 +122,8 @@ case "${1:-}" in
     [[ -f "$dir/etcd" ]] || die "no cluster in $dir (scripts/cluster.sh up)"
     "$cli" cluster status --etcd "$(cat "$dir/etcd")"
     cat "$dir/nodes" ;;
-  etcd)
-    [[ -f "$dir/etcd" ]] || die "no cluster in $dir (scripts/cluster.sh up)"
-    cat "$dir/etcd" ;;
-  *) die "usage: scripts/cluster.sh up [--nodes N] [--shards S] | status | etcd | down" ;;
+  etcd | router)
+    [[ -f "$dir/$1" ]] || die "no cluster in $dir (scripts/cluster.sh up)"
+    cat "$dir/$1" ;;
+  *) die "usage: scripts/cluster.sh up [--nodes N] [--shards S] | status | etcd | router | down" ;;
 esac

@@ -968,6 +968,31 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   }
   EXPECT_EQ(stored, routed);
 
+  // A file sent in a stream is stored as one sent whole.
+  {
+    const std::string text = BvhText(ChainClip(0.3));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kBound);
+    v1::IngestClipResponse response;
+    auto writer = router->IngestClipStream(&context, &response);
+    for (size_t at = 0; at < text.size(); at += text.size() / 3 + 1) {
+      v1::IngestClipStreamRequest piece;
+      if (at == 0) {
+        piece.set_file_name("streamed.bvh");
+        piece.add_tags("in-pieces");
+      }
+      piece.set_chunk(text.substr(at, text.size() / 3 + 1));
+      ASSERT_TRUE(writer->Write(piece));
+    }
+    writer->WritesDone();
+    const grpc::Status status = writer->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    const int64_t id = response.clip().clip_id();
+    EXPECT_EQ(routed.count(id), 0u);
+    EXPECT_THAT(response.clip().tags(), ::testing::ElementsAre("in-pieces"));
+    EXPECT_EQ(clips_on(map.owners[ShardOfClip(id, map.shard_count())]).at(id), "streamed");
+  }
+
   // The same name again: skipped when identical, refused when not, replaced when asked: on the
   // clip's own shard, under a new id there, which the name then follows.
   const int64_t first = routed.begin()->first;

@@ -12,6 +12,7 @@
 #include "server/grpc/clip_conversion.h"
 #include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
+#include "server/grpc/stream_upload.h"
 #include "storage/clip_name_check.h"
 #include "util/status_macros.h"
 
@@ -25,6 +26,31 @@ void PassTokenOn(const grpc::ServerContext& from, grpc::ClientContext* to) {
     to->AddMetadata("authorization", std::string(token->second.data(), token->second.size()));
   }
 }
+
+// A stream's messages as ReceiveUpload reads them, kept as the one request a router passes on:
+// the first one's fields, and every chunk's bytes.
+class KeptStream {
+ public:
+  explicit KeptStream(grpc::ServerReader<v1::IngestClipStreamRequest>& reader) : reader_(reader) {}
+  bool Read(v1::IngestClipStreamRequest* message) {
+    if (!reader_.Read(message)) return false;
+    if (first_) {
+      first_ = false;
+      request_.set_file_name(message->file_name());
+      request_.set_name(message->name());
+      *request_.mutable_tags() = message->tags();
+      request_.set_on_conflict(message->on_conflict());
+    }
+    request_.mutable_bvh()->append(message->chunk());
+    return true;
+  }
+  const v1::IngestClipRequest& request() const { return request_; }
+
+ private:
+  grpc::ServerReader<v1::IngestClipStreamRequest>& reader_;
+  bool first_ = true;
+  v1::IngestClipRequest request_;
+};
 
 // Whether a failed call may have stored the clip all the same: its answer lost on the way.
 bool IsOutcomeUnknown(const absl::Status& status) {
@@ -177,6 +203,27 @@ absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
   return error;
 }
 
+absl::Status RoutedClipServiceImpl::StoreTakes(grpc::ServerContext& context,
+                                               const v1::IngestClipRequest& request,
+                                               const std::string& name, const UploadedFile& file,
+                                               v1::IngestClipResponse* response) {
+  std::vector<std::string> stored;
+  for (size_t t = 0; t < file.takes.size(); ++t) {
+    const std::string take_name = TakeClipName(name, file, t);
+    v1::IngestClipResponse taken;
+    const absl::Status status = StoreTake(context, request, t, take_name, &taken);
+    if (!status.ok()) return TakeFailure(status, take_name, stored);
+    stored.push_back(take_name);
+    if (t == 0) {
+      *response = std::move(taken);
+    } else {
+      taken.clear_file();
+      *response->add_more_takes() = std::move(taken);
+    }
+  }
+  return absl::OkStatus();
+}
+
 grpc::Status RoutedClipServiceImpl::IngestClip(grpc::ServerContext* context,
                                                const v1::IngestClipRequest* request,
                                                v1::IngestClipResponse* response) {
@@ -189,21 +236,30 @@ grpc::Status RoutedClipServiceImpl::IngestClip(grpc::ServerContext* context,
     // reads the file again (it is sent whole) and stores that take alone.
     MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile file,
                               ReadUpload(request->bvh(), ingest.file_name, limits_, should_stop));
-    std::vector<std::string> stored;
-    for (size_t t = 0; t < file.takes.size(); ++t) {
-      const std::string take_name = TakeClipName(name, file, t);
-      v1::IngestClipResponse taken;
-      const absl::Status status = StoreTake(*context, *request, t, take_name, &taken);
-      if (!status.ok()) return TakeFailure(status, take_name, stored);
-      stored.push_back(take_name);
-      if (t == 0) {
-        *response = std::move(taken);
-      } else {
-        taken.clear_file();
-        *response->add_more_takes() = std::move(taken);
-      }
-    }
-    return absl::OkStatus();
+    return StoreTakes(*context, *request, name, file, response);
+  });
+}
+
+grpc::Status RoutedClipServiceImpl::IngestClipStream(
+    grpc::ServerContext* context, grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+    v1::IngestClipResponse* response) {
+  // As one node reads a stream (ClipServiceImpl::IngestClipStream: the right first, the stream
+  // read outside --threads, parsed as it arrives), keeping its bytes to pass them on whole.
+  if (grpc::Status allowed = gate_.Allowed(context); !allowed.ok()) return allowed;
+  absl::StatusOr<UploadBudget::Ticket> ticket = budget_.Admit();
+  if (!ticket.ok()) return ToGrpcStatus(ticket.status());
+  KeptStream kept(*reader);
+  absl::StatusOr<ReceivedUpload> received;
+  {
+    StreamWatchdog::Watch watch = watchdog_.Start(context);
+    received = ReceiveUpload(kept, watch, limits_, *ticket);
+  }
+  if (!received.ok()) return ToGrpcStatus(ExplainStop(received.status(), context));
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
+    MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile file, received->bvh.Finish(should_stop));
+    MOTIONDB_ASSIGN_OR_RETURN(const std::string name, ClipName(received->request));
+    return StoreTakes(*context, kept.request(), name, file, response);
   });
 }
 

@@ -15,6 +15,7 @@
 #include "motiondb/v1/clip_service.grpc.pb.h"
 #include "server/grpc/call_gate.h"
 #include "server/grpc/server_options.h"
+#include "server/grpc/stream_watchdog.h"
 #include "server/upload/upload.h"
 #include "server/upload/upload_budget.h"
 
@@ -22,12 +23,20 @@ namespace motiondb::server {
 
 class RoutedClipServiceImpl final : public v1::ClipService::Service {
  public:
-  RoutedClipServiceImpl(const UploadLimits& limits, UploadBudget& budget, CallGate& gate,
-                        std::shared_ptr<ClipRouting> routing)
-      : limits_(limits), budget_(budget), gate_(gate), routing_(std::move(routing)) {}
+  // `budget` and `watchdog` bound the ingests in progress, as ClipServiceImpl's.
+  RoutedClipServiceImpl(const UploadLimits& limits, UploadBudget& budget, StreamWatchdog& watchdog,
+                        CallGate& gate, std::shared_ptr<ClipRouting> routing)
+      : limits_(limits),
+        budget_(budget),
+        watchdog_(watchdog),
+        gate_(gate),
+        routing_(std::move(routing)) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
+  grpc::Status IngestClipStream(grpc::ServerContext* context,
+                                grpc::ServerReader<v1::IngestClipStreamRequest>* reader,
+                                v1::IngestClipResponse* response) override;
   grpc::Status GetClip(grpc::ServerContext* context, const v1::GetClipRequest* request,
                        v1::Clip* response) override;
   grpc::Status ExportClip(grpc::ServerContext* context, const v1::ExportClipRequest* request,
@@ -64,6 +73,10 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
                     grpc::Status (v1::ClipService::Stub::*method)(grpc::ClientContext*,
                                                                   const Request&, Response*));
 
+  // Every take of `file` (read from `request`, whose clip name is `name`) stored on its shard.
+  absl::Status StoreTakes(grpc::ServerContext& context, const v1::IngestClipRequest& request,
+                          const std::string& name, const UploadedFile& file,
+                          v1::IngestClipResponse* response);
   // Take `take` of the file stored under its route: the shard's answer, the name settled.
   absl::Status StoreTake(grpc::ServerContext& context, const v1::IngestClipRequest& request,
                          size_t take, const std::string& take_name,
@@ -73,6 +86,7 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
 
   UploadLimits limits_;
   UploadBudget& budget_;
+  StreamWatchdog& watchdog_;
   CallGate& gate_;
   std::shared_ptr<ClipRouting> routing_;
   std::mutex mutex_;
