@@ -37,6 +37,7 @@
 #include "motiondb/v1/server_service.grpc.pb.h"
 #include "testing/etcd_processes.h"
 #include "testing/server_process.h"
+#include "tests/clip_builder.h"
 #include "tests/server_fixture.h"
 #include "tests/test_data.h"
 
@@ -1077,14 +1078,33 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
     ASSERT_TRUE(reader->Finish().ok());
     EXPECT_EQ(streamed, exported.bvh());
   }
+  // An answer past gRPC's default 4 MiB comes through whole, as from one node.
+  {
+    v1::IngestClipRequest request;
+    request.set_file_name("long.bvh");
+    request.set_bvh(BvhText(testing::MakeClip(
+        testing::ChainSkeleton(), 60000, 1.0 / 120,
+        [](int f, int j) {
+          return Quat(Eigen::AngleAxisd(0.001 * f * (j + 1), Eigen::Vector3d::UnitY()));
+        },
+        [](int f, int) { return Eigen::Vector3d(0.01 * f, 90, 0); })));
+    v1::IngestClipResponse long_clip;
+    ASSERT_TRUE(router->IngestClip(context().get(), request, &long_clip).ok());
+    v1::ExportClipRequest whole;
+    whole.mutable_clip()->set_clip_id(long_clip.clip().clip_id());
+    v1::ExportClipResponse long_export;
+    const grpc::Status status = router->ExportClip(context().get(), whole, &long_export);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_GT(long_export.bvh().size(), 4u << 20);
+  }
   v1::GetClipPosesRequest poses_request;
   poses_request.mutable_clip()->set_clip_id(second);
   v1::ClipPoses poses;
   EXPECT_TRUE(router->GetClipPoses(context().get(), poses_request, &poses).ok());
-  v1::GetClipRequest nothing;
+  v1::GetClipRequest nothing;  // id 0: as one node answers it
   v1::Clip none;
   EXPECT_EQ(router->GetClip(context().get(), nothing, &none).error_code(),
-            grpc::StatusCode::INVALID_ARGUMENT);
+            grpc::StatusCode::NOT_FOUND);
   v1::DeleteClipRequest delete_request;
   delete_request.set_clip_id(second);
   v1::DeleteClipResponse deleted;
@@ -1111,7 +1131,9 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
 
   // etcd gone: reads go on from the last map and the addresses known.
   etcd_.Stop(0, /*graceful=*/true);
-  for (const auto& [id, name] : clips_on("s1")) {
+  const std::map<int64_t, std::string> on_s1 = clips_on("s1");
+  ASSERT_FALSE(on_s1.empty());
+  for (const auto& [id, name] : on_s1) {
     v1::GetClipRequest get;
     get.set_clip_id(id);
     v1::Clip clip;

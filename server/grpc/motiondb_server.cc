@@ -122,8 +122,9 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
                    .rate_grace = options.uploads.rate_grace});
   const AnswerLimit answers(int64_t{options.max_answer_mb} << 20);
   if (options.clip_routing) {
-    s.clips = std::make_unique<RoutedClipServiceImpl>(options.uploads, *s.uploads, *s.watchdog,
-                                                      *s.gate, options.clip_routing);
+    s.clips = std::make_unique<RoutedClipServiceImpl>(
+        options.uploads, *s.uploads, *s.watchdog, *s.gate, answers,
+        int64_t{options.max_message_mb} << 20, options.clip_routing);
   } else {
     s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
                                                 *s.uploads, *s.watchdog, *s.metrics, *s.gate);

@@ -1,15 +1,19 @@
 #include "server/grpc/routed_clip_service.h"
 
+#include <algorithm>
+#include <limits>
 #include <utility>
 #include <vector>
 
 #include <grpcpp/create_channel.h>
 #include <grpcpp/security/credentials.h>
+#include <grpcpp/support/channel_arguments.h>
 
 #include "absl/strings/str_cat.h"
 #include "server/clip_ingest.h"
 #include "server/grpc/call_context.h"
 #include "server/grpc/clip_conversion.h"
+#include "server/grpc/request_logger.h"
 #include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
@@ -27,13 +31,21 @@ void PassTokenOn(const grpc::ServerContext& from, grpc::ClientContext* to) {
   }
 }
 
+// Room in a message beyond its payload (the call's other fields and framing).
+constexpr int64_t kAnswerSlack = 1 << 20;
+
 // A stream's messages as ReceiveUpload reads them, kept as the one request a router passes on:
 // the first one's fields, and every chunk's bytes.
 class KeptStream {
  public:
-  explicit KeptStream(grpc::ServerReader<v1::IngestClipStreamRequest>& reader) : reader_(reader) {}
+  // The kept bytes are counted against `ticket` too: the file is held twice while it is read
+  // (its text, and its parse).
+  KeptStream(grpc::ServerReader<v1::IngestClipStreamRequest>& reader, UploadBudget::Ticket& ticket)
+      : reader_(reader), ticket_(ticket) {}
   bool Read(v1::IngestClipStreamRequest* message) {
-    if (!reader_.Read(message)) return false;
+    if (!status_.ok() || !reader_.Read(message)) return false;
+    status_ = ticket_.Reserve(static_cast<int64_t>(message->chunk().size()));
+    if (!status_.ok()) return false;
     if (first_) {
       first_ = false;
       request_.set_file_name(message->file_name());
@@ -44,10 +56,14 @@ class KeptStream {
     request_.mutable_bvh()->append(message->chunk());
     return true;
   }
-  const v1::IngestClipRequest& request() const { return request_; }
+  // Why reading stopped early (the budget refused what was kept), else OK.
+  const absl::Status& status() const { return status_; }
+  v1::IngestClipRequest Take() { return std::move(request_); }
 
  private:
   grpc::ServerReader<v1::IngestClipStreamRequest>& reader_;
+  UploadBudget::Ticket& ticket_;
+  absl::Status status_;
   bool first_ = true;
   v1::IngestClipRequest request_;
 };
@@ -64,8 +80,12 @@ RoutedClipServiceImpl::NodeStubs& RoutedClipServiceImpl::NodeAt(const std::strin
   std::lock_guard<std::mutex> lock(mutex_);
   NodeStubs& stubs = nodes_[address];
   if (stubs.shard == nullptr) {
+    // A node answers up to its answer limit (an export, a clip's poses), past gRPC's 4 MiB.
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(static_cast<int>(
+        std::min<int64_t>(answers_.max_bytes() + kAnswerSlack, std::numeric_limits<int>::max())));
     const std::shared_ptr<grpc::Channel> channel =
-        grpc::CreateChannel(address, grpc::InsecureChannelCredentials());
+        grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments);
     stubs.shard = shard::v1::ShardService::NewStub(channel);
     stubs.clips = v1::ClipService::NewStub(channel);
   }
@@ -84,6 +104,8 @@ absl::Status RoutedClipServiceImpl::NodeFailed(const grpc::Status& status,
 
 absl::StatusOr<RoutedClipServiceImpl::NodeCall> RoutedClipServiceImpl::CallClipNode(
     const grpc::ServerContext& context, int64_t clip_id) {
+  // As one node answers an id no clip has.
+  if (clip_id < 1) return absl::NotFoundError(absl::StrCat("clip ", clip_id, " not found"));
   NodeCall call;
   MOTIONDB_ASSIGN_OR_RETURN(call.route, routing_->Locate(clip_id, /*refresh=*/false));
   call.clips = NodeAt(call.route.address).clips.get();
@@ -169,15 +191,13 @@ grpc::Status RoutedClipServiceImpl::DeleteClip(grpc::ServerContext* context,
 }
 
 absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
-                                              const v1::IngestClipRequest& request, size_t take,
+                                              shard::v1::StoreTakeRequest& store, size_t take,
                                               const std::string& take_name,
                                               v1::IngestClipResponse* response) {
   // Checked before the name is reserved cluster-wide; the shard checks it again.
   MOTIONDB_RETURN_IF_ERROR(storage::CheckClipName(take_name));
   MOTIONDB_ASSIGN_OR_RETURN(const cluster::ClipRoute route,
                             routing_->Route(take_name, DeadlineOf(context)));
-  shard::v1::StoreTakeRequest store;
-  *store.mutable_ingest() = request;
   store.set_take(static_cast<int>(take));
   store.set_clip_id(route.clip_id);
   // The caller's deadline and cancellation, and its token.
@@ -204,14 +224,21 @@ absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
 }
 
 absl::Status RoutedClipServiceImpl::StoreTakes(grpc::ServerContext& context,
-                                               const v1::IngestClipRequest& request,
+                                               shard::v1::StoreTakeRequest& store,
                                                const std::string& name, const UploadedFile& file,
                                                v1::IngestClipResponse* response) {
+  // The file goes to a node whole, in one message: a node refuses more than --max-message-mb.
+  if (static_cast<int64_t>(store.ByteSizeLong()) > max_message_bytes_ - kAnswerSlack) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "'", store.ingest().file_name(), "' is ", store.ingest().bvh().size(),
+        " bytes: a cluster passes a file to its shard node in one message, of at most ",
+        max_message_bytes_ - kAnswerSlack, " (--max-message-mb, less room for the call)"));
+  }
   std::vector<std::string> stored;
   for (size_t t = 0; t < file.takes.size(); ++t) {
     const std::string take_name = TakeClipName(name, file, t);
     v1::IngestClipResponse taken;
-    const absl::Status status = StoreTake(context, request, t, take_name, &taken);
+    const absl::Status status = StoreTake(context, store, t, take_name, &taken);
     if (!status.ok()) return TakeFailure(status, take_name, stored);
     stored.push_back(take_name);
     if (t == 0) {
@@ -236,7 +263,11 @@ grpc::Status RoutedClipServiceImpl::IngestClip(grpc::ServerContext* context,
     // reads the file again (it is sent whole) and stores that take alone.
     MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile file,
                               ReadUpload(request->bvh(), ingest.file_name, limits_, should_stop));
-    return StoreTakes(*context, *request, name, file, response);
+    // The request is gRPC's to keep: the one copy sent is counted too.
+    MOTIONDB_RETURN_IF_ERROR(ticket.Reserve(static_cast<int64_t>(request->bvh().size())));
+    shard::v1::StoreTakeRequest store;
+    *store.mutable_ingest() = *request;
+    return StoreTakes(*context, store, name, file, response);
   });
 }
 
@@ -248,18 +279,21 @@ grpc::Status RoutedClipServiceImpl::IngestClipStream(
   if (grpc::Status allowed = gate_.Allowed(context); !allowed.ok()) return allowed;
   absl::StatusOr<UploadBudget::Ticket> ticket = budget_.Admit();
   if (!ticket.ok()) return ToGrpcStatus(ticket.status());
-  KeptStream kept(*reader);
+  KeptStream kept(*reader, *ticket);
   absl::StatusOr<ReceivedUpload> received;
   {
     StreamWatchdog::Watch watch = watchdog_.Start(context);
     received = ReceiveUpload(kept, watch, limits_, *ticket);
   }
+  if (!kept.status().ok()) return ToGrpcStatus(kept.status());
   if (!received.ok()) return ToGrpcStatus(ExplainStop(received.status(), context));
   return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
     if (should_stop()) return absl::CancelledError("the upload ended before its last chunk");
     MOTIONDB_ASSIGN_OR_RETURN(const UploadedFile file, received->bvh.Finish(should_stop));
     MOTIONDB_ASSIGN_OR_RETURN(const std::string name, ClipName(received->request));
-    return StoreTakes(*context, kept.request(), name, file, response);
+    shard::v1::StoreTakeRequest store;
+    *store.mutable_ingest() = kept.Take();
+    return StoreTakes(*context, store, name, file, response);
   });
 }
 

@@ -13,6 +13,7 @@
 
 #include "motiondb/shard/v1/shard_service.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
+#include "server/answer_limit.h"
 #include "server/grpc/call_gate.h"
 #include "server/grpc/server_options.h"
 #include "server/grpc/stream_watchdog.h"
@@ -23,13 +24,18 @@ namespace motiondb::server {
 
 class RoutedClipServiceImpl final : public v1::ClipService::Service {
  public:
-  // `budget` and `watchdog` bound the ingests in progress, as ClipServiceImpl's.
+  // `budget` and `watchdog` bound the ingests in progress, as ClipServiceImpl's; a node's
+  // answer may be as large as `answers` allows (the nodes' --max-answer-mb), and what is sent to
+  // a node at most `max_message_bytes` (their --max-message-mb).
   RoutedClipServiceImpl(const UploadLimits& limits, UploadBudget& budget, StreamWatchdog& watchdog,
-                        CallGate& gate, std::shared_ptr<ClipRouting> routing)
+                        CallGate& gate, const AnswerLimit& answers, int64_t max_message_bytes,
+                        std::shared_ptr<ClipRouting> routing)
       : limits_(limits),
         budget_(budget),
         watchdog_(watchdog),
         gate_(gate),
+        answers_(answers),
+        max_message_bytes_(max_message_bytes),
         routing_(std::move(routing)) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
@@ -73,12 +79,13 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
                     grpc::Status (v1::ClipService::Stub::*method)(grpc::ClientContext*,
                                                                   const Request&, Response*));
 
-  // Every take of `file` (read from `request`, whose clip name is `name`) stored on its shard.
-  absl::Status StoreTakes(grpc::ServerContext& context, const v1::IngestClipRequest& request,
+  // Every take of `file` (read from `store`'s ingest, whose clip name is `name`) stored on its
+  // shard: `store` is sent for each, with the take's index and id.
+  absl::Status StoreTakes(grpc::ServerContext& context, shard::v1::StoreTakeRequest& store,
                           const std::string& name, const UploadedFile& file,
                           v1::IngestClipResponse* response);
   // Take `take` of the file stored under its route: the shard's answer, the name settled.
-  absl::Status StoreTake(grpc::ServerContext& context, const v1::IngestClipRequest& request,
+  absl::Status StoreTake(grpc::ServerContext& context, shard::v1::StoreTakeRequest& store,
                          size_t take, const std::string& take_name,
                          v1::IngestClipResponse* response);
   // One channel a shard node, kept for the router's life.
@@ -88,6 +95,8 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
   UploadBudget& budget_;
   StreamWatchdog& watchdog_;
   CallGate& gate_;
+  const AnswerLimit answers_;
+  const int64_t max_message_bytes_;
   std::shared_ptr<ClipRouting> routing_;
   std::mutex mutex_;
   std::map<std::string, NodeStubs> nodes_;  // guarded by mutex_; by address
