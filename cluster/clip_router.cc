@@ -97,6 +97,25 @@ absl::StatusOr<ClipRoute> ClipRouter::Locate(int64_t clip_id, bool refresh) {
   return route;
 }
 
+absl::StatusOr<std::vector<ShardNode>> ClipRouter::ShardNodes(bool refresh) {
+  const std::shared_ptr<const ShardMap> map = watcher_.map();
+  if (map == nullptr) {
+    return absl::UnavailableError(
+        "the cluster's shard map has not been read yet (is the cluster initialised, and etcd "
+        "reachable?)");
+  }
+  std::vector<ShardNode> nodes;
+  for (const auto& [node_id, count] : map->ShardsPerNode()) {
+    ShardNode& node = nodes.emplace_back();
+    node.node_id = node_id;
+    node.shards = map->ShardsOf(node_id);
+    MOTIONDB_ASSIGN_OR_RETURN(node.address,
+                              AddressOf(node_id, node.shards.front(), map->epoch, refresh));
+    refresh = false;  // one listing serves every node
+  }
+  return nodes;
+}
+
 absl::Status ClipRouter::ReleaseName(const std::string& name, int64_t clip_id) {
   return names_.Release(name, clip_id).status();
 }

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -28,6 +29,13 @@ struct ClipRoute {
   int64_t epoch = 0;    // of the map routed by
   std::string node_id;  // holding the shard
   std::string address;  // its gRPC face
+};
+
+// A node holding shards in the last map seen, and where it answers.
+struct ShardNode {
+  std::string node_id;
+  std::string address;
+  std::vector<int> shards;  // ascending
 };
 
 class ClipRouter {
@@ -56,6 +64,10 @@ class ClipRouter {
   // UNAVAILABLE before the first map, or when the node is not live; INVALID_ARGUMENT for an id
   // below 1.
   absl::StatusOr<ClipRoute> Locate(int64_t clip_id, bool refresh = false);
+  // Every node the last map seen gives shards, in node id order, at the addresses last listed
+  // (listed afresh from etcd with `refresh`, or when one is unknown): what a listing asks.
+  // UNAVAILABLE before the first map, or when a node holding shards is not live (naming it).
+  absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh = false);
   // Frees `name` if clip `clip_id` holds it (a deleted clip's), as ClipNames::Release.
   absl::Status ReleaseName(const std::string& name, int64_t clip_id);
 

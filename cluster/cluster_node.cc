@@ -77,6 +77,11 @@ absl::Status ClusterNode::ReleaseClipName(const std::string& name, int64_t clip_
   return router_->ReleaseName(name, clip_id);
 }
 
+absl::StatusOr<std::vector<ShardNode>> ClusterNode::ShardNodes(bool refresh) const {
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
+  return router_->ShardNodes(refresh);
+}
+
 absl::Status ClusterNode::CheckRouter() const {
   if (router_ != nullptr) return absl::OkStatus();
   return absl::FailedPreconditionError(

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -52,6 +53,8 @@ class ClusterNode {
   // ClipRouter::Locate and ReleaseName on a router; FAILED_PRECONDITION on a shard node.
   absl::StatusOr<ClipRoute> LocateClip(int64_t clip_id, bool refresh) const;
   absl::Status ReleaseClipName(const std::string& name, int64_t clip_id) const;
+  // ClipRouter::ShardNodes on a router; FAILED_PRECONDITION on a shard node.
+  absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh) const;
 
  private:
   explicit ClusterNode(std::string node_id) : node_id_(std::move(node_id)) {}

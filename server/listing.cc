@@ -15,6 +15,25 @@ absl::StatusOr<int> ResolvePageSize(int requested) {
   return requested == 0 ? storage::kDefaultPageSize : std::min(requested, storage::kMaxPageSize);
 }
 
+// Whether `a` comes before `b` in `order`: by its sort key, then its id (as the database orders
+// a listing; SQLite compares names bytewise, as std::string does).
+bool ListedBefore(storage::ClipOrder order, const storage::ClipRecord& a,
+                  const storage::ClipRecord& b) {
+  switch (order) {
+    case storage::ClipOrder::kName:
+      if (a.name != b.name) return a.name < b.name;
+      break;
+    case storage::ClipOrder::kCreated:
+      if (a.created_unix_ms != b.created_unix_ms) return a.created_unix_ms < b.created_unix_ms;
+      break;
+    case storage::ClipOrder::kId:
+      break;
+  }
+  return a.clip_id < b.clip_id;
+}
+
+}  // namespace
+
 absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort) {
   if (sort.empty() || sort == "id") return storage::ClipOrder::kId;
   if (sort == "name") return storage::ClipOrder::kName;
@@ -23,7 +42,34 @@ absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort) {
       absl::StrCat("sort: '", sort.substr(0, 40), "' is not id, name or created"));
 }
 
-}  // namespace
+MergedClipPage MergeClipPages(storage::ClipOrder order, int page_size,
+                              const std::vector<PartPage>& parts) {
+  std::vector<std::pair<size_t, size_t>> all;
+  const storage::ClipRecord* bound = nullptr;  // the first last clip of a part with more
+  bool more = false;
+  for (size_t p = 0; p < parts.size(); ++p) {
+    for (size_t i = 0; i < parts[p].positions.size(); ++i) all.emplace_back(p, i);
+    if (!parts[p].more) continue;
+    more = true;
+    const storage::ClipRecord& last = parts[p].positions.back();
+    if (bound == nullptr || ListedBefore(order, last, *bound)) bound = &last;
+  }
+  const auto at = [&](const std::pair<size_t, size_t>& item) -> const storage::ClipRecord& {
+    return parts[item.first].positions[item.second];
+  };
+  std::sort(all.begin(), all.end(),
+            [&](const auto& a, const auto& b) { return ListedBefore(order, at(a), at(b)); });
+  MergedClipPage page;
+  for (const auto& item : all) {
+    if (static_cast<int>(page.taken.size()) == page_size) break;
+    if (bound != nullptr && ListedBefore(order, *bound, at(item))) break;
+    page.taken.push_back(item);
+  }
+  if (!page.taken.empty() && (more || page.taken.size() < all.size())) {
+    page.next_page_token = storage::ClipPageToken(order, at(page.taken.back()));
+  }
+  return page;
+}
 
 absl::StatusOr<storage::Page> StoragePage(const PageRequest& page) {
   storage::Page stored;

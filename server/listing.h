@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -39,6 +40,28 @@ struct ClipListRequest {
 absl::StatusOr<storage::ClipPage> ListClips(storage::Database& database,
                                             const ClipListRequest& request,
                                             const AnswerLimit& answers);
+
+// `sort` as the API gives it: "id" (or empty), "name" or "created"; another is INVALID_ARGUMENT
+// naming `sort`.
+absl::StatusOr<storage::ClipOrder> ClipOrderOf(const std::string& sort);
+
+// A page of the same clip listing from each part of a library (a cluster's shard nodes, whose
+// clips are no other's): where each clip stands (its id, name and creation time; the rest of a
+// record is not read), in the listing's order, and whether the part has clips after its page.
+struct PartPage {
+  std::vector<storage::ClipRecord> positions;
+  bool more = false;
+};
+// The whole library's page: which clips of the parts' pages it holds, in order, as (part, index),
+// and the token of the page after it (storage::ClipPageToken: good on every part), empty on the
+// last page. Up to `page_size` clips; none after the last clip of a part whose page was cut
+// short (its answer limit), since that part's next clips may come before them.
+struct MergedClipPage {
+  std::vector<std::pair<size_t, size_t>> taken;
+  std::string next_page_token;
+};
+MergedClipPage MergeClipPages(storage::ClipOrder order, int page_size,
+                              const std::vector<PartPage>& parts);
 
 // A skeleton's name for people: its root joint's and its first clip's, "Hips (01_01)"; the
 // root's alone when it has no clip.

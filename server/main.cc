@@ -162,6 +162,10 @@ class JoinedNode final : public motiondb::server::ClipRouting {
     MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
     return node->ReleaseClipName(clip_name, clip_id);
   }
+  absl::StatusOr<std::vector<motiondb::cluster::ShardNode>> ShardNodes(bool refresh) override {
+    MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
+    return node->ShardNodes(refresh);
+  }
 
  private:
   absl::StatusOr<std::shared_ptr<motiondb::cluster::ClusterNode>> Get() const {

@@ -172,6 +172,10 @@ struct ClipPage {
   int64_t total_size = 0;       // clips the filter takes, on every page
 };
 
+// The token of the page after `last` in `order`: the position of `last` (its sort key and id),
+// so a token is good for any database in that order (a cluster's shards take the same tokens).
+std::string ClipPageToken(ClipOrder order, const ClipRecord& last);
+
 // A skeleton as a listing shows it.
 struct SkeletonSummary {
   int64_t skeleton_id = 0;

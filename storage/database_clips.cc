@@ -32,21 +32,6 @@ struct PageStart {
   std::string key;
 };
 
-// The token of a page starting after `last`. Id order keeps the plain decimal id of earlier
-// servers; the others are "n.ID.BASE64(name)" and "c.ID.MS", so that a token of one order is
-// not read in another. Names may hold any printable byte, hence the base64.
-std::string PageToken(ClipOrder order, const ClipRecord& last) {
-  switch (order) {
-    case ClipOrder::kName:
-      return absl::StrCat("n.", last.clip_id, ".", absl::WebSafeBase64Escape(last.name));
-    case ClipOrder::kCreated:
-      return absl::StrCat("c.", last.clip_id, ".", last.created_unix_ms);
-    case ClipOrder::kId:
-      break;
-  }
-  return absl::StrCat(last.clip_id);
-}
-
 bool IsDecimal(absl::string_view text) {
   return !text.empty() &&
          std::all_of(text.begin(), text.end(), [](char c) { return absl::ascii_isdigit(c); });
@@ -234,6 +219,21 @@ absl::Status InsertProjectionsOfClip(
 }
 
 }  // namespace
+
+std::string ClipPageToken(ClipOrder order, const ClipRecord& last) {
+  // Id order keeps the plain decimal id of earlier servers; the others are "n.ID.BASE64(name)"
+  // and "c.ID.MS", so that a token of one order is not read in another. Names may hold any
+  // printable byte, hence the base64.
+  switch (order) {
+    case ClipOrder::kName:
+      return absl::StrCat("n.", last.clip_id, ".", absl::WebSafeBase64Escape(last.name));
+    case ClipOrder::kCreated:
+      return absl::StrCat("c.", last.clip_id, ".", last.created_unix_ms);
+    case ClipOrder::kId:
+      break;
+  }
+  return absl::StrCat(last.clip_id);
+}
 
 absl::StatusOr<int64_t> Database::InsertClip(
     const ClipRecord& record, const Clip& clip,
@@ -535,7 +535,7 @@ absl::StatusOr<ClipPage> Database::ListClips(const Page& page, const ClipFilter&
       result.clips.pop_back();
       cut = true;
     }
-    if (cut) result.next_page_token = PageToken(filter.order, result.clips.back());
+    if (cut) result.next_page_token = ClipPageToken(filter.order, result.clips.back());
     // In the same read transaction: the total agrees with the page.
     MOTIONDB_ASSIGN_OR_RETURN(result.total_size, CountClips(db, filter));
     return absl::OkStatus();

@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include <gmock/gmock.h>
 #include <grpcpp/grpcpp.h>
@@ -1118,6 +1119,48 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   EXPECT_EQ(router->DeleteClip(context().get(), delete_request, &deleted).error_code(),
             grpc::StatusCode::NOT_FOUND);
 
+  // A listing through the router, page by page in each order, is the nodes' clips merged in that
+  // order: each page token holds on every node.
+  {
+    std::vector<v1::Clip> all;
+    for (const std::string node : {"s1", "s2"}) {
+      v1::ListClipsResponse listed;
+      ASSERT_TRUE(stub_of(node)->ListClips(context().get(), {}, &listed).ok());
+      all.insert(all.end(), listed.clips().begin(), listed.clips().end());
+    }
+    ASSERT_GE(all.size(), 6u);
+    for (const std::string sort : {"id", "name", "created"}) {
+      std::sort(all.begin(), all.end(), [&](const v1::Clip& a, const v1::Clip& b) {
+        const auto key = [&](const v1::Clip& c) {
+          return std::make_tuple(sort == "name" ? c.name() : std::string(),
+                                 sort == "created" ? c.created_unix_ms() : 0, c.clip_id());
+        };
+        return key(a) < key(b);
+      });
+      std::vector<int64_t> paged;
+      v1::ListClipsRequest request;
+      request.set_sort(sort);
+      request.set_page_size(2);
+      for (int pages = 0; pages < 100; ++pages) {
+        v1::ListClipsResponse page;
+        const grpc::Status listed = router->ListClips(context().get(), request, &page);
+        ASSERT_TRUE(listed.ok()) << listed.error_message();
+        EXPECT_EQ(page.total_size(), static_cast<int64_t>(all.size()));
+        for (const v1::Clip& clip : page.clips()) paged.push_back(clip.clip_id());
+        if (page.next_page_token().empty()) break;
+        request.set_page_token(page.next_page_token());
+      }
+      std::vector<int64_t> expected;
+      for (const v1::Clip& clip : all) expected.push_back(clip.clip_id());
+      EXPECT_EQ(paged, expected) << sort;
+    }
+    v1::ListClipsRequest bad;
+    bad.set_sort("size");
+    v1::ListClipsResponse page;
+    EXPECT_EQ(router->ListClips(context().get(), bad, &page).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+  }
+
   // s2 killed: the next ingest whose id falls on its shards fails, naming it.
   nodes["s2"].Stop(SIGKILL);
   grpc::Status failed;
@@ -1128,6 +1171,12 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   }
   EXPECT_EQ(failed.error_code(), grpc::StatusCode::UNAVAILABLE) << failed.error_message();
   EXPECT_THAT(failed.error_message(), HasSubstr("node 's2'"));
+  {
+    v1::ListClipsResponse page;
+    const grpc::Status listed = router->ListClips(context().get(), {}, &page);
+    EXPECT_EQ(listed.error_code(), grpc::StatusCode::UNAVAILABLE);
+    EXPECT_THAT(listed.error_message(), HasSubstr("node 's2'"));
+  }
 
   // etcd gone: reads go on from the last map and the addresses known.
   etcd_.Stop(0, /*graceful=*/true);

@@ -10,6 +10,7 @@
 #include <grpcpp/support/channel_arguments.h>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "server/clip_ingest.h"
 #include "server/grpc/call_context.h"
 #include "server/grpc/clip_conversion.h"
@@ -17,6 +18,7 @@
 #include "server/grpc/serve.h"
 #include "server/grpc/status_conversion.h"
 #include "server/grpc/stream_upload.h"
+#include "server/listing.h"
 #include "storage/clip_name_check.h"
 #include "util/status_macros.h"
 
@@ -93,13 +95,20 @@ RoutedClipServiceImpl::NodeStubs& RoutedClipServiceImpl::NodeAt(const std::strin
 }
 
 absl::Status RoutedClipServiceImpl::NodeFailed(const grpc::Status& status,
-                                               const cluster::ClipRoute& route) {
+                                               const std::string& node_id,
+                                               const std::string& address,
+                                               const std::string& holding) {
   absl::Status error = FromGrpcStatus(status);
   // The node's own refusal (a bad file, a conflict, no such clip) is told as one node tells it.
   if (!absl::IsUnavailable(error)) return error;
-  (void)routing_->Locate(route.clip_id, /*refresh=*/true);  // its address may have changed
-  return absl::UnavailableError(absl::StrCat("shard ", route.shard, " (node '", route.node_id,
-                                             "' at ", route.address, "): ", error.message()));
+  (void)routing_->ShardNodes(/*refresh=*/true);  // its address may have changed
+  return absl::UnavailableError(
+      absl::StrCat(holding, " (node '", node_id, "' at ", address, "): ", error.message()));
+}
+
+absl::Status RoutedClipServiceImpl::NodeFailed(const grpc::Status& status,
+                                               const cluster::ClipRoute& route) {
+  return NodeFailed(status, route.node_id, route.address, absl::StrCat("shard ", route.shard));
 }
 
 absl::StatusOr<RoutedClipServiceImpl::NodeCall> RoutedClipServiceImpl::CallClipNode(
@@ -162,6 +171,57 @@ grpc::Status RoutedClipServiceImpl::ExportClipStream(
     }
     const grpc::Status status = pieces->Finish();
     return status.ok() ? absl::OkStatus() : NodeFailed(status, call.route);
+  });
+}
+
+grpc::Status RoutedClipServiceImpl::ListClips(grpc::ServerContext* context,
+                                              const v1::ListClipsRequest* request,
+                                              v1::ListClipsResponse* response) {
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipOrder order, ClipOrderOf(request->sort()));
+    if (request->skeleton_id() != 0) {
+      return absl::InvalidArgumentError(
+          "skeleton_id: in a cluster a skeleton's id is its shard node's own; a listing by "
+          "skeleton is not routed yet");
+    }
+    MOTIONDB_ASSIGN_OR_RETURN(
+        const storage::Page page,
+        StoragePage({.page_size = request->page_size(), .page_token = request->page_token()}));
+    MOTIONDB_ASSIGN_OR_RETURN(const std::vector<cluster::ShardNode> nodes,
+                              routing_->ShardNodes(/*refresh=*/false));
+    // Each node's first page after the token: a token is a place in the order, good on every
+    // node, so the whole page is among them.
+    v1::ListClipsRequest ask = *request;
+    ask.set_page_size(page.page_size);
+    std::vector<v1::ListClipsResponse> answers(nodes.size());
+    std::vector<PartPage> parts(nodes.size());
+    int64_t total = 0;
+    for (size_t n = 0; n < nodes.size(); ++n) {
+      const std::unique_ptr<grpc::ClientContext> call =
+          grpc::ClientContext::FromServerContext(*context);
+      PassTokenOn(*context, call.get());
+      const grpc::Status status =
+          NodeAt(nodes[n].address).clips->ListClips(call.get(), ask, &answers[n]);
+      if (!status.ok()) {
+        return NodeFailed(status, nodes[n].node_id, nodes[n].address,
+                          absl::StrCat("shards ", absl::StrJoin(nodes[n].shards, ", ")));
+      }
+      parts[n].more = !answers[n].next_page_token().empty();
+      for (const v1::Clip& clip : answers[n].clips()) {
+        storage::ClipRecord& position = parts[n].positions.emplace_back();
+        position.clip_id = clip.clip_id();
+        position.name = clip.name();
+        position.created_unix_ms = clip.created_unix_ms();
+      }
+      total += answers[n].total_size();
+    }
+    const MergedClipPage merged = MergeClipPages(order, page.page_size, parts);
+    for (const auto& [part, index] : merged.taken) {
+      *response->add_clips() = std::move(*answers[part].mutable_clips(static_cast<int>(index)));
+    }
+    response->set_next_page_token(merged.next_page_token);
+    response->set_total_size(total);
+    return absl::OkStatus();
   });
 }
 

@@ -1,8 +1,9 @@
 // motiondb.v1.ClipService on a cluster's router: an ingest's takes each stored on the shard node
 // its clip id belongs to (motiondb.shard.v1.ShardService.StoreTake), the ids and the names
 // reserved cluster-wide first and settled after (`routing`, cluster::ClipRouter); a call on one
-// clip (get, export, poses, delete) passed to its shard's node. The rest of the service is not
-// routed yet: UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
+// clip (get, export, poses, delete) passed to its shard's node; a listing asked of every node
+// holding shards and merged (server/listing.h). The rest of the service is not routed yet:
+// UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
 #ifndef MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 
@@ -51,6 +52,8 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
                                 grpc::ServerWriter<v1::ExportClipResponse>* writer) override;
   grpc::Status GetClipPoses(grpc::ServerContext* context, const v1::GetClipPosesRequest* request,
                             v1::ClipPoses* response) override;
+  grpc::Status ListClips(grpc::ServerContext* context, const v1::ListClipsRequest* request,
+                         v1::ListClipsResponse* response) override;
   // Frees the clip's name in the cluster once its shard has deleted it.
   grpc::Status DeleteClip(grpc::ServerContext* context, const v1::DeleteClipRequest* request,
                           v1::DeleteClipResponse* response) override;
@@ -72,6 +75,8 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
   // What a node's failure tells the caller; the clip's node is looked up afresh next time when
   // it did not answer.
   absl::Status NodeFailed(const grpc::Status& status, const cluster::ClipRoute& route);
+  absl::Status NodeFailed(const grpc::Status& status, const std::string& node_id,
+                          const std::string& address, const std::string& holding);
   // A unary call on one clip, passed to its node.
   template <typename Request, typename Response>
   grpc::Status Pass(grpc::ServerContext* context, int64_t clip_id, const Request& request,
