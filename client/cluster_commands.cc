@@ -4,6 +4,7 @@
 #include <iostream>
 #include <map>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "client/commands.h"
@@ -92,6 +93,22 @@ absl::Status ClusterStatus(const ClusterCommandFlags& flags) {
                !coordinator.ok() ? std::string(coordinator.status().message())
                : *coordinator    ? (*coordinator)->value
                                  : std::string("none (no live router holds the office)"));
+  // Each member asked alone: which answer and which leads (during a failover, none).
+  std::vector<std::string> members;
+  for (const std::string& endpoint : etcd->options().endpoints) {
+    const absl::StatusOr<std::unique_ptr<cluster::EtcdClient>> member =
+        cluster::EtcdClient::Create(cluster::EtcdOptions{.endpoints = {endpoint},
+                                                         .call_timeout = absl::Seconds(2),
+                                                         .attempt_timeout = absl::Seconds(2)});
+    const absl::StatusOr<cluster::MemberStatus> status =
+        member.ok() ? (*member)->Status() : member.status();
+    members.push_back(absl::StrCat(endpoint, " ",
+                                   !status.ok()             ? "unreachable"
+                                   : status->leads()        ? "leader"
+                                   : status->leader_id != 0 ? "follower"
+                                                            : "without a leader"));
+  }
+  absl::PrintF("etcd members: %s\n", absl::StrJoin(members, ", "));
   absl::PrintF("%d live nodes\n", nodes.size());
   absl::PrintF("  %-16s %-7s %-22s %-10s %s\n", "NODE", "ROLE", "ADDRESS", "LEASE LEFT",
                "SHARDS IN THE MAP");

@@ -51,13 +51,26 @@ absl::StatusOr<ClipRoute> ClipRouter::Route(const std::string& name, absl::Time 
     MOTIONDB_ASSIGN_OR_RETURN(
         route.clip_id, NextIdOnShard(ShardOfClip(*held, map.shard_count()), map.shard_count()));
   }
+  // A write is routed to a node live now, not to an address remembered.
+  MOTIONDB_RETURN_IF_ERROR(RouteTo(map, /*refresh=*/true, route));
+  return route;
+}
+
+absl::Status ClipRouter::RouteTo(const ShardMap& map, bool refresh, ClipRoute& route) {
   route.shard = ShardOfClip(route.clip_id, map.shard_count());
   route.epoch = map.epoch;
   route.node_id = map.owners[route.shard];
-  // A write is routed to a node live now, not to an address remembered.
   MOTIONDB_ASSIGN_OR_RETURN(route.address,
-                            AddressOf(route.node_id, route.shard, map.epoch, /*refresh=*/true));
-  return route;
+                            AddressOf(route.node_id, route.shard, map.epoch, refresh));
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::shared_ptr<const ShardMap>> ClipRouter::LastMap() const {
+  std::shared_ptr<const ShardMap> map = watcher_.map();
+  if (map != nullptr) return map;
+  return absl::UnavailableError(
+      "the cluster's shard map has not been read yet (is the cluster initialised, and etcd "
+      "reachable?)");
 }
 
 absl::StatusOr<std::string> ClipRouter::AddressOf(const std::string& node_id, int shard,
@@ -81,29 +94,15 @@ absl::StatusOr<ClipRoute> ClipRouter::Locate(int64_t clip_id, bool refresh) {
   if (clip_id < 1) {
     return absl::InvalidArgumentError(absl::StrCat("clip_id: ", clip_id, "; ids are positive"));
   }
-  const std::shared_ptr<const ShardMap> map = watcher_.map();
-  if (map == nullptr) {
-    return absl::UnavailableError(
-        "the cluster's shard map has not been read yet (is the cluster initialised, and etcd "
-        "reachable?)");
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const ShardMap> map, LastMap());
   ClipRoute route;
   route.clip_id = clip_id;
-  route.shard = ShardOfClip(clip_id, map->shard_count());
-  route.epoch = map->epoch;
-  route.node_id = map->owners[route.shard];
-  MOTIONDB_ASSIGN_OR_RETURN(route.address,
-                            AddressOf(route.node_id, route.shard, map->epoch, refresh));
+  MOTIONDB_RETURN_IF_ERROR(RouteTo(*map, refresh, route));
   return route;
 }
 
 absl::StatusOr<std::vector<ShardNode>> ClipRouter::ShardNodes(bool refresh) {
-  const std::shared_ptr<const ShardMap> map = watcher_.map();
-  if (map == nullptr) {
-    return absl::UnavailableError(
-        "the cluster's shard map has not been read yet (is the cluster initialised, and etcd "
-        "reachable?)");
-  }
+  MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<const ShardMap> map, LastMap());
   std::vector<ShardNode> nodes;
   for (const auto& [node_id, count] : map->ShardsPerNode()) {
     ShardNode& node = nodes.emplace_back();
@@ -116,6 +115,10 @@ absl::StatusOr<std::vector<ShardNode>> ClipRouter::ShardNodes(bool refresh) {
   return nodes;
 }
 
+absl::Status ClipRouter::ReserveName(const std::string& name, int64_t clip_id) {
+  return names_.Reserve(name, clip_id);
+}
+
 absl::Status ClipRouter::ReleaseName(const std::string& name, int64_t clip_id) {
   return names_.Release(name, clip_id).status();
 }
@@ -123,7 +126,7 @@ absl::Status ClipRouter::ReleaseName(const std::string& name, int64_t clip_id) {
 absl::Status ClipRouter::Settle(const std::string& name, const ClipRoute& route,
                                 std::optional<int64_t> stored_clip_id) {
   if (!stored_clip_id) {
-    if (route.held_by == 0) return names_.Release(name, route.clip_id).status();
+    if (route.held_by == 0) return ReleaseName(name, route.clip_id);
     return absl::OkStatus();
   }
   if (route.held_by != 0 && *stored_clip_id == route.clip_id) {

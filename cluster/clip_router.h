@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 #include "cluster/clip_id_blocks.h"
 #include "cluster/clip_names.h"
 #include "cluster/etcd_client.h"
+#include "cluster/shard_map.h"
 #include "cluster/shard_map_watcher.h"
 
 namespace motiondb::cluster {
@@ -68,7 +70,9 @@ class ClipRouter {
   // (listed afresh from etcd with `refresh`, or when one is unknown): what a listing asks.
   // UNAVAILABLE before the first map, or when a node holding shards is not live (naming it).
   absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh = false);
-  // Frees `name` if clip `clip_id` holds it (a deleted clip's), as ClipNames::Release.
+  // Reserves `name` for clip `clip_id` (a rename's new name), as ClipNames::Reserve.
+  absl::Status ReserveName(const std::string& name, int64_t clip_id);
+  // Frees `name` if clip `clip_id` holds it (a deleted or renamed clip's), as ClipNames::Release.
   absl::Status ReleaseName(const std::string& name, int64_t clip_id);
 
  private:
@@ -76,6 +80,10 @@ class ClipRouter {
   absl::StatusOr<std::string> AddressOf(const std::string& node_id, int shard, int64_t epoch,
                                         bool refresh);
 
+  // Fills `route`'s shard, epoch, node and address for its clip_id in `map`.
+  absl::Status RouteTo(const ShardMap& map, bool refresh, ClipRoute& route);
+  // The last map seen; UNAVAILABLE before the first.
+  absl::StatusOr<std::shared_ptr<const ShardMap>> LastMap() const;
   // The next id of the block on `shard` of `shard_count`; the ids passed over are never used.
   absl::StatusOr<int64_t> NextIdOnShard(int shard, int shard_count);
 

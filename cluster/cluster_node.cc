@@ -72,6 +72,11 @@ absl::StatusOr<ClipRoute> ClusterNode::LocateClip(int64_t clip_id, bool refresh)
   return router_->Locate(clip_id, refresh);
 }
 
+absl::Status ClusterNode::ReserveClipName(const std::string& name, int64_t clip_id) const {
+  MOTIONDB_RETURN_IF_ERROR(CheckRouter());
+  return router_->ReserveName(name, clip_id);
+}
+
 absl::Status ClusterNode::ReleaseClipName(const std::string& name, int64_t clip_id) const {
   MOTIONDB_RETURN_IF_ERROR(CheckRouter());
   return router_->ReleaseName(name, clip_id);

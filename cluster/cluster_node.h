@@ -50,8 +50,10 @@ class ClusterNode {
   // ClipRouter::Settle on a router; FAILED_PRECONDITION on a shard node.
   absl::Status SettleClip(const std::string& name, const ClipRoute& route,
                           std::optional<int64_t> stored_clip_id) const;
-  // ClipRouter::Locate and ReleaseName on a router; FAILED_PRECONDITION on a shard node.
+  // ClipRouter::Locate, ReserveName and ReleaseName on a router; FAILED_PRECONDITION on a shard
+  // node.
   absl::StatusOr<ClipRoute> LocateClip(int64_t clip_id, bool refresh) const;
+  absl::Status ReserveClipName(const std::string& name, int64_t clip_id) const;
   absl::Status ReleaseClipName(const std::string& name, int64_t clip_id) const;
   // ClipRouter::ShardNodes on a router; FAILED_PRECONDITION on a shard node.
   absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh) const;

@@ -214,6 +214,14 @@ absl::Status EtcdClient::RevokeLease(int64_t lease) const {
   return absl::IsNotFound(status) ? absl::OkStatus() : status;  // gone already
 }
 
+absl::StatusOr<MemberStatus> EtcdClient::Status() const {
+  etcdserverpb::StatusResponse response;
+  const absl::Status status = Unary(*channels_, &etcdserverpb::Maintenance::Stub::Status,
+                                    etcdserverpb::StatusRequest(), &response);
+  if (!status.ok()) return status;
+  return MemberStatus{.member_id = response.header().member_id(), .leader_id = response.leader()};
+}
+
 std::unique_ptr<EtcdWatch> EtcdClient::Watch(const std::string& prefix, int64_t start_revision,
                                              EtcdWatch::Callbacks callbacks) const {
   return std::make_unique<EtcdWatch>(channels_, prefix, start_revision, std::move(callbacks));

@@ -1,6 +1,6 @@
-// A client of etcd's v3 API (KV, Txn, Lease, Watch) in application terms: keys and values as
-// strings, answers as absl::Status. Every call has a deadline (EtcdOptions::call_timeout) and
-// goes on to the next member when one is down. Thread-safe.
+// A client of etcd's v3 API (KV, Txn, Lease, Watch, a member's status) in application terms: keys
+// and values as strings, answers as absl::Status. Every call has a deadline
+// (EtcdOptions::call_timeout) and goes on to the next member when one is down. Thread-safe.
 #ifndef MOTIONDB_CLUSTER_ETCD_CLIENT_H_
 #define MOTIONDB_CLUSTER_ETCD_CLIENT_H_
 
@@ -37,6 +37,13 @@ struct SwapOutcome {
   std::optional<KeyValue> current;
 };
 
+// What an etcd member says of itself.
+struct MemberStatus {
+  uint64_t member_id = 0;  // the member that answered
+  uint64_t leader_id = 0;  // the raft leader it follows; 0 while there is none
+  bool leads() const { return leader_id != 0 && leader_id == member_id; }
+};
+
 class EtcdClient {
  public:
   // INVALID_ARGUMENT without endpoints; connects lazily (a call to a member that is down fails
@@ -70,6 +77,9 @@ class EtcdClient {
   absl::StatusOr<absl::Duration> TimeToLive(int64_t lease) const;
   // Ends `lease` now, deleting its keys.
   absl::Status RevokeLease(int64_t lease) const;
+
+  // The status of the first member that answers (with one endpoint: that member's).
+  absl::StatusOr<MemberStatus> Status() const;
 
   // Watches every key beginning with `prefix` (EtcdWatch).
   std::unique_ptr<EtcdWatch> Watch(const std::string& prefix, int64_t start_revision,

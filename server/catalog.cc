@@ -188,8 +188,9 @@ absl::Status Catalog::DeleteClip(int64_t clip_id, const std::function<bool()>& s
 
 absl::StatusOr<storage::ClipRecord> Catalog::UpdateClip(int64_t clip_id,
                                                         const storage::ClipUpdate& update,
+                                                        const UpdateClipOptions& options,
                                                         const std::function<bool()>& should_stop) {
-  if (cluster_shard_ && update.name) {
+  if (cluster_shard_ && update.name && !options.name_reserved) {
     return absl::FailedPreconditionError(
         "this node is a cluster's shard node: a clip's name is reserved in the cluster, and "
         "renamed through a router");

@@ -66,11 +66,17 @@ struct IngestClipOptions {
   int64_t clip_id = 0;
 };
 
+struct UpdateClipOptions {
+  // A cluster's router has reserved the new name cluster-wide: a shard node renames only then.
+  bool name_reserved = false;
+};
+
 class Catalog {
  public:
   // `cluster_shard`: the database is a cluster's shard node's, whose clips come through a router
   // with ids unique cluster-wide (IngestClipOptions::clip_id) and names reserved cluster-wide: an
-  // ingest without an id, and a rename, are refused (FAILED_PRECONDITION).
+  // ingest without an id, and a rename without a reserved name (UpdateClipOptions), are refused
+  // (FAILED_PRECONDITION).
   Catalog(storage::Database& database, IndexRegistry& registry, bool cluster_shard = false)
       : database_(database), registry_(registry), cluster_shard_(cluster_shard) {}
 
@@ -90,6 +96,7 @@ class Catalog {
   // Renames and re-tags a clip (storage::Database::UpdateClip's rules and errors), and gives
   // every space of its skeleton a snapshot that shows the new name and tags.
   absl::StatusOr<storage::ClipRecord> UpdateClip(int64_t clip_id, const storage::ClipUpdate& update,
+                                                 const UpdateClipOptions& options = {},
                                                  const std::function<bool()>& should_stop = {});
 
   // Stores `change` to skeleton `skeleton_id`'s humanoid map (storage::Database::

@@ -118,6 +118,21 @@ bool EtcdProcesses::Restart(int member, std::string* error) {
   return Launch(member, error) && WaitUntilAnswering({endpoints_[member]}, error);
 }
 
+int EtcdProcesses::Leader() const {
+  for (size_t member = 0; member < pids_.size(); ++member) {
+    if (pids_[member] <= 0) continue;
+    auto client =
+        cluster::EtcdClient::Create(cluster::EtcdOptions{.endpoints = {endpoints_[member]},
+                                                         .call_timeout = absl::Seconds(2),
+                                                         .attempt_timeout = absl::Seconds(1)});
+    const absl::StatusOr<cluster::MemberStatus> status = (*client)->Status();
+    if (status.ok() && status->leads()) {
+      return static_cast<int>(member);
+    }
+  }
+  return -1;
+}
+
 bool EtcdProcesses::WaitUntilAnswering(const std::vector<std::string>& endpoints,
                                        std::string* error) const {
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(1);

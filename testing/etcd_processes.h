@@ -30,6 +30,9 @@ class EtcdProcesses {
   // Starts `member` again on its ports and data; waits until the cluster answers through it.
   bool Restart(int member, std::string* error);
 
+  // The running member that is raft leader now, or -1 while none is (an election under way).
+  int Leader() const;
+
   // Every member's client address (host:port), and them comma-separated (--cluster's value).
   const std::vector<std::string>& endpoints() const { return endpoints_; }
   std::string endpoints_flag() const;

@@ -7,9 +7,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -21,6 +23,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include "absl/cleanup/cleanup.h"
 #include "cluster/clip_id_blocks.h"
 #include "cluster/clip_names.h"
 #include "cluster/cluster_keys.h"
@@ -697,6 +700,29 @@ bool Serving(const std::shared_ptr<grpc::Channel>& channel) {
 
 class ClusterServerTest : public ClusterEtcdTest {};
 
+// Shard nodes s1 and s2 and router r1 of the cluster "motiondb" (their databases in `dir`), each
+// listed in etcd, and the map of 4 shards over s1 and s2 that the cluster starts with.
+void StartTwoShardsAndARouter(const EtcdProcesses& etcd, const EtcdClient& client,
+                              const std::filesystem::path& dir,
+                              std::map<std::string, testing::ServerProcess>& nodes, ShardMap& map) {
+  std::string error;
+  for (const std::string id : {"s1", "s2", "r1"}) {
+    ASSERT_TRUE(
+        nodes[id].Start({"--db", (dir / (id + ".sqlite")).string(), "--http", "off", "--quiet",
+                         "--cluster", etcd.endpoints_flag(), "--node-id", id, "--role",
+                         id == "r1" ? "router" : "shard", "--cluster-lease-s", "2"},
+                        &error))
+        << error;
+  }
+  ASSERT_TRUE(PollUntil([&] {
+    return Listed(client, "motiondb", "s1") && Listed(client, "motiondb", "s2") &&
+           Listed(client, "motiondb", "r1");
+  }));
+  const ShardMapStore store(client, "motiondb");
+  ASSERT_TRUE(store.Create(4, {"s1", "s2"}).ok());
+  map = store.Read()->map;
+}
+
 TEST_F(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   std::string error;
   const std::filesystem::path dir = testing::MakeTempDir("cluster_server");
@@ -729,6 +755,7 @@ TEST_F(ClusterServerTest, RegistersIsListedSurvivesEtcdAndRegistersAgain) {
   cli = testing::RunCli({"cluster", "status", "--etcd", ep});
   EXPECT_EQ(cli.exit_code, 0) << cli.err;
   EXPECT_THAT(cli.out, HasSubstr("shard map epoch 1, 8 shards"));
+  EXPECT_THAT(cli.out, HasSubstr(absl::StrCat("etcd members: ", ep, " leader\n")));
   EXPECT_THAT(cli.out, ::testing::ContainsRegex("s1 +shard +127.0.0.1:[0-9]+ +[0-9]+ s +8"));
   cli = testing::RunCli({"cluster", "init", "--etcd", ep});
   EXPECT_EQ(cli.exit_code, 1);
@@ -874,6 +901,25 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
     status = clips->IngestClip(&context, direct, &stored);
     EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
     EXPECT_THAT(status.error_message(), HasSubstr("clips are stored through a router"));
+    // Nor renames one: the name is the cluster's, reserved by a router, which then renames
+    // through ShardService.UpdateClip, fenced as StoreTake is.
+    v1::UpdateClipRequest rename;
+    rename.set_clip_id(id_of["s1"]);
+    rename.set_name("own-renamed");
+    v1::Clip renamed;
+    grpc::ClientContext direct_rename;
+    status = clips->UpdateClip(&direct_rename, rename, &renamed);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    EXPECT_THAT(status.error_message(), HasSubstr("renamed through a router"));
+    grpc::ClientContext routed_rename;
+    status = s1->UpdateClip(&routed_rename, rename, &renamed);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(renamed.name(), "own-renamed");
+    rename.set_clip_id(id_of["s2"]);
+    grpc::ClientContext fenced_rename;
+    status = s1->UpdateClip(&fenced_rename, rename, &renamed);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    EXPECT_THAT(status.error_message(), HasSubstr("is node 's2''s in the map"));
   }
   EXPECT_THAT(clips_on_s1(), ::testing::ElementsAre(id_of["s1"]));
 
@@ -888,18 +934,18 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
   EXPECT_EQ(stored.clip().clip_id(), id_of["s2"]);
   EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
 
-  // Without etcd the map cannot be read: the write fails UNAVAILABLE at its deadline.
+  // Without etcd the map cannot be read: the write waits until shortly before its deadline (a
+  // tenth of it, here half a second) and fails UNAVAILABLE then.
   etcd_.Stop(0, /*graceful=*/true);
   shard::v1::StoreTakeRequest request;
   request.mutable_ingest()->set_file_name("late.bvh");
   request.mutable_ingest()->set_bvh(BvhText(ChainClip()));
   request.set_clip_id(id_of["s1"] + 4);
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(3));
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
   status = s1->StoreTake(&context, request, &stored);
-  EXPECT_TRUE(status.error_code() == grpc::StatusCode::UNAVAILABLE ||
-              status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED)
-      << status.error_code() << " " << status.error_message();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("the shard map cannot be read"));
   EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
 }
 
@@ -907,24 +953,10 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
 // cluster-wide; a name stored already goes to its clip's shard, which decides the conflict as one
 // node does; a shard node that is gone makes the ingest UNAVAILABLE naming it.
 TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
-  std::string error;
-  const std::filesystem::path dir = testing::MakeTempDir("cluster_route");
   std::map<std::string, testing::ServerProcess> nodes;
-  for (const std::string id : {"s1", "s2", "r1"}) {
-    ASSERT_TRUE(
-        nodes[id].Start({"--db", (dir / (id + ".sqlite")).string(), "--http", "off", "--quiet",
-                         "--cluster", etcd_.endpoints_flag(), "--node-id", id, "--role",
-                         id == "r1" ? "router" : "shard", "--cluster-lease-s", "2"},
-                        &error))
-        << error;
-  }
-  ASSERT_TRUE(PollUntil([&] {
-    return Listed(*client_, "motiondb", "s1") && Listed(*client_, "motiondb", "s2") &&
-           Listed(*client_, "motiondb", "r1");
-  }));
-  const ShardMapStore store(*client_, "motiondb");
-  ASSERT_TRUE(store.Create(4, {"s1", "s2"}).ok());
-  const ShardMap map = store.Read()->map;
+  ShardMap map;
+  ASSERT_NO_FATAL_FAILURE(
+      StartTwoShardsAndARouter(etcd_, *client_, testing::MakeTempDir("cluster_route"), nodes, map));
 
   auto router = v1::ClipService::NewStub(testing::InsecureChannel(nodes["r1"].address()));
   const auto ingest = [&](const std::string& name, double speed, v1::OnConflict on_conflict,
@@ -1119,6 +1151,57 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
   EXPECT_EQ(router->DeleteClip(context().get(), delete_request, &deleted).error_code(),
             grpc::StatusCode::NOT_FOUND);
 
+  // A rename reserves the new name, has the clip's node rename it, and frees the old name; a name
+  // another clip holds is refused with nothing changed; re-tagging alone goes to the node.
+  {
+    const int64_t third = std::next(routed.begin(), 2)->first;
+    const std::string old_name = routed.at(third);
+    v1::UpdateClipRequest rename;
+    rename.set_clip_id(third);
+    rename.set_name("renamed/third");
+    rename.add_add_tags("moved");
+    v1::Clip updated;
+    const grpc::Status status = router->UpdateClip(context().get(), rename, &updated);
+    ASSERT_TRUE(status.ok()) << status.error_message() << nodes["r1"].Log();
+    EXPECT_EQ(updated.name(), "renamed/third");
+    EXPECT_THAT(updated.tags(), ::testing::ElementsAre("moved"));
+    const std::string node = map.owners[ShardOfClip(third, map.shard_count())];
+    EXPECT_EQ(clips_on(node).at(third), "renamed/third");
+    EXPECT_EQ(*names.Lookup("renamed/third"), third);
+    EXPECT_EQ(*names.Lookup(old_name), std::nullopt);
+
+    const int64_t fourth = std::next(routed.begin(), 3)->first;
+    rename.set_clip_id(fourth);
+    const grpc::Status taken = router->UpdateClip(context().get(), rename, &updated);
+    EXPECT_EQ(taken.error_code(), grpc::StatusCode::ALREADY_EXISTS) << taken.error_message();
+    EXPECT_THAT(taken.error_message(), HasSubstr(absl::StrCat("taken by clip ", third)));
+    EXPECT_EQ(*names.Lookup(routed.at(fourth)), fourth);
+    rename.set_name("a//b");
+    EXPECT_EQ(router->UpdateClip(context().get(), rename, &updated).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(*names.Lookup("a//b"), std::nullopt);
+    rename.set_name("renamed/fourth");
+    rename.set_clip_id(999'999);  // no such clip: nothing reserved
+    EXPECT_EQ(router->UpdateClip(context().get(), rename, &updated).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+    EXPECT_EQ(*names.Lookup("renamed/fourth"), std::nullopt);
+
+    v1::UpdateClipRequest retag;
+    retag.set_clip_id(fourth);
+    retag.add_add_tags("kept");
+    ASSERT_TRUE(router->UpdateClip(context().get(), retag, &updated).ok());
+    EXPECT_EQ(updated.name(), routed.at(fourth));
+    EXPECT_THAT(updated.tags(), ::testing::ElementsAre("kept"));
+
+    // The old name is free: an ingest under it stores a new clip.
+    v1::IngestClipResponse reused;
+    ASSERT_TRUE(ingest(old_name, 0.9, v1::ON_CONFLICT_UNSPECIFIED, &reused).ok());
+    EXPECT_EQ(reused.result(), v1::INGEST_RESULT_STORED);
+    EXPECT_NE(reused.clip().clip_id(), third);
+    routed[third] = "renamed/third";
+    routed.emplace(reused.clip().clip_id(), old_name);
+  }
+
   // A listing through the router, page by page in each order, is the nodes' clips merged in that
   // order: each page token holds on every node.
   {
@@ -1189,6 +1272,129 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
     const grpc::Status got = router->GetClip(context().get(), get, &clip);
     EXPECT_TRUE(got.ok()) << got.error_message();
     EXPECT_EQ(clip.name(), name);
+  }
+  // A write, which needs the map and the names, waits for etcd until shortly before its
+  // deadline (a tenth of it, here half a second) and is refused UNAVAILABLE then, storing nothing.
+  {
+    v1::IngestClipRequest request;
+    request.set_file_name("while_etcd_is_down.bvh");
+    request.set_bvh(BvhText(ChainClip(0.7)));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    v1::IngestClipResponse response;
+    const grpc::Status refused = router->IngestClip(&context, request, &response);
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAVAILABLE) << refused.error_message();
+    EXPECT_THAT(refused.error_message(), HasSubstr("etcd"));
+    EXPECT_EQ(clips_on("s1"), on_s1);
+  }
+}
+
+// Three etcd members under the motiondb nodes, so that etcd's leader can be killed.
+class ClusterServerFailoverTest : public ClusterEtcdTest {
+ protected:
+  ClusterServerFailoverTest() : ClusterEtcdTest(3) {}
+};
+
+// etcd's leader killed while a router ingests: writes wait while the other two members elect a
+// leader and go on; every ingest acknowledged is stored on its shard's node under its name, and
+// the name is the cluster's. How long the writes stalled is printed, not judged.
+TEST_F(ClusterServerFailoverTest, AnEtcdLeaderKilledMidIngestLosesNothingAcknowledged) {
+  std::map<std::string, testing::ServerProcess> nodes;
+  ShardMap map;
+  ASSERT_NO_FATAL_FAILURE(StartTwoShardsAndARouter(
+      etcd_, *client_, testing::MakeTempDir("cluster_etcd_failover"), nodes, map));
+  auto router = v1::ClipService::NewStub(testing::InsecureChannel(nodes["r1"].address()));
+
+  // One client ingesting take_0, take_1, ... until told to stop.
+  struct Outcome {
+    std::string name;
+    grpc::Status status;
+    int64_t clip_id = 0;
+    std::chrono::steady_clock::time_point answered;
+  };
+  std::mutex mutex;
+  std::vector<Outcome> outcomes;
+  std::atomic<int> acknowledged{0};
+  std::atomic<bool> stop{false};
+  std::thread client([&] {
+    for (int i = 0; !stop && i < 10'000; ++i) {
+      v1::IngestClipRequest request;
+      request.set_file_name("take.bvh");
+      request.set_name(absl::StrCat("take_", i));
+      request.set_bvh(BvhText(ChainClip(0.001 * (i + 1))));
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() + kBound);
+      v1::IngestClipResponse response;
+      Outcome outcome{.name = request.name(),
+                      .status = router->IngestClip(&context, request, &response),
+                      .clip_id = response.clip().clip_id(),
+                      .answered = std::chrono::steady_clock::now()};
+      if (outcome.status.ok()) ++acknowledged;
+      std::lock_guard<std::mutex> lock(mutex);
+      outcomes.push_back(std::move(outcome));
+    }
+  });
+  auto stop_client = absl::MakeCleanup([&] {
+    stop = true;
+    client.join();
+  });
+
+  ASSERT_TRUE(PollUntil([&] { return acknowledged >= 5; })) << nodes["r1"].Log();
+  int leader = -1;
+  ASSERT_TRUE(PollUntil([&] { return (leader = etcd_.Leader()) >= 0; }));
+  const auto killed = std::chrono::steady_clock::now();
+  etcd_.Stop(leader, /*graceful=*/false);
+  const int before = acknowledged;
+  EXPECT_TRUE(PollUntil([&] { return acknowledged >= before + 10; })) << nodes["r1"].Log();
+  std::move(stop_client).Invoke();
+  // `cluster status` shows the members: the one killed unreachable, another leading.
+  const testing::CommandResult cli =
+      testing::RunCli({"cluster", "status", "--etcd", etcd_.endpoints_flag()});
+  EXPECT_EQ(cli.exit_code, 0) << cli.err;
+  EXPECT_THAT(cli.out, HasSubstr(etcd_.endpoints()[leader] + " unreachable"));
+  EXPECT_THAT(cli.out, ::testing::ContainsRegex(":[0-9]+ leader"));
+
+  // The stall: the longest wait for an answer from the kill on (from the kill, or the answer
+  // before).
+  std::map<std::string, int64_t> acked;  // name -> id
+  int refused = 0;
+  std::chrono::steady_clock::duration stall{};
+  std::chrono::steady_clock::time_point last = killed;
+  for (const Outcome& outcome : outcomes) {
+    if (outcome.answered > killed) {
+      stall = std::max(stall, outcome.answered - last);
+      last = outcome.answered;
+    }
+    if (!outcome.status.ok()) {
+      ++refused;
+      std::cout << outcome.name << ": " << outcome.status.error_message() << "\n";
+      continue;
+    }
+    EXPECT_TRUE(acked.emplace(outcome.name, outcome.clip_id).second);
+  }
+  std::cout << "etcd member m" << leader << " (the leader) killed: " << acked.size()
+            << " ingests acknowledged, " << refused << " refused; the longest wait for an answer "
+            << "from the kill on "
+            << std::chrono::duration_cast<std::chrono::milliseconds>(stall).count() << " ms\n";
+
+  std::map<int64_t, std::string> stored;  // id -> name, from the nodes themselves
+  for (const std::string node : {"s1", "s2"}) {
+    auto clips = v1::ClipService::NewStub(testing::InsecureChannel(nodes[node].address()));
+    v1::ListClipsRequest all;
+    all.set_page_size(1000);
+    grpc::ClientContext context;
+    v1::ListClipsResponse listed;
+    ASSERT_TRUE(clips->ListClips(&context, all, &listed).ok()) << node;
+    for (const v1::Clip& clip : listed.clips()) {
+      EXPECT_EQ(map.owners[ShardOfClip(clip.clip_id(), map.shard_count())], node);
+      EXPECT_TRUE(stored.emplace(clip.clip_id(), clip.name()).second);
+    }
+  }
+  const ClipNames names(*client_, "motiondb", 512);
+  for (const auto& [name, id] : acked) {
+    ASSERT_EQ(stored.count(id), 1u) << name << " (clip " << id << ") acknowledged, not stored";
+    EXPECT_EQ(stored.at(id), name);
+    EXPECT_EQ(*names.Lookup(name), id) << name;
   }
 }
 

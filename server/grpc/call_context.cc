@@ -1,5 +1,6 @@
 #include "server/grpc/call_context.h"
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -29,10 +30,12 @@ absl::Status ExplainStop(absl::Status status, const grpc::ServerContext* context
   return absl::CancelledError(absl::StrCat("cancelled by the client (", status.message(), ")"));
 }
 
-absl::Time DeadlineOf(const grpc::ServerContext& context, absl::Duration otherwise) {
+absl::Time WaitDeadlineOf(const grpc::ServerContext& context, absl::Duration otherwise) {
   const auto deadline = context.deadline();
   if (deadline == std::chrono::system_clock::time_point::max()) return absl::Now() + otherwise;
-  return absl::FromChrono(deadline);
+  const absl::Time end = absl::FromChrono(deadline);
+  const absl::Duration left = std::max(end - absl::Now(), absl::ZeroDuration());
+  return end - std::min(left / 10, absl::Seconds(1));
 }
 
 }  // namespace motiondb::server

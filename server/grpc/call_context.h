@@ -19,10 +19,12 @@ std::function<bool()> StopWhenCallEnds(const grpc::ServerContext* context);
 // is told DEADLINE_EXCEEDED. Other statuses pass through.
 absl::Status ExplainStop(absl::Status status, const grpc::ServerContext* context);
 
-// The call's deadline, for what waits on another service (a cluster node's etcd reads); a call
-// without one is given `otherwise` from now.
-absl::Time DeadlineOf(const grpc::ServerContext& context,
-                      absl::Duration otherwise = absl::Seconds(10));
+// When what waits on another service (a cluster node's etcd reads) gives up: a tenth of the
+// time left (at most a second) before the call's deadline, so that the call still answers, saying
+// which service it waited for, rather than the caller seeing only its deadline pass. A call
+// without a deadline is given `otherwise` from now.
+absl::Time WaitDeadlineOf(const grpc::ServerContext& context,
+                          absl::Duration otherwise = absl::Seconds(10));
 
 }  // namespace motiondb::server
 

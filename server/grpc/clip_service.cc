@@ -153,7 +153,7 @@ grpc::Status ClipServiceImpl::UpdateClip(grpc::ServerContext* context,
   return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
     MOTIONDB_ASSIGN_OR_RETURN(
         const storage::ClipRecord updated,
-        catalog_.UpdateClip(request->clip_id(), FromProto(*request), should_stop));
+        catalog_.UpdateClip(request->clip_id(), FromProto(*request), {}, should_stop));
     ToProto(updated, response);
     return absl::OkStatus();
   });

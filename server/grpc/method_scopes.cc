@@ -53,6 +53,7 @@ const absl::flat_hash_map<absl::string_view, TokenScope>& Table() {
       {"/motiondb.v1.SpaceService/GetCurve", S::kRead},
       // A router passes its caller's token on: storing a take is that caller's ingest.
       {"/motiondb.shard.v1.ShardService/StoreTake", S::kWrite},
+      {"/motiondb.shard.v1.ShardService/UpdateClip", S::kWrite},
   };
   return *table;
 }

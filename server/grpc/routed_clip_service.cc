@@ -33,6 +33,13 @@ void PassTokenOn(const grpc::ServerContext& from, grpc::ClientContext* to) {
   }
 }
 
+// A call to a node in the name of the call `from`: its deadline, cancellation and token.
+std::unique_ptr<grpc::ClientContext> NodeContext(const grpc::ServerContext& from) {
+  std::unique_ptr<grpc::ClientContext> call = grpc::ClientContext::FromServerContext(from);
+  PassTokenOn(from, call.get());
+  return call;
+}
+
 // Room in a message beyond its payload (the call's other fields and framing).
 constexpr int64_t kAnswerSlack = 1 << 20;
 
@@ -118,8 +125,7 @@ absl::StatusOr<RoutedClipServiceImpl::NodeCall> RoutedClipServiceImpl::CallClipN
   NodeCall call;
   MOTIONDB_ASSIGN_OR_RETURN(call.route, routing_->Locate(clip_id, /*refresh=*/false));
   call.clips = NodeAt(call.route.address).clips.get();
-  call.context = grpc::ClientContext::FromServerContext(context);
-  PassTokenOn(context, call.context.get());
+  call.context = NodeContext(context);
   return call;
 }
 
@@ -197,9 +203,7 @@ grpc::Status RoutedClipServiceImpl::ListClips(grpc::ServerContext* context,
     std::vector<PartPage> parts(nodes.size());
     int64_t total = 0;
     for (size_t n = 0; n < nodes.size(); ++n) {
-      const std::unique_ptr<grpc::ClientContext> call =
-          grpc::ClientContext::FromServerContext(*context);
-      PassTokenOn(*context, call.get());
+      const std::unique_ptr<grpc::ClientContext> call = NodeContext(*context);
       const grpc::Status status =
           NodeAt(nodes[n].address).clips->ListClips(call.get(), ask, &answers[n]);
       if (!status.ok()) {
@@ -225,27 +229,67 @@ grpc::Status RoutedClipServiceImpl::ListClips(grpc::ServerContext* context,
   });
 }
 
+absl::StatusOr<v1::Clip> RoutedClipServiceImpl::ClipOnNode(NodeCall& call, int64_t clip_id) {
+  v1::GetClipRequest which;
+  which.set_clip_id(clip_id);
+  v1::Clip clip;
+  const grpc::Status status = call.clips->GetClip(call.context.get(), which, &clip);
+  if (!status.ok()) return NodeFailed(status, call.route);
+  return clip;
+}
+
+void RoutedClipServiceImpl::FreeName(const std::string& name, int64_t clip_id,
+                                     absl::string_view done) {
+  // What was done stands whatever etcd says: a name left reserved harms nothing (its next ingest
+  // takes it over: ClipRouter::Route), so a failed release is logged, not told.
+  if (const absl::Status freed = routing_->ReleaseName(name, clip_id); !freed.ok()) {
+    LogLine(absl::StrCat("clip ", clip_id, " was ", done, "; the name '", name,
+                         "' stays reserved for it in the cluster: ", freed.message()));
+  }
+}
+
+grpc::Status RoutedClipServiceImpl::UpdateClip(grpc::ServerContext* context,
+                                               const v1::UpdateClipRequest* request,
+                                               v1::Clip* response) {
+  if (!request->has_name()) {
+    return Pass(context, request->clip_id(), *request, response,
+                &v1::ClipService::Stub::UpdateClip);
+  }
+  return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
+    // Checked before the name is reserved cluster-wide; the shard checks it again.
+    MOTIONDB_RETURN_IF_ERROR(storage::CheckClipName(request->name()));
+    MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, request->clip_id()));
+    MOTIONDB_ASSIGN_OR_RETURN(const v1::Clip before, ClipOnNode(call, request->clip_id()));
+    MOTIONDB_RETURN_IF_ERROR(routing_->ReserveName(request->name(), request->clip_id()));
+    const bool renamed = request->name() != before.name();
+    const grpc::Status status =
+        NodeAt(call.route.address)
+            .shard->UpdateClip(NodeContext(*context).get(), *request, response);
+    if (!status.ok()) {
+      const absl::Status error = NodeFailed(status, call.route);
+      // Refused: the new name is free again. Unanswered: the shard may have renamed the clip,
+      // so the name stays the clip's.
+      if (renamed && !IsOutcomeUnknown(error)) {
+        FreeName(request->name(), request->clip_id(), "not renamed");
+      }
+      return error;
+    }
+    if (renamed) FreeName(before.name(), request->clip_id(), "renamed");
+    return absl::OkStatus();
+  });
+}
+
 grpc::Status RoutedClipServiceImpl::DeleteClip(grpc::ServerContext* context,
                                                const v1::DeleteClipRequest* request,
                                                v1::DeleteClipResponse* response) {
   return Serve(gate_, context, [&](const ShouldStop&) -> absl::Status {
     // The name, to free once the clip is gone.
-    MOTIONDB_ASSIGN_OR_RETURN(NodeCall get, CallClipNode(*context, request->clip_id()));
-    v1::GetClipRequest which;
-    which.set_clip_id(request->clip_id());
-    v1::Clip clip;
-    grpc::Status status = get.clips->GetClip(get.context.get(), which, &clip);
-    if (!status.ok()) return NodeFailed(status, get.route);
     MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, request->clip_id()));
-    status = call.clips->DeleteClip(call.context.get(), *request, response);
+    MOTIONDB_ASSIGN_OR_RETURN(const v1::Clip clip, ClipOnNode(call, request->clip_id()));
+    const grpc::Status status =
+        call.clips->DeleteClip(NodeContext(*context).get(), *request, response);
     if (!status.ok()) return NodeFailed(status, call.route);
-    // The clip is gone whatever etcd says: a name left reserved harms nothing (its next ingest
-    // takes it over: ClipRouter::Route), so a failed release is logged, not told.
-    if (const absl::Status freed = routing_->ReleaseName(clip.name(), request->clip_id());
-        !freed.ok()) {
-      LogLine(absl::StrCat("clip ", request->clip_id(), " was deleted; its name '", clip.name(),
-                           "' stays reserved in the cluster: ", freed.message()));
-    }
+    FreeName(clip.name(), request->clip_id(), "deleted");
     return absl::OkStatus();
   });
 }
@@ -257,12 +301,10 @@ absl::Status RoutedClipServiceImpl::StoreTake(grpc::ServerContext& context,
   // Checked before the name is reserved cluster-wide; the shard checks it again.
   MOTIONDB_RETURN_IF_ERROR(storage::CheckClipName(take_name));
   MOTIONDB_ASSIGN_OR_RETURN(const cluster::ClipRoute route,
-                            routing_->Route(take_name, DeadlineOf(context)));
+                            routing_->Route(take_name, WaitDeadlineOf(context)));
   store.set_take(static_cast<int>(take));
   store.set_clip_id(route.clip_id);
-  // The caller's deadline and cancellation, and its token.
-  const std::unique_ptr<grpc::ClientContext> call = grpc::ClientContext::FromServerContext(context);
-  PassTokenOn(context, call.get());
+  const std::unique_ptr<grpc::ClientContext> call = NodeContext(context);
   const grpc::Status stored = NodeAt(route.address).shard->StoreTake(call.get(), store, response);
   if (stored.ok()) {
     MOTIONDB_RETURN_IF_ERROR(routing_->Settle(take_name, route, response->clip().clip_id()));

@@ -1,8 +1,8 @@
 // motiondb.v1.ClipService on a cluster's router: an ingest's takes each stored on the shard node
 // its clip id belongs to (motiondb.shard.v1.ShardService.StoreTake), the ids and the names
 // reserved cluster-wide first and settled after (`routing`, cluster::ClipRouter); a call on one
-// clip (get, export, poses, delete) passed to its shard's node; a listing asked of every node
-// holding shards and merged (server/listing.h). The rest of the service is not routed yet:
+// clip (get, export, poses, update, delete) passed to its shard's node; a listing asked of every
+// node holding shards and merged (server/listing.h). The rest of the service is not routed yet:
 // UNIMPLEMENTED (ARCHITECTURE.md, "The cluster").
 #ifndef MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
 #define MOTIONDB_SERVER_GRPC_ROUTED_CLIP_SERVICE_H_
@@ -11,6 +11,8 @@
 #include <memory>
 #include <mutex>
 #include <string>
+
+#include "absl/strings/string_view.h"
 
 #include "motiondb/shard/v1/shard_service.grpc.pb.h"
 #include "motiondb/v1/clip_service.grpc.pb.h"
@@ -54,6 +56,10 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
                             v1::ClipPoses* response) override;
   grpc::Status ListClips(grpc::ServerContext* context, const v1::ListClipsRequest* request,
                          v1::ListClipsResponse* response) override;
+  // A rename reserves the new name in the cluster first (ALREADY_EXISTS when another clip holds
+  // it), has the shard rename the clip (ShardService.UpdateClip), then frees the old name.
+  grpc::Status UpdateClip(grpc::ServerContext* context, const v1::UpdateClipRequest* request,
+                          v1::Clip* response) override;
   // Frees the clip's name in the cluster once its shard has deleted it.
   grpc::Status DeleteClip(grpc::ServerContext* context, const v1::DeleteClipRequest* request,
                           v1::DeleteClipResponse* response) override;
@@ -72,6 +78,11 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
     std::unique_ptr<grpc::ClientContext> context;
   };
   absl::StatusOr<NodeCall> CallClipNode(const grpc::ServerContext& context, int64_t clip_id);
+  // The clip as its node holds it (its name, before a rename or a delete), through `call`.
+  absl::StatusOr<v1::Clip> ClipOnNode(NodeCall& call, int64_t clip_id);
+  // Frees `name` in the cluster if clip `clip_id` holds it, once the clip was `done` (deleted,
+  // renamed); a failed release is logged.
+  void FreeName(const std::string& name, int64_t clip_id, absl::string_view done);
   // What a node's failure tells the caller; the clip's node is looked up afresh next time when
   // it did not answer.
   absl::Status NodeFailed(const grpc::Status& status, const cluster::ClipRoute& route);

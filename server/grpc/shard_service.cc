@@ -19,9 +19,22 @@ grpc::Status ShardServiceImpl::StoreTake(grpc::ServerContext* context,
           absl::StrCat("clip_id: ", request->clip_id(), "; a routed take needs a positive id"));
     }
     ingest.routed = IngestRequest::Routed{.take = request->take(), .clip_id = request->clip_id()};
-    MOTIONDB_RETURN_IF_ERROR(check_owner_(request->clip_id(), DeadlineOf(*context)));
+    MOTIONDB_RETURN_IF_ERROR(check_owner_(request->clip_id(), WaitDeadlineOf(*context)));
     return IngestUploadedFile({catalog_, limits_, budget_, metrics_}, ingest,
                               request->ingest().bvh(), should_stop, response);
+  });
+}
+
+grpc::Status ShardServiceImpl::UpdateClip(grpc::ServerContext* context,
+                                          const v1::UpdateClipRequest* request,
+                                          v1::Clip* response) {
+  return Serve(gate_, context, [&](const ShouldStop& should_stop) -> absl::Status {
+    MOTIONDB_RETURN_IF_ERROR(check_owner_(request->clip_id(), WaitDeadlineOf(*context)));
+    MOTIONDB_ASSIGN_OR_RETURN(const storage::ClipRecord updated,
+                              catalog_.UpdateClip(request->clip_id(), FromProto(*request),
+                                                  {.name_reserved = true}, should_stop));
+    ToProto(updated, response);
+    return absl::OkStatus();
   });
 }
 

@@ -36,6 +36,8 @@ class ShardServiceImpl final : public shard::v1::ShardService::Service {
 
   grpc::Status StoreTake(grpc::ServerContext* context, const shard::v1::StoreTakeRequest* request,
                          v1::IngestClipResponse* response) override;
+  grpc::Status UpdateClip(grpc::ServerContext* context, const v1::UpdateClipRequest* request,
+                          v1::Clip* response) override;
 
  private:
   Catalog& catalog_;
