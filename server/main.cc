@@ -67,6 +67,7 @@ struct ServerFlags {
 struct ClusterFlags {
   std::string etcd;
   std::string advertise;
+  std::string token_file;
   motiondb::cluster::ClusterOptions options;
   int lease_s = 5;
 };
@@ -103,6 +104,14 @@ void AddClusterFlags(CLI::App& app, ClusterFlags* cluster) {
       ->type_name("S")
       ->capture_default_str()
       ->check(CLI::Range(2, 3600).description(""))
+      ->needs(etcd);
+  app.add_option("--cluster-token-file", cluster->token_file,
+                 "with --cluster: the cluster's own token, a secret every node is given: a router "
+                 "presents it to the shard nodes, a shard node accepts it (scope 'cluster', which "
+                 "the routers' calls need) beside --auth-token-file's; needed with "
+                 "--auth-token-file")
+      ->type_name("FILE")
+      ->check(motiondb::cli::ExistingFile())
       ->needs(etcd);
 }
 
@@ -434,6 +443,17 @@ int main(int argc, char** argv) {
   }
   if (const absl::Status status = ReadClusterFlags(&cluster); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
+  }
+  if (!cluster.etcd.empty() && !flags.auth_token_file.empty() && cluster.token_file.empty()) {
+    return motiondb::cli::UsageError(
+        app,
+        "--cluster with --auth-token-file needs --cluster-token-file: the token the cluster's "
+        "nodes present to each other (the same file on every node)");
+  }
+  if (!cluster.token_file.empty()) {
+    absl::StatusOr<std::string> token = motiondb::ReadTokenFile(cluster.token_file);
+    if (!token.ok()) return motiondb::cli::UsageError(app, std::string(token.status().message()));
+    options.cluster_token = *std::move(token);
   }
   if (!cluster.etcd.empty() && !flags.tls_cert.empty()) {
     return motiondb::cli::UsageError(

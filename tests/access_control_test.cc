@@ -48,6 +48,8 @@ TEST(ScopedTokenFileTest, BadFilesAreRefusedWithTheirLine) {
     return std::string(ReadScopedTokenFile(WriteTokenFile(text)).status().message());
   };
   EXPECT_NE(error("read a\nroot b\n").find("line 2: unknown scope 'root'"), std::string::npos);
+  // The cluster's scope is its own token's (--cluster-token-file), never a client's.
+  EXPECT_NE(error("cluster c\n").find("line 1: unknown scope 'cluster'"), std::string::npos);
   EXPECT_NE(error("read a\nwrite a\n").find("line 2: this token is given twice"),
             std::string::npos);
   EXPECT_NE(error("read a b c\n").find("line 1: expected 'SCOPE TOKEN'"), std::string::npos);
@@ -57,9 +59,11 @@ TEST(ScopedTokenFileTest, BadFilesAreRefusedWithTheirLine) {
 }
 
 AccessControl Access() {
-  return AccessControl(AccessOptions{
-      .tokens = {{TokenScope::kRead, "r"}, {TokenScope::kWrite, "w"}, {TokenScope::kAdmin, "a"}},
-      .max_failures = 3});
+  return AccessControl(AccessOptions{.tokens = {{TokenScope::kRead, "r"},
+                                                {TokenScope::kWrite, "w"},
+                                                {TokenScope::kAdmin, "a"},
+                                                {TokenScope::kCluster, "c"}},
+                                     .max_failures = 3});
 }
 
 TEST(AccessControlTest, ATokenMayDoWhatItsScopeHolds) {
@@ -72,6 +76,9 @@ TEST(AccessControlTest, ATokenMayDoWhatItsScopeHolds) {
   EXPECT_EQ(decide("Bearer w", TokenScope::kWrite), grpc::StatusCode::OK);
   EXPECT_EQ(decide("Bearer w", TokenScope::kAdmin), grpc::StatusCode::PERMISSION_DENIED);
   EXPECT_EQ(decide("bearer a", TokenScope::kAdmin), grpc::StatusCode::OK);
+  EXPECT_EQ(decide("Bearer a", TokenScope::kCluster), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_EQ(decide("Bearer c", TokenScope::kCluster), grpc::StatusCode::OK);
+  EXPECT_EQ(decide("Bearer c", TokenScope::kAdmin), grpc::StatusCode::OK);
   const AccessControl::Verdict denied =
       access.Decide("POST /v1/labels", TokenScope::kWrite, "10.0.0.1", {"Bearer r"}, "header");
   EXPECT_EQ(denied.status.error_message(),
@@ -155,6 +162,8 @@ TEST(MethodScopesTest, EveryMethodIsInTheTable) {
   EXPECT_GT(methods, 30);
   EXPECT_EQ(RequiredScope("/motiondb.v1.ClipService/DeleteClip"), TokenScope::kAdmin);
   EXPECT_EQ(RequiredScope("/motiondb.v1.Unknown/Thing"), TokenScope::kAdmin);
+  EXPECT_EQ(RequiredScope("/motiondb.shard.v1.ShardService/StoreTake"), TokenScope::kCluster);
+  EXPECT_EQ(RequiredScope("/motiondb.shard.v1.ShardService/UpdateClip"), TokenScope::kCluster);
 }
 
 }  // namespace

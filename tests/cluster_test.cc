@@ -24,6 +24,7 @@
 #include <gtest/gtest.h>
 
 #include "absl/cleanup/cleanup.h"
+#include "absl/strings/escaping.h"
 #include "cluster/clip_id_blocks.h"
 #include "cluster/clip_names.h"
 #include "cluster/cluster_keys.h"
@@ -44,6 +45,8 @@
 #include "tests/clip_builder.h"
 #include "tests/server_fixture.h"
 #include "tests/test_data.h"
+// Last: httplib.h includes <resolv.h>, whose _res macro breaks the Eigen headers above.
+#include <httplib.h>
 
 namespace motiondb::cluster {
 namespace {
@@ -700,19 +703,30 @@ bool Serving(const std::shared_ptr<grpc::Channel>& channel) {
 
 class ClusterServerTest : public ClusterEtcdTest {};
 
-// Shard nodes s1 and s2 and router r1 of the cluster "motiondb" (their databases in `dir`), each
-// listed in etcd, and the map of 4 shards over s1 and s2 that the cluster starts with.
+// Shard nodes s1 and s2 and router r1 of the cluster "motiondb" (their databases in `dir`, their
+// other flags `extra_flags`, the router's HTTP face on with `router_http`), each listed in etcd,
+// and the map of 4 shards over s1 and s2 that the cluster starts with.
 void StartTwoShardsAndARouter(const EtcdProcesses& etcd, const EtcdClient& client,
                               const std::filesystem::path& dir,
-                              std::map<std::string, testing::ServerProcess>& nodes, ShardMap& map) {
+                              std::map<std::string, testing::ServerProcess>& nodes, ShardMap& map,
+                              const std::vector<std::string>& extra_flags = {},
+                              bool router_http = false) {
   std::string error;
   for (const std::string id : {"s1", "s2", "r1"}) {
-    ASSERT_TRUE(
-        nodes[id].Start({"--db", (dir / (id + ".sqlite")).string(), "--http", "off", "--quiet",
-                         "--cluster", etcd.endpoints_flag(), "--node-id", id, "--role",
-                         id == "r1" ? "router" : "shard", "--cluster-lease-s", "2"},
-                        &error))
-        << error;
+    std::vector<std::string> args = {"--db",
+                                     (dir / (id + ".sqlite")).string(),
+                                     "--quiet",
+                                     "--cluster",
+                                     etcd.endpoints_flag(),
+                                     "--node-id",
+                                     id,
+                                     "--role",
+                                     id == "r1" ? "router" : "shard",
+                                     "--cluster-lease-s",
+                                     "2"};
+    if (id != "r1" || !router_http) args.insert(args.end(), {"--http", "off"});
+    args.insert(args.end(), extra_flags.begin(), extra_flags.end());
+    ASSERT_TRUE(nodes[id].Start(args, &error)) << error;
   }
   ASSERT_TRUE(PollUntil([&] {
     return Listed(client, "motiondb", "s1") && Listed(client, "motiondb", "s2") &&
@@ -1396,6 +1410,98 @@ TEST_F(ClusterServerFailoverTest, AnEtcdLeaderKilledMidIngestLosesNothingAcknowl
     EXPECT_EQ(stored.at(id), name);
     EXPECT_EQ(*names.Lookup(name), id) << name;
   }
+}
+
+// With tokens the nodes trust each other by the cluster's own token (--cluster-token-file): a
+// router checks its caller as one node does and presents the cluster's token to the shard nodes,
+// so that its HTTP face, whose in-process calls carry no token on, stores clips too; no client's
+// token, not even an admin's, may call a shard node's ShardService, whose writes bypass the
+// reservation of names.
+TEST_F(ClusterServerTest, NodesTrustEachOtherByTheClusterToken) {
+  const std::filesystem::path dir = testing::MakeTempDir("cluster_tokens");
+  const std::string tokens = (dir / "tokens").string();
+  const std::string cluster_token = (dir / "cluster-token").string();
+  std::ofstream(tokens) << "read r-token\nwrite w-token\nadmin a-token\n";
+  std::ofstream(cluster_token) << "c-token\n";
+  {
+    std::string error;
+    testing::ServerProcess lacking;
+    EXPECT_FALSE(
+        lacking.Start({"--db", (dir / "x.sqlite").string(), "--http", "off", "--cluster",
+                       etcd_.endpoints_flag(), "--node-id", "x", "--auth-token-file", tokens},
+                      &error));
+    EXPECT_THAT(error, HasSubstr("--cluster with --auth-token-file needs --cluster-token-file"));
+  }
+  std::map<std::string, testing::ServerProcess> nodes;
+  ShardMap map;
+  ASSERT_NO_FATAL_FAILURE(StartTwoShardsAndARouter(
+      etcd_, *client_, dir, nodes, map,
+      {"--auth-token-file", tokens, "--cluster-token-file", cluster_token}, /*router_http=*/true));
+  const auto with_token = [](const std::string& token) {
+    auto context = std::make_unique<grpc::ClientContext>();
+    context->set_deadline(std::chrono::system_clock::now() + kBound);
+    if (!token.empty()) context->AddMetadata("authorization", "Bearer " + token);
+    return context;
+  };
+
+  // The router checks its caller as one node does; the nodes see the cluster's token.
+  auto router = v1::ClipService::NewStub(testing::InsecureChannel(nodes["r1"].address()));
+  v1::IngestClipRequest request;
+  request.set_file_name("take.bvh");
+  request.set_bvh(BvhText(ChainClip(0.2)));
+  v1::IngestClipResponse response;
+  EXPECT_EQ(router->IngestClip(with_token("r-token").get(), request, &response).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  grpc::Status status = router->IngestClip(with_token("w-token").get(), request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message() << nodes["r1"].Log();
+  v1::GetClipRequest get;
+  get.set_clip_id(response.clip().clip_id());
+  v1::Clip clip;
+  status = router->GetClip(with_token("r-token").get(), get, &clip);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  v1::DeleteClipRequest remove;
+  remove.set_clip_id(response.clip().clip_id());
+  v1::DeleteClipResponse removed;
+  EXPECT_EQ(router->DeleteClip(with_token("w-token").get(), remove, &removed).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
+  status = router->DeleteClip(with_token("a-token").get(), remove, &removed);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+
+  // Through the router's HTTP face, whose calls carry no token on to the nodes.
+  httplib::Client http("127.0.0.1", nodes["r1"].http_port());
+  http.set_read_timeout(60);
+  http.set_bearer_token_auth("w-token");
+  const httplib::Result posted =
+      http.Post("/v1/clips",
+                absl::StrCat(R"({"file_name":"over_http.bvh","bvh":")",
+                             absl::Base64Escape(BvhText(ChainClip(0.4))), R"("})"),
+                "application/json");
+  ASSERT_TRUE(posted);
+  EXPECT_EQ(posted->status, 200) << posted->body;
+  EXPECT_THAT(posted->body, HasSubstr("over_http"));
+
+  // A shard node's ShardService takes the cluster's token only.
+  int64_t on_s1 = 1'000'000;
+  while (map.owners[ShardOfClip(on_s1, map.shard_count())] != "s1") ++on_s1;
+  auto s1 = shard::v1::ShardService::NewStub(testing::InsecureChannel(nodes["s1"].address()));
+  shard::v1::StoreTakeRequest store;
+  *store.mutable_ingest() = request;
+  store.mutable_ingest()->set_name("around-the-router");
+  store.set_clip_id(on_s1);
+  for (const std::string token : {"a-token", "w-token"}) {
+    status = s1->StoreTake(with_token(token).get(), store, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << token;
+    EXPECT_THAT(status.error_message(), HasSubstr("needs 'cluster'"));
+  }
+  EXPECT_EQ(s1->StoreTake(with_token("").get(), store, &response).error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  status = s1->StoreTake(with_token("c-token").get(), store, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  // Its ClipService answers clients' tokens as one node does.
+  auto s1_clips = v1::ClipService::NewStub(testing::InsecureChannel(nodes["s1"].address()));
+  v1::ListClipsResponse listed;
+  status = s1_clips->ListClips(with_token("r-token").get(), {}, &listed);
+  EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.

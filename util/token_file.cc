@@ -44,6 +44,8 @@ absl::string_view TokenScopeName(TokenScope scope) {
       return "write";
     case TokenScope::kAdmin:
       return "admin";
+    case TokenScope::kCluster:
+      return "cluster";
   }
   return "admin";
 }

@@ -20,9 +20,13 @@ enum class TokenScope {
   kRead = 1,   // search, list, export, curves: what the web page reads
   kWrite = 2,  // and ingest, labels, jobs, spaces, edits
   kAdmin = 3,  // and deletes, backups, metrics
+  // And what a cluster's router asks of its shard nodes (motiondb.shard.v1), having checked its
+  // own caller: held only by the cluster's own token (--cluster-token-file), never by a line of
+  // a token file.
+  kCluster = 4,
 };
 
-// "read", "write", "admin".
+// "read", "write", "admin", "cluster".
 absl::string_view TokenScopeName(TokenScope scope);
 
 struct ScopedToken {

@@ -13,7 +13,8 @@ namespace {
 constexpr absl::string_view kInProcessPeer = "unknown";
 
 std::optional<TokenScope> ScopeNamed(absl::string_view name) {
-  for (const TokenScope scope : {TokenScope::kRead, TokenScope::kWrite, TokenScope::kAdmin}) {
+  for (const TokenScope scope :
+       {TokenScope::kRead, TokenScope::kWrite, TokenScope::kAdmin, TokenScope::kCluster}) {
     if (TokenScopeName(scope) == name) return scope;
   }
   return std::nullopt;

@@ -51,9 +51,9 @@ const absl::flat_hash_map<absl::string_view, TokenScope>& Table() {
       {"/motiondb.v1.SpaceService/GetSpace", S::kRead},
       {"/motiondb.v1.SpaceService/DeleteSpace", S::kAdmin},
       {"/motiondb.v1.SpaceService/GetCurve", S::kRead},
-      // A router passes its caller's token on: storing a take is that caller's ingest.
-      {"/motiondb.shard.v1.ShardService/StoreTake", S::kWrite},
-      {"/motiondb.shard.v1.ShardService/UpdateClip", S::kWrite},
+      // A router, having checked its caller, presents the cluster's own token.
+      {"/motiondb.shard.v1.ShardService/StoreTake", S::kCluster},
+      {"/motiondb.shard.v1.ShardService/UpdateClip", S::kCluster},
   };
   return *table;
 }

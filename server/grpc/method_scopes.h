@@ -1,7 +1,7 @@
 // The scope (util/token_file.h) each motiondb method needs: read for what only reads
 // (search, lists, exports, curves), write for what adds or changes (ingest, labels, jobs,
-// spaces, edits), admin for deletes and backups. The HTTP face asks the same table for the
-// route's method.
+// spaces, edits), admin for deletes and backups, cluster for what a router asks of a shard node
+// (motiondb.shard.v1). The HTTP face asks the same table for the route's method.
 #ifndef MOTIONDB_SERVER_GRPC_METHOD_SCOPES_H_
 #define MOTIONDB_SERVER_GRPC_METHOD_SCOPES_H_
 

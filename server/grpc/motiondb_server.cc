@@ -114,7 +114,11 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   s.uploads = std::make_unique<UploadBudget>(options.uploads);
   s.metrics = std::make_unique<ServerMetrics>(s.registry, *s.database, *s.uploads);
   s.request_log = std::make_unique<RequestLog>(options.log_requests, *s.metrics);
-  s.access = std::make_unique<AccessControl>(AccessOptions{.tokens = options.auth_tokens});
+  std::vector<ScopedToken> tokens = options.auth_tokens;
+  if (options.check_shard_owner && !options.cluster_token.empty()) {
+    tokens.push_back({.scope = TokenScope::kCluster, .token = options.cluster_token});
+  }
+  s.access = std::make_unique<AccessControl>(AccessOptions{.tokens = std::move(tokens)});
   s.gate = std::make_unique<CallGate>(options.threads, options.max_waiting_calls, s.access.get());
   s.watchdog = std::make_unique<StreamWatchdog>(
       StreamLimits{.idle_timeout = std::chrono::seconds(options.stream_idle_timeout_s),
@@ -124,7 +128,7 @@ absl::StatusOr<std::unique_ptr<MotionDbServer>> MotionDbServer::Start(
   if (options.clip_routing) {
     s.clips = std::make_unique<RoutedClipServiceImpl>(
         options.uploads, *s.uploads, *s.watchdog, *s.gate, answers,
-        int64_t{options.max_message_mb} << 20, options.clip_routing);
+        int64_t{options.max_message_mb} << 20, options.clip_routing, options.cluster_token);
   } else {
     s.clips = std::make_unique<ClipServiceImpl>(*s.database, *s.catalog, options.uploads, answers,
                                                 *s.uploads, *s.watchdog, *s.metrics, *s.gate);

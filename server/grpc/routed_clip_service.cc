@@ -25,21 +25,6 @@
 namespace motiondb::server {
 namespace {
 
-// The caller's token, which the shard checks as this node did (the scopes are the same).
-void PassTokenOn(const grpc::ServerContext& from, grpc::ClientContext* to) {
-  const auto token = from.client_metadata().find("authorization");
-  if (token != from.client_metadata().end()) {
-    to->AddMetadata("authorization", std::string(token->second.data(), token->second.size()));
-  }
-}
-
-// A call to a node in the name of the call `from`: its deadline, cancellation and token.
-std::unique_ptr<grpc::ClientContext> NodeContext(const grpc::ServerContext& from) {
-  std::unique_ptr<grpc::ClientContext> call = grpc::ClientContext::FromServerContext(from);
-  PassTokenOn(from, call.get());
-  return call;
-}
-
 // Room in a message beyond its payload (the call's other fields and framing).
 constexpr int64_t kAnswerSlack = 1 << 20;
 
@@ -84,6 +69,14 @@ bool IsOutcomeUnknown(const absl::Status& status) {
 }
 
 }  // namespace
+
+std::unique_ptr<grpc::ClientContext> RoutedClipServiceImpl::NodeContext(
+    const grpc::ServerContext& from) const {
+  std::unique_ptr<grpc::ClientContext> call = grpc::ClientContext::FromServerContext(from);
+  // The caller was checked here; the node checks that the call is the cluster's.
+  if (!cluster_token_.empty()) call->AddMetadata("authorization", "Bearer " + cluster_token_);
+  return call;
+}
 
 RoutedClipServiceImpl::NodeStubs& RoutedClipServiceImpl::NodeAt(const std::string& address) {
   std::lock_guard<std::mutex> lock(mutex_);

@@ -29,17 +29,19 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
  public:
   // `budget` and `watchdog` bound the ingests in progress, as ClipServiceImpl's; a node's
   // answer may be as large as `answers` allows (the nodes' --max-answer-mb), and what is sent to
-  // a node at most `max_message_bytes` (their --max-message-mb).
+  // a node at most `max_message_bytes` (their --max-message-mb). Every call to a node presents
+  // `cluster_token` (ServerOptions::cluster_token), none when it is empty.
   RoutedClipServiceImpl(const UploadLimits& limits, UploadBudget& budget, StreamWatchdog& watchdog,
                         CallGate& gate, const AnswerLimit& answers, int64_t max_message_bytes,
-                        std::shared_ptr<ClipRouting> routing)
+                        std::shared_ptr<ClipRouting> routing, std::string cluster_token)
       : limits_(limits),
         budget_(budget),
         watchdog_(watchdog),
         gate_(gate),
         answers_(answers),
         max_message_bytes_(max_message_bytes),
-        routing_(std::move(routing)) {}
+        routing_(std::move(routing)),
+        cluster_token_(std::move(cluster_token)) {}
 
   grpc::Status IngestClip(grpc::ServerContext* context, const v1::IngestClipRequest* request,
                           v1::IngestClipResponse* response) override;
@@ -71,12 +73,15 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
     std::unique_ptr<v1::ClipService::Stub> clips;
   };
   // A call to the node holding clip `clip_id`, in `context`'s name (its deadline, cancellation
-  // and token).
+  // and the cluster's token).
   struct NodeCall {
     cluster::ClipRoute route;
     v1::ClipService::Stub* clips = nullptr;
     std::unique_ptr<grpc::ClientContext> context;
   };
+  // A call to a node in the name of the call `from`: its deadline and cancellation, and the
+  // cluster's token.
+  std::unique_ptr<grpc::ClientContext> NodeContext(const grpc::ServerContext& from) const;
   absl::StatusOr<NodeCall> CallClipNode(const grpc::ServerContext& context, int64_t clip_id);
   // The clip as its node holds it (its name, before a rename or a delete), through `call`.
   absl::StatusOr<v1::Clip> ClipOnNode(NodeCall& call, int64_t clip_id);
@@ -114,6 +119,7 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
   const AnswerLimit answers_;
   const int64_t max_message_bytes_;
   std::shared_ptr<ClipRouting> routing_;
+  const std::string cluster_token_;
   std::mutex mutex_;
   std::map<std::string, NodeStubs> nodes_;  // guarded by mutex_; by address
 };

@@ -96,6 +96,11 @@ struct ServerOptions {
   // Set on a cluster's router (server/main.cc): ClipService's ingests go to their clips' shard
   // nodes (server/grpc/routed_clip_service.h) instead of this node's database.
   std::shared_ptr<ClipRouting> clip_routing;
+  // A cluster's own token, a secret its nodes share (--cluster-token-file): a router presents it
+  // on every call to a shard node in place of its caller's, whom it has checked itself; a shard
+  // node grants it scope cluster, which ShardService needs. Empty: a router presents no token,
+  // and a shard node's ShardService answers only when it needs none (no auth_tokens).
+  std::string cluster_token;
 };
 
 }  // namespace motiondb::server
