@@ -130,7 +130,17 @@ absl::Status ClipRouter::Settle(const std::string& name, const ClipRoute& route,
     return absl::OkStatus();
   }
   if (route.held_by != 0 && *stored_clip_id == route.clip_id) {
-    return names_.Reassign(name, route.held_by, route.clip_id).status();
+    MOTIONDB_ASSIGN_OR_RETURN(const bool moved,
+                              names_.Reassign(name, route.held_by, route.clip_id));
+    if (moved) return absl::OkStatus();
+    // Freed since the route was chosen (its clip deleted or renamed): the stored clip reserves it.
+    const absl::Status reserved = names_.Reserve(name, route.clip_id);
+    if (absl::IsAlreadyExists(reserved)) {
+      return absl::AbortedError(absl::StrCat("clip ", route.clip_id, " was stored as '", name,
+                                             "', which another clip reserved meanwhile (",
+                                             reserved.message(), "): rename one of them"));
+    }
+    return reserved;
   }
   return absl::OkStatus();
 }

@@ -108,8 +108,8 @@ void AddClusterFlags(CLI::App& app, ClusterFlags* cluster) {
   app.add_option("--cluster-token-file", cluster->token_file,
                  "with --cluster: the cluster's own token, a secret every node is given: a router "
                  "presents it to the shard nodes, a shard node accepts it (scope 'cluster', which "
-                 "the routers' calls need) beside --auth-token-file's; needed with "
-                 "--auth-token-file")
+                 "the routers' calls need) beside --auth-token-file's; given with "
+                 "--auth-token-file, and only then")
       ->type_name("FILE")
       ->check(motiondb::cli::ExistingFile())
       ->needs(etcd);
@@ -444,15 +444,25 @@ int main(int argc, char** argv) {
   if (const absl::Status status = ReadClusterFlags(&cluster); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
   }
-  if (!cluster.etcd.empty() && !flags.auth_token_file.empty() && cluster.token_file.empty()) {
+  // Both or neither: a router given the cluster's token but no client tokens would lend that
+  // token to every caller.
+  if (!cluster.etcd.empty() && flags.auth_token_file.empty() != cluster.token_file.empty()) {
     return motiondb::cli::UsageError(
         app,
-        "--cluster with --auth-token-file needs --cluster-token-file: the token the cluster's "
-        "nodes present to each other (the same file on every node)");
+        "--cluster: --auth-token-file and --cluster-token-file go together (the cluster's token "
+        "is what its nodes present to each other, the same file on every node)");
   }
   if (!cluster.token_file.empty()) {
     absl::StatusOr<std::string> token = motiondb::ReadTokenFile(cluster.token_file);
     if (!token.ok()) return motiondb::cli::UsageError(app, std::string(token.status().message()));
+    for (const motiondb::ScopedToken& client_token : options.auth_tokens) {
+      if (client_token.token == *token) {
+        return motiondb::cli::UsageError(
+            app,
+            "--cluster-token-file: the cluster's token is also one of --auth-token-file's; "
+            "it must be a secret of its own, which no client holds");
+      }
+    }
     options.cluster_token = *std::move(token);
   }
   if (!cluster.etcd.empty() && !flags.tls_cert.empty()) {

@@ -125,6 +125,7 @@ int EtcdProcesses::Leader() const {
         cluster::EtcdClient::Create(cluster::EtcdOptions{.endpoints = {endpoints_[member]},
                                                          .call_timeout = absl::Seconds(2),
                                                          .attempt_timeout = absl::Seconds(1)});
+    if (!client.ok()) continue;
     const absl::StatusOr<cluster::MemberStatus> status = (*client)->Status();
     if (status.ok() && status->leads()) {
       return static_cast<int>(member);

@@ -27,6 +27,7 @@
 #include "absl/strings/escaping.h"
 #include "cluster/clip_id_blocks.h"
 #include "cluster/clip_names.h"
+#include "cluster/clip_router.h"
 #include "cluster/cluster_keys.h"
 #include "cluster/etcd_client.h"
 #include "cluster/leader_election.h"
@@ -477,6 +478,37 @@ TEST_F(ClusterEtcdTest, ClipNamesHaveOneHolderAtATime) {
   const absl::StatusOr<std::optional<int64_t>> odd = names.Lookup("odd");
   EXPECT_EQ(odd.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(std::string(odd.status().message()), HasSubstr("'/names/clip_names/odd'"));
+}
+
+// After a store on a held name's shard the name follows the clip stored; a name its holder gave
+// up meanwhile (renamed, deleted) is reserved for the clip stored; one another clip reserved
+// meanwhile is reported, not taken.
+TEST_F(ClusterEtcdTest, SettleGivesTheNameToTheClipStored) {
+  const ShardMapWatcher watcher(*client_, NodeOptions(etcd_, "settle", "a"), nullptr);
+  ClipRouter router(*client_, watcher, "settle", 512);
+  const ClipNames names(*client_, "settle", 512);
+  ASSERT_TRUE(names.Reserve("walk", 7).ok());
+  ClipRoute route;
+  route.clip_id = 9;
+  route.held_by = 7;
+  ASSERT_TRUE(router.Settle("walk", route, 9).ok());
+  EXPECT_EQ(*names.Lookup("walk"), 9);
+
+  ASSERT_TRUE(*names.Release("walk", 9));
+  route.clip_id = 11;
+  route.held_by = 9;
+  ASSERT_TRUE(router.Settle("walk", route, 11).ok());
+  EXPECT_EQ(*names.Lookup("walk"), 11);
+
+  ASSERT_TRUE(*names.Release("walk", 11));
+  ASSERT_TRUE(names.Reserve("walk", 12).ok());
+  route.clip_id = 13;
+  route.held_by = 11;
+  const absl::Status reported = router.Settle("walk", route, 13);
+  EXPECT_EQ(reported.code(), absl::StatusCode::kAborted);
+  EXPECT_THAT(std::string(reported.message()),
+              HasSubstr("clip 13 was stored as 'walk', which another clip reserved meanwhile"));
+  EXPECT_EQ(*names.Lookup("walk"), 12);
 }
 
 TEST_F(ClusterEtcdTest, ClipNamesWithSlashesAndPrefixesAreEachTheirOwn) {
@@ -949,14 +981,14 @@ TEST_F(ClusterServerTest, AShardNodeStoresOnlyTheClipsOfItsShards) {
   EXPECT_THAT(clips_on_s1(), ::testing::UnorderedElementsAre(id_of["s1"], id_of["s2"]));
 
   // Without etcd the map cannot be read: the write waits until shortly before its deadline (a
-  // tenth of it, here half a second) and fails UNAVAILABLE then.
+  // tenth of it, here a second) and fails UNAVAILABLE then.
   etcd_.Stop(0, /*graceful=*/true);
   shard::v1::StoreTakeRequest request;
   request.mutable_ingest()->set_file_name("late.bvh");
   request.mutable_ingest()->set_bvh(BvhText(ChainClip()));
   request.set_clip_id(id_of["s1"] + 4);
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
   status = s1->StoreTake(&context, request, &stored);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::UNAVAILABLE) << status.error_message();
   EXPECT_THAT(status.error_message(), HasSubstr("the shard map cannot be read"));
@@ -1288,13 +1320,13 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
     EXPECT_EQ(clip.name(), name);
   }
   // A write, which needs the map and the names, waits for etcd until shortly before its
-  // deadline (a tenth of it, here half a second) and is refused UNAVAILABLE then, storing nothing.
+  // deadline (a tenth of it, here a second) and is refused UNAVAILABLE then, storing nothing.
   {
     v1::IngestClipRequest request;
     request.set_file_name("while_etcd_is_down.bvh");
     request.set_bvh(BvhText(ChainClip(0.7)));
     grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
     v1::IngestClipResponse response;
     const grpc::Status refused = router->IngestClip(&context, request, &response);
     EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAVAILABLE) << refused.error_message();
@@ -1423,14 +1455,22 @@ TEST_F(ClusterServerTest, NodesTrustEachOtherByTheClusterToken) {
   const std::string cluster_token = (dir / "cluster-token").string();
   std::ofstream(tokens) << "read r-token\nwrite w-token\nadmin a-token\n";
   std::ofstream(cluster_token) << "c-token\n";
-  {
+  // Client tokens and the cluster's go together, and are not the same.
+  std::ofstream(dir / "bare-token") << "a-token\n";
+  for (const auto& [flags, refusal] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--auth-token-file", tokens},
+            "--auth-token-file and --cluster-token-file go together"},
+           {{"--cluster-token-file", cluster_token},
+            "--auth-token-file and --cluster-token-file go together"},
+           {{"--auth-token-file", tokens, "--cluster-token-file", (dir / "bare-token").string()},
+            "the cluster's token is also one of --auth-token-file's"}}) {
+    std::vector<std::string> args = {"--db",      (dir / "x.sqlite").string(), "--http",    "off",
+                                     "--cluster", etcd_.endpoints_flag(),      "--node-id", "x"};
+    args.insert(args.end(), flags.begin(), flags.end());
     std::string error;
-    testing::ServerProcess lacking;
-    EXPECT_FALSE(
-        lacking.Start({"--db", (dir / "x.sqlite").string(), "--http", "off", "--cluster",
-                       etcd_.endpoints_flag(), "--node-id", "x", "--auth-token-file", tokens},
-                      &error));
-    EXPECT_THAT(error, HasSubstr("--cluster with --auth-token-file needs --cluster-token-file"));
+    testing::ServerProcess refused;
+    EXPECT_FALSE(refused.Start(args, &error));
+    EXPECT_THAT(error, HasSubstr(refusal));
   }
   std::map<std::string, testing::ServerProcess> nodes;
   ShardMap map;
@@ -1495,6 +1535,12 @@ TEST_F(ClusterServerTest, NodesTrustEachOtherByTheClusterToken) {
   }
   EXPECT_EQ(s1->StoreTake(with_token("").get(), store, &response).error_code(),
             grpc::StatusCode::UNAUTHENTICATED);
+  v1::UpdateClipRequest rename;
+  rename.set_clip_id(on_s1);
+  rename.set_name("renamed-around-the-router");
+  v1::Clip renamed;
+  EXPECT_EQ(s1->UpdateClip(with_token("a-token").get(), rename, &renamed).error_code(),
+            grpc::StatusCode::PERMISSION_DENIED);
   status = s1->StoreTake(with_token("c-token").get(), store, &response);
   EXPECT_TRUE(status.ok()) << status.error_message();
   // Its ClipService answers clients' tokens as one node does.
@@ -1502,6 +1548,24 @@ TEST_F(ClusterServerTest, NodesTrustEachOtherByTheClusterToken) {
   v1::ListClipsResponse listed;
   status = s1_clips->ListClips(with_token("r-token").get(), {}, &listed);
   EXPECT_TRUE(status.ok()) << status.error_message();
+
+  // A router given another cluster token is refused by the nodes: its caller is told so, not
+  // that its own token is wrong.
+  std::ofstream(dir / "other-cluster-token") << "not-c-token\n";
+  testing::ServerProcess stray;
+  std::string error;
+  ASSERT_TRUE(stray.Start(
+      {"--db", (dir / "r2.sqlite").string(), "--http", "off", "--quiet", "--cluster",
+       etcd_.endpoints_flag(), "--node-id", "r2", "--role", "router", "--auth-token-file", tokens,
+       "--cluster-token-file", (dir / "other-cluster-token").string()},
+      &error))
+      << error;
+  ASSERT_TRUE(PollUntil([&] { return Listed(*client_, "motiondb", "r2"); }));
+  status = v1::ClipService::NewStub(testing::InsecureChannel(stray.address()))
+               ->ListClips(with_token("r-token").get(), {}, &listed);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INTERNAL);
+  EXPECT_THAT(status.error_message(), HasSubstr("give every node of the cluster the same "
+                                                "--cluster-token-file"));
 }
 
 // A node registers where others reach it (--advertise), and refuses an address nobody reaches.

@@ -99,6 +99,12 @@ absl::Status RoutedClipServiceImpl::NodeFailed(const grpc::Status& status,
                                                const std::string& address,
                                                const std::string& holding) {
   absl::Status error = FromGrpcStatus(status);
+  // The caller was let in here: a node refusing this node's call refuses the cluster's token.
+  if (absl::IsUnauthenticated(error) || absl::IsPermissionDenied(error)) {
+    return absl::InternalError(absl::StrCat(
+        "node '", node_id, "' at ", address, " refused this router's call (", error.message(),
+        "): give every node of the cluster the same --cluster-token-file"));
+  }
   // The node's own refusal (a bad file, a conflict, no such clip) is told as one node tells it.
   if (!absl::IsUnavailable(error)) return error;
   (void)routing_->ShardNodes(/*refresh=*/true);  // its address may have changed
@@ -233,8 +239,9 @@ absl::StatusOr<v1::Clip> RoutedClipServiceImpl::ClipOnNode(NodeCall& call, int64
 
 void RoutedClipServiceImpl::FreeName(const std::string& name, int64_t clip_id,
                                      absl::string_view done) {
-  // What was done stands whatever etcd says: a name left reserved harms nothing (its next ingest
-  // takes it over: ClipRouter::Route), so a failed release is logged, not told.
+  // What was done stands whatever etcd says, so a failed release is logged, not told: a name left
+  // reserved is taken over by its next ingest (ClipRouter::Route); a rename to it is refused
+  // until then.
   if (const absl::Status freed = routing_->ReleaseName(name, clip_id); !freed.ok()) {
     LogLine(absl::StrCat("clip ", clip_id, " was ", done, "; the name '", name,
                          "' stays reserved for it in the cluster: ", freed.message()));
