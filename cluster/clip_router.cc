@@ -115,8 +115,17 @@ absl::StatusOr<std::vector<ShardNode>> ClipRouter::ShardNodes(bool refresh) {
   return nodes;
 }
 
-absl::Status ClipRouter::ReserveName(const std::string& name, int64_t clip_id) {
-  return names_.Reserve(name, clip_id);
+absl::Status ClipRouter::ReserveName(const std::string& name, int64_t clip_id,
+                                     const StillNamed& still_named) {
+  const absl::Status reserved = names_.Reserve(name, clip_id);
+  if (!absl::IsAlreadyExists(reserved)) return reserved;
+  MOTIONDB_ASSIGN_OR_RETURN(const std::optional<int64_t> holder, names_.Lookup(name));
+  if (!holder) return names_.Reserve(name, clip_id);  // freed meanwhile
+  if (*holder == clip_id) return absl::OkStatus();
+  MOTIONDB_ASSIGN_OR_RETURN(const bool holds, still_named(*holder));
+  if (holds) return reserved;
+  MOTIONDB_ASSIGN_OR_RETURN(const bool moved, names_.Reassign(name, *holder, clip_id));
+  return moved ? absl::OkStatus() : reserved;  // changed meanwhile: taken, as far as is known
 }
 
 absl::Status ClipRouter::ReleaseName(const std::string& name, int64_t clip_id) {

@@ -70,8 +70,12 @@ class ClipRouter {
   // (listed afresh from etcd with `refresh`, or when one is unknown): what a listing asks.
   // UNAVAILABLE before the first map, or when a node holding shards is not live (naming it).
   absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh = false);
-  // Reserves `name` for clip `clip_id` (a rename's new name), as ClipNames::Reserve.
-  absl::Status ReserveName(const std::string& name, int64_t clip_id);
+  // Whether clip `clip_id` is still named as a reservation for it says (asked of its node): a
+  // reservation left by a rename or a delete whose release failed is not.
+  using StillNamed = std::function<absl::StatusOr<bool>(int64_t clip_id)>;
+  // Reserves `name` for clip `clip_id` (a rename's new name), as ClipNames::Reserve; a name
+  // reserved for another clip that `still_named` says is not named so any more is taken over.
+  absl::Status ReserveName(const std::string& name, int64_t clip_id, const StillNamed& still_named);
   // Frees `name` if clip `clip_id` holds it (a deleted or renamed clip's), as ClipNames::Release.
   absl::Status ReleaseName(const std::string& name, int64_t clip_id);
 

@@ -72,9 +72,10 @@ absl::StatusOr<ClipRoute> ClusterNode::LocateClip(int64_t clip_id, bool refresh)
   return router_->Locate(clip_id, refresh);
 }
 
-absl::Status ClusterNode::ReserveClipName(const std::string& name, int64_t clip_id) const {
+absl::Status ClusterNode::ReserveClipName(const std::string& name, int64_t clip_id,
+                                          const ClipRouter::StillNamed& still_named) const {
   MOTIONDB_RETURN_IF_ERROR(CheckRouter());
-  return router_->ReserveName(name, clip_id);
+  return router_->ReserveName(name, clip_id, still_named);
 }
 
 absl::Status ClusterNode::ReleaseClipName(const std::string& name, int64_t clip_id) const {

@@ -53,7 +53,8 @@ class ClusterNode {
   // ClipRouter::Locate, ReserveName and ReleaseName on a router; FAILED_PRECONDITION on a shard
   // node.
   absl::StatusOr<ClipRoute> LocateClip(int64_t clip_id, bool refresh) const;
-  absl::Status ReserveClipName(const std::string& name, int64_t clip_id) const;
+  absl::Status ReserveClipName(const std::string& name, int64_t clip_id,
+                               const ClipRouter::StillNamed& still_named) const;
   absl::Status ReleaseClipName(const std::string& name, int64_t clip_id) const;
   // ClipRouter::ShardNodes on a router; FAILED_PRECONDITION on a shard node.
   absl::StatusOr<std::vector<ShardNode>> ShardNodes(bool refresh) const;

@@ -167,9 +167,10 @@ class JoinedNode final : public motiondb::server::ClipRouting {
     MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
     return node->LocateClip(clip_id, refresh);
   }
-  absl::Status ReserveName(const std::string& clip_name, int64_t clip_id) override {
+  absl::Status ReserveName(const std::string& clip_name, int64_t clip_id,
+                           const motiondb::cluster::ClipRouter::StillNamed& still_named) override {
     MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());
-    return node->ReserveClipName(clip_name, clip_id);
+    return node->ReserveClipName(clip_name, clip_id, still_named);
   }
   absl::Status ReleaseName(const std::string& clip_name, int64_t clip_id) override {
     MOTIONDB_ASSIGN_OR_RETURN(const std::shared_ptr<motiondb::cluster::ClusterNode> node, Get());

@@ -1231,6 +1231,20 @@ TEST_F(ClusterServerTest, ARouterStoresEachClipOnItsShard) {
     EXPECT_EQ(router->UpdateClip(context().get(), rename, &updated).error_code(),
               grpc::StatusCode::NOT_FOUND);
     EXPECT_EQ(*names.Lookup("renamed/fourth"), std::nullopt);
+    // A name left reserved for a clip named otherwise now (a release that failed), or for a clip
+    // gone, is taken over; one its clip still has is not (above).
+    for (const auto& [left, holder] : std::vector<std::pair<std::string, int64_t>>{
+             {"left/by-third", third}, {"left/by-a-clip-gone", second}}) {
+      ASSERT_TRUE(names.Reserve(left, holder).ok());
+      rename.clear_add_tags();
+      rename.set_clip_id(fourth);
+      rename.set_name(left);
+      const grpc::Status taken_over = router->UpdateClip(context().get(), rename, &updated);
+      ASSERT_TRUE(taken_over.ok()) << left << ": " << taken_over.error_message();
+      EXPECT_EQ(updated.name(), left);
+      EXPECT_EQ(*names.Lookup(left), fourth);
+    }
+    routed[fourth] = "left/by-a-clip-gone";
 
     v1::UpdateClipRequest retag;
     retag.set_clip_id(fourth);

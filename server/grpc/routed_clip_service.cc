@@ -240,8 +240,7 @@ absl::StatusOr<v1::Clip> RoutedClipServiceImpl::ClipOnNode(NodeCall& call, int64
 void RoutedClipServiceImpl::FreeName(const std::string& name, int64_t clip_id,
                                      absl::string_view done) {
   // What was done stands whatever etcd says, so a failed release is logged, not told: a name left
-  // reserved is taken over by its next ingest (ClipRouter::Route); a rename to it is refused
-  // until then.
+  // reserved is taken over by its next ingest (ClipRouter::Route) or rename (ReserveName).
   if (const absl::Status freed = routing_->ReleaseName(name, clip_id); !freed.ok()) {
     LogLine(absl::StrCat("clip ", clip_id, " was ", done, "; the name '", name,
                          "' stays reserved for it in the cluster: ", freed.message()));
@@ -260,7 +259,16 @@ grpc::Status RoutedClipServiceImpl::UpdateClip(grpc::ServerContext* context,
     MOTIONDB_RETURN_IF_ERROR(storage::CheckClipName(request->name()));
     MOTIONDB_ASSIGN_OR_RETURN(NodeCall call, CallClipNode(*context, request->clip_id()));
     MOTIONDB_ASSIGN_OR_RETURN(const v1::Clip before, ClipOnNode(call, request->clip_id()));
-    MOTIONDB_RETURN_IF_ERROR(routing_->ReserveName(request->name(), request->clip_id()));
+    // A name left reserved for a clip named otherwise now is taken over.
+    const auto still_named = [&](int64_t holder) -> absl::StatusOr<bool> {
+      MOTIONDB_ASSIGN_OR_RETURN(NodeCall holder_call, CallClipNode(*context, holder));
+      const absl::StatusOr<v1::Clip> held = ClipOnNode(holder_call, holder);
+      if (absl::IsNotFound(held.status())) return false;
+      MOTIONDB_RETURN_IF_ERROR(held.status());
+      return held->name() == request->name();
+    };
+    MOTIONDB_RETURN_IF_ERROR(
+        routing_->ReserveName(request->name(), request->clip_id(), still_named));
     const bool renamed = request->name() != before.name();
     const grpc::Status status =
         NodeAt(call.route.address)

@@ -59,7 +59,8 @@ class RoutedClipServiceImpl final : public v1::ClipService::Service {
   grpc::Status ListClips(grpc::ServerContext* context, const v1::ListClipsRequest* request,
                          v1::ListClipsResponse* response) override;
   // A rename reserves the new name in the cluster first (ALREADY_EXISTS when another clip holds
-  // it), has the shard rename the clip (ShardService.UpdateClip), then frees the old name.
+  // it and is still named so), has the shard rename the clip (ShardService.UpdateClip), then frees
+  // the old name.
   grpc::Status UpdateClip(grpc::ServerContext* context, const v1::UpdateClipRequest* request,
                           v1::Clip* response) override;
   // Frees the clip's name in the cluster once its shard has deleted it.
