@@ -135,6 +135,30 @@ absl::Status ReadClusterFlags(ClusterFlags* cluster) {
   return absl::OkStatus();
 }
 
+// The cluster's own token (--cluster-token-file) into `options`, checked against the client
+// tokens already read from `auth_token_file`.
+absl::Status ReadClusterToken(const ClusterFlags& cluster, const std::string& auth_token_file,
+                              motiondb::server::ServerOptions* options) {
+  // Both or neither: a router given the cluster's token but no client tokens would lend that
+  // token to every caller.
+  if (!cluster.etcd.empty() && auth_token_file.empty() != cluster.token_file.empty()) {
+    return absl::InvalidArgumentError(
+        "--cluster: --auth-token-file and --cluster-token-file go together (the cluster's token "
+        "is what its nodes present to each other, the same file on every node)");
+  }
+  if (cluster.token_file.empty()) return absl::OkStatus();
+  MOTIONDB_ASSIGN_OR_RETURN(std::string token, motiondb::ReadTokenFile(cluster.token_file));
+  for (const motiondb::ScopedToken& client_token : options->auth_tokens) {
+    if (client_token.token == token) {
+      return absl::InvalidArgumentError(
+          "--cluster-token-file: the cluster's token is also one of --auth-token-file's; it must "
+          "be a secret of its own, which no client holds");
+    }
+  }
+  options->cluster_token = std::move(token);
+  return absl::OkStatus();
+}
+
 // The cluster node once it has joined, for a shard's checks and a router's routes: the server
 // starts serving first, since the node advertises the port it listens on.
 class JoinedNode final : public motiondb::server::ClipRouting {
@@ -445,26 +469,9 @@ int main(int argc, char** argv) {
   if (const absl::Status status = ReadClusterFlags(&cluster); !status.ok()) {
     return motiondb::cli::UsageError(app, std::string(status.message()));
   }
-  // Both or neither: a router given the cluster's token but no client tokens would lend that
-  // token to every caller.
-  if (!cluster.etcd.empty() && flags.auth_token_file.empty() != cluster.token_file.empty()) {
-    return motiondb::cli::UsageError(
-        app,
-        "--cluster: --auth-token-file and --cluster-token-file go together (the cluster's token "
-        "is what its nodes present to each other, the same file on every node)");
-  }
-  if (!cluster.token_file.empty()) {
-    absl::StatusOr<std::string> token = motiondb::ReadTokenFile(cluster.token_file);
-    if (!token.ok()) return motiondb::cli::UsageError(app, std::string(token.status().message()));
-    for (const motiondb::ScopedToken& client_token : options.auth_tokens) {
-      if (client_token.token == *token) {
-        return motiondb::cli::UsageError(
-            app,
-            "--cluster-token-file: the cluster's token is also one of --auth-token-file's; "
-            "it must be a secret of its own, which no client holds");
-      }
-    }
-    options.cluster_token = *std::move(token);
+  if (const absl::Status status = ReadClusterToken(cluster, flags.auth_token_file, &options);
+      !status.ok()) {
+    return motiondb::cli::UsageError(app, std::string(status.message()));
   }
   if (!cluster.etcd.empty() && !flags.tls_cert.empty()) {
     return motiondb::cli::UsageError(
